@@ -1,0 +1,25 @@
+"""pamdp: deep reinforcement learning in parameterized action spaces.
+
+Importing the package registers its environments with Gymnasium (``pamdp/Platform-v0``,
+``pamdp/HalfFieldOffense-v0``). Algorithms are importable from here: ``from pamdp import PATRPO``.
+"""
+
+from importlib import import_module
+
+from pamdp.envs import register_envs
+from pamdp.spaces import HybridActionSpace
+
+__version__ = "0.1.0"
+
+register_envs()
+
+_ALGOS = {"PATRPO": "pamdp.algos.patrpo", "PASVG0": "pamdp.algos.pasvg", "PADDPG": "pamdp.algos.paddpg"}
+
+__all__ = ["HybridActionSpace", "register_envs", "__version__", *_ALGOS]
+
+
+def __getattr__(name):
+    # Algorithms import torch; load them on first use so that `import pamdp` (and env creation) stays light.
+    if name in _ALGOS:
+        return getattr(import_module(_ALGOS[name]), name)
+    raise AttributeError(f"module 'pamdp' has no attribute {name!r}")

@@ -1,0 +1,1 @@
+"""Learning algorithms for parameterized action spaces, sharing one API (see ``base.py``)."""

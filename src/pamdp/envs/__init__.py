@@ -1,0 +1,32 @@
+"""Parameterized-action domains, registered with Gymnasium on ``import pamdp``.
+
+- ``pamdp/Platform-v0``: Masson, Ranchod & Konidaris' Platform (``platform.py``).
+- ``pamdp/HalfFieldOffense-v0``: Half Field Offense 1v0, empty goal (``hfo.py``).
+
+Each has a scalar ``gymnasium.Env`` and a batched NumPy ``gymnasium.vector.VectorEnv`` registered as
+its ``vector_entry_point``, so ``gymnasium.make_vec(id, num_envs=N,
+vectorization_mode="vector_entry_point")`` returns the batched version.
+"""
+
+from __future__ import annotations
+
+import gymnasium
+
+_REGISTRATIONS = {
+    "pamdp/Platform-v0": dict(
+        entry_point="pamdp.envs.platform:PlatformEnv",
+        vector_entry_point="pamdp.envs.platform:PlatformVectorEnv",
+        max_episode_steps=200,
+    ),
+    "pamdp/HalfFieldOffense-v0": dict(
+        entry_point="pamdp.envs.hfo:HalfFieldOffenseEnv",
+        vector_entry_point="pamdp.envs.hfo:HalfFieldOffenseVectorEnv",
+    ),
+}
+
+
+def register_envs() -> None:
+    """Register pamdp's environments with Gymnasium (idempotent)."""
+    for env_id, kwargs in _REGISTRATIONS.items():
+        if env_id not in gymnasium.registry:
+            gymnasium.register(id=env_id, **kwargs)
