@@ -1,0 +1,508 @@
+"""What every pamdp algorithm shares: settings, environments, the epoch loop, logging and checkpoints.
+
+The public API is Stable-Baselines3's, which users know: ``Algo(env, config)``, ``.learn(total_timesteps)``,
+``.predict(obs, deterministic=True)``, ``.save(path)``, ``Algo.load(path)``. An algorithm subclasses
+:class:`Algorithm` (one level of inheritance) and provides ``_build`` (networks and optimisers),
+``_run_epoch`` (collect and learn from one epoch of samples), ``_act`` (actions for a batch of
+observations) and ``_modules``/``_optimizers`` (what a checkpoint holds).
+
+Checkpoints are one file written atomically (a temporary file, fsync, rename) holding tensors and plain
+data only; they are read back with ``torch.load(weights_only=True)``, so loading never executes code.
+"""
+
+from __future__ import annotations
+
+import csv
+import dataclasses
+import math
+import os
+import tempfile
+import time
+import types
+import typing
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any, ClassVar
+
+import gymnasium
+import numpy as np
+import torch
+from gymnasium import spaces
+from gymnasium.vector import AutoresetMode
+
+import pamdp
+from pamdp.spaces import HybridActionSpace
+
+__all__ = ["AlgoConfig", "Algorithm", "setting", "load_model", "make_vector_env", "EpisodeTracker", "Logger"]
+
+FINAL_MODEL = "final_model.pt"
+CHECKPOINT = "checkpoint.pt"
+_FORMAT = "pamdp-checkpoint"
+
+
+def setting(default: Any, help: str) -> Any:
+    """A documented dataclass field: the ``help`` text is the field's documentation and its CLI help."""
+    if isinstance(default, (list, dict)):
+        raise TypeError("use tuples for sequence settings, so that configs stay immutable")
+    return dataclasses.field(default=default, metadata={"help": help})
+
+
+@dataclasses.dataclass(frozen=True)
+class AlgoConfig:
+    """Settings every algorithm has. Subclasses add their own and a ``presets()`` table."""
+
+    seed: int = setting(0, "Seeds the networks' initialisation, action sampling and the environments.")
+    num_envs: int = setting(
+        16, "Copies of the environment stepped together (batched when the env has a vector version)."
+    )
+    torch_threads: int = setting(
+        1, "Torch intra-op threads; 1 is fastest for these small networks on a laptop CPU."
+    )
+
+    def __post_init__(self):
+        for f in dataclasses.fields(self):
+            value = getattr(self, f.name)
+            if isinstance(value, float) and not math.isfinite(value):
+                raise ValueError(f"{type(self).__name__}.{f.name} = {value!r}; expected a finite number")
+        self._check(self.num_envs >= 1, "num_envs", "an integer >= 1")
+        self._check(self.torch_threads >= 1, "torch_threads", "an integer >= 1")
+
+    def _check(self, ok: bool, name: str, expected: str) -> None:
+        if not ok:
+            raise ValueError(f"{type(self).__name__}.{name} = {getattr(self, name)!r}; expected {expected}")
+
+    @classmethod
+    def presets(cls) -> dict[str, AlgoConfig]:
+        """Named settings, e.g. ``"paper"``; the first one is the default."""
+        return {"default": cls()}
+
+    @classmethod
+    def preset(cls, name: str) -> AlgoConfig:
+        table = cls.presets()
+        if name not in table:
+            raise ValueError(
+                f"unknown preset {name!r} for {cls.__name__}; expected one of {', '.join(table)}"
+            )
+        return table[name]
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            f.name: (list(v) if isinstance(v := getattr(self, f.name), tuple) else v)
+            for f in dataclasses.fields(self)
+        }
+
+    @classmethod
+    def field_types(cls) -> dict[str, Any]:
+        return typing.get_type_hints(cls)
+
+    @classmethod
+    def from_dict(cls, values: dict[str, Any], base: AlgoConfig | None = None) -> AlgoConfig:
+        """Settings from plain data (a config file, a checkpoint), over ``base`` (default: the defaults).
+
+        Unknown names and values of the wrong type raise a ``ValueError`` naming them.
+        """
+        base = base if base is not None else cls()
+        names = {f.name for f in dataclasses.fields(cls)}
+        unknown = sorted(set(values) - names)
+        if unknown:
+            raise ValueError(f"unknown {cls.__name__} setting(s) {unknown}; expected some of {sorted(names)}")
+        hints = cls.field_types()
+        return dataclasses.replace(base, **{k: _coerce(k, v, hints[k]) for k, v in values.items()})
+
+
+def _coerce(name: str, value: Any, hint: Any) -> Any:
+    """Check a plain value against a field's type hint, converting lists to tuples and ints to floats."""
+    origin = typing.get_origin(hint)
+    if origin in (typing.Union, types.UnionType):
+        options = typing.get_args(hint)
+        if value is None and type(None) in options:
+            return None
+        hint = next(t for t in options if t is not type(None))
+        origin = typing.get_origin(hint)
+    if origin is tuple:
+        if not isinstance(value, (list, tuple)):
+            raise ValueError(f"setting {name!r} = {value!r}; expected a list")
+        (item,) = {a for a in typing.get_args(hint) if a is not Ellipsis}
+        return tuple(_coerce(name, v, item) for v in value)
+    if hint is float and isinstance(value, (int, float)) and not isinstance(value, bool):
+        return float(value)
+    if hint in (int, str, bool) and type(value) is not hint:
+        raise ValueError(f"setting {name!r} = {value!r}; expected {hint.__name__}")
+    return value
+
+
+# -- environments -----------------------------------------------------------------------------------
+def make_vector_env(env_id: str, num_envs: int, env_kwargs: dict | None = None) -> gymnasium.vector.VectorEnv:
+    """The batched env when the id has a ``vector_entry_point``, else synchronous copies of the scalar env."""
+    spec = gymnasium.spec(env_id)
+    mode = "vector_entry_point" if spec.vector_entry_point is not None else "sync"
+    return gymnasium.make_vec(env_id, num_envs=num_envs, vectorization_mode=mode, **(env_kwargs or {}))
+
+
+def _describe_env(env) -> tuple[str | None, dict, spaces.Space, spaces.Space]:
+    """``(env_id, env_kwargs, single observation space, single action space)`` of what a user passed."""
+    if isinstance(env, str):
+        spec = gymnasium.spec(env)
+        probe = gymnasium.make(env)
+        obs_space, act_space = probe.observation_space, probe.action_space
+        probe.close()
+        return spec.id, {}, obs_space, act_space
+    if isinstance(env, gymnasium.vector.VectorEnv):
+        spec = env.spec
+        return (
+            (spec.id if spec else None),
+            dict(spec.kwargs if spec else {}),
+            env.single_observation_space,
+            env.single_action_space,
+        )
+    if isinstance(env, gymnasium.Env):
+        spec = env.spec
+        return (
+            (spec.id if spec else None),
+            dict(spec.kwargs if spec else {}),
+            env.observation_space,
+            env.action_space,
+        )
+    raise ValueError(f"env must be a registered env id, a gymnasium.Env or a VectorEnv; got {env!r}")
+
+
+class EpisodeTracker:
+    """Running return and length per env copy; completed episodes are kept until :meth:`pop`."""
+
+    def __init__(self, num_envs: int):
+        self.returns = np.zeros(num_envs)
+        self.lengths = np.zeros(num_envs, dtype=np.int64)
+        self.done_returns: list[float] = []
+        self.done_lengths: list[int] = []
+
+    def reset(self) -> None:
+        self.returns[:] = 0.0
+        self.lengths[:] = 0
+
+    def step(self, rewards: np.ndarray, dones: np.ndarray, valid: np.ndarray) -> None:
+        """Add one vector step; ``valid`` is false for the autoreset steps of Gymnasium's vector envs."""
+        self.returns += np.where(valid, rewards, 0.0)
+        self.lengths += valid
+        ended = dones & valid
+        self.done_returns += self.returns[ended].tolist()
+        self.done_lengths += self.lengths[ended].tolist()
+        self.returns[ended] = 0.0
+        self.lengths[ended] = 0
+
+    def pop(self) -> dict[str, float]:
+        """Statistics of the episodes completed since the last call (empty if none)."""
+        if not self.done_returns:
+            return {}
+        stats = {
+            "charts/episodic_return": float(np.mean(self.done_returns)),
+            "charts/episodic_length": float(np.mean(self.done_lengths)),
+            "charts/episodes": float(len(self.done_returns)),
+        }
+        self.done_returns, self.done_lengths = [], []
+        return stats
+
+
+# -- logging ------------------------------------------------------------------------------------------
+class Logger:
+    """One CSV row and a set of TensorBoard scalars per epoch, in ``run_dir/progress.csv`` and ``run_dir/tb``.
+
+    On resume (``resume_step > 0``) rows logged after the checkpoint being resumed are dropped, so that a
+    killed and restarted run leaves one clean log.
+    """
+
+    def __init__(self, run_dir: str | os.PathLike, resume_step: int = 0):
+        from torch.utils.tensorboard import SummaryWriter
+
+        self.run_dir = Path(run_dir)
+        self.run_dir.mkdir(parents=True, exist_ok=True)
+        self.csv_path = self.run_dir / "progress.csv"
+        self.rows: list[dict[str, Any]] = []
+        if self.csv_path.exists():
+            with open(self.csv_path, newline="") as f:
+                self.rows = [r for r in csv.DictReader(f) if float(r["time/total_timesteps"]) <= resume_step]
+        if resume_step == 0:
+            self.rows = []
+        self.writer = SummaryWriter(str(self.run_dir / "tb"), purge_step=resume_step or None)
+
+    def record(self, stats: dict[str, float], step: int) -> None:
+        for key, value in stats.items():
+            self.writer.add_scalar(key, value, step)
+        self.writer.flush()
+        self.rows.append(stats)
+        columns: list[str] = []
+        for row in self.rows:
+            columns += [k for k in row if k not in columns]
+        tmp = self.csv_path.with_suffix(".csv.tmp")
+        with open(tmp, "w", newline="") as f:
+            writer = csv.DictWriter(f, fieldnames=columns)
+            writer.writeheader()
+            writer.writerows(self.rows)
+        os.replace(tmp, self.csv_path)
+
+    def close(self) -> None:
+        self.writer.close()
+
+
+# -- checkpoints --------------------------------------------------------------------------------------
+def atomic_save(payload: dict, path: str | os.PathLike) -> None:
+    """``torch.save`` to a temporary file beside ``path``, fsync, then rename over it."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as f:
+            torch.save(payload, f)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+        raise
+
+
+def _resolve_model_path(path: str | os.PathLike) -> Path:
+    path = Path(path)
+    if path.is_dir():
+        for name in (FINAL_MODEL, CHECKPOINT):
+            if (path / name).is_file():
+                return path / name
+        raise FileNotFoundError(f"run directory {path} holds neither {FINAL_MODEL} nor {CHECKPOINT}")
+    if not path.is_file():
+        raise FileNotFoundError(f"no pamdp model at {path}: expected a checkpoint file or a run directory")
+    return path
+
+
+def read_checkpoint(path: str | os.PathLike) -> dict:
+    """Read a checkpoint with ``weights_only=True``; a file that is not one raises a clear ``ValueError``."""
+    path = _resolve_model_path(path)
+    try:
+        payload = torch.load(path, map_location="cpu", weights_only=True)
+    except Exception as exc:
+        raise ValueError(f"{path} is not a readable pamdp checkpoint ({type(exc).__name__}: {exc})") from exc
+    if not isinstance(payload, dict) or payload.get("format") != _FORMAT:
+        raise ValueError(f"{path} is not a pamdp checkpoint (no '{_FORMAT}' header)")
+    return payload
+
+
+_REGISTRY: dict[str, type[Algorithm]] = {}
+
+
+def load_model(path: str | os.PathLike, env=None) -> Algorithm:
+    """Load any pamdp model (file or run directory), whichever algorithm wrote it."""
+    payload = read_checkpoint(path)
+    name = payload["algo"]
+    if name not in _REGISTRY:
+        import_module_for = {"PATRPO": "patrpo", "PASVG0": "pasvg", "PADDPG": "paddpg"}
+        if name in import_module_for:
+            __import__(f"pamdp.algos.{import_module_for[name]}")
+    if name not in _REGISTRY:
+        raise ValueError(f"{path} was written by unknown algorithm {name!r}")
+    return _REGISTRY[name]._from_payload(payload, env)
+
+
+class Algorithm:
+    """Base class of pamdp's algorithms; see the module docstring for what a subclass provides."""
+
+    config_class: ClassVar[type[AlgoConfig]] = AlgoConfig
+
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        _REGISTRY[cls.__name__] = cls
+
+    def __init__(self, env, config: AlgoConfig | None = None, env_kwargs: dict | None = None):
+        config = self.config_class() if config is None else config
+        if not isinstance(config, self.config_class):
+            raise ValueError(
+                f"{type(self).__name__} needs a {self.config_class.__name__}, got {type(config).__name__}"
+            )
+        self.config = config
+        env_id, spec_kwargs, obs_space, act_space = _describe_env(env)
+        self.env_id = env_id
+        self.env_kwargs = {**spec_kwargs, **(env_kwargs or {})}
+        self._env_arg = None if isinstance(env, str) else env
+        if not (isinstance(obs_space, spaces.Box) and len(obs_space.shape) == 1):
+            raise ValueError(f"observation space {obs_space!r} is not supported; expected a 1-D Box")
+        self.observation_space = obs_space
+        self.action_space = act_space
+        self.hybrid = HybridActionSpace.from_gym(act_space)
+        self.obs_dim = int(obs_space.shape[0])
+        self.num_timesteps = 0
+        self.epoch = 0
+        self.np_rng = np.random.default_rng(config.seed)
+        self.torch_gen = torch.Generator().manual_seed(config.seed)
+        with torch.random.fork_rng():
+            torch.manual_seed(config.seed)
+            self._build()
+        self._vec_env: gymnasium.vector.VectorEnv | None = None
+
+    # -- to be provided by each algorithm ----------------------------------------------------
+    def _build(self) -> None:
+        raise NotImplementedError
+
+    def _run_epoch(self) -> dict[str, float]:
+        """Collect one epoch of samples and learn from them; returns statistics including ``"steps"``."""
+        raise NotImplementedError
+
+    def _act(self, obs: torch.Tensor, deterministic: bool) -> tuple[torch.Tensor, torch.Tensor]:
+        """Discrete actions ``(B,)`` and padded ``[-1, 1]`` parameters ``(B, m)`` for a batch of observations."""
+        raise NotImplementedError
+
+    def _modules(self) -> dict[str, torch.nn.Module]:
+        raise NotImplementedError
+
+    def _optimizers(self) -> dict[str, torch.optim.Optimizer]:
+        return {}
+
+    def _extra_state(self) -> dict:
+        return {}
+
+    def _load_extra_state(self, state: dict) -> None:
+        pass
+
+    # -- environments ------------------------------------------------------------------------
+    @property
+    def vec_env(self) -> gymnasium.vector.VectorEnv:
+        """The batched training env, created on first use."""
+        if self._vec_env is None:
+            if isinstance(self._env_arg, gymnasium.vector.VectorEnv):
+                self._vec_env = self._env_arg
+            elif self.env_id is not None:
+                self._vec_env = make_vector_env(self.env_id, self.config.num_envs, self.env_kwargs)
+            else:
+                env = self._env_arg
+                self._vec_env = gymnasium.vector.SyncVectorEnv([lambda: env])
+            mode = self._vec_env.metadata.get("autoreset_mode", AutoresetMode.NEXT_STEP)
+            if AutoresetMode(mode) != AutoresetMode.NEXT_STEP:
+                raise ValueError(
+                    f"vector env with autoreset mode {mode!r}; pamdp expects {AutoresetMode.NEXT_STEP!r}"
+                )
+        return self._vec_env
+
+    def _obs_tensor(self, obs) -> torch.Tensor:
+        return torch.as_tensor(np.asarray(obs, dtype=np.float32))
+
+    # -- public API --------------------------------------------------------------------------
+    def predict(self, obs, deterministic: bool = True):
+        """The action for one observation (the env's action tuple) or a batch (a vector env's action)."""
+        obs = np.asarray(obs, dtype=np.float32)
+        single = obs.ndim == 1
+        if obs.shape[-1] != self.obs_dim or obs.ndim not in (1, 2):
+            raise ValueError(
+                f"observation of shape {obs.shape}; expected ({self.obs_dim},) or (N, {self.obs_dim})"
+            )
+        with torch.no_grad():
+            a, x = self._act(torch.as_tensor(obs.reshape(-1, self.obs_dim)), deterministic)
+        a, x = a.numpy(), x.numpy()
+        return self.hybrid.to_env(a[0], x[0]) if single else self.hybrid.to_env_batch(a, x)
+
+    def learn(
+        self,
+        total_timesteps: int,
+        callback: Callable[[Algorithm, dict[str, float]], bool | None] | None = None,
+        progress_bar: bool = True,
+        run_dir: str | os.PathLike | None = None,
+        checkpoint_every: int = 1,
+    ) -> Algorithm:
+        """Train for ``total_timesteps`` more environment steps, in whole epochs.
+
+        Args:
+            callback: called after every epoch with the algorithm and the epoch's statistics; returning
+                ``False`` stops training.
+            progress_bar: show a tqdm progress bar on the terminal.
+            run_dir: where to write ``progress.csv``, TensorBoard logs (``tb/``) and ``checkpoint.pt``.
+            checkpoint_every: epochs between checkpoints (with ``run_dir``).
+        """
+        from tqdm.auto import tqdm
+
+        if total_timesteps < 0:
+            raise ValueError(f"total_timesteps = {total_timesteps!r}; expected a non-negative integer")
+        torch.set_num_threads(self.config.torch_threads)
+        target = self.num_timesteps + int(total_timesteps)
+        logger = Logger(run_dir, resume_step=self.num_timesteps) if run_dir is not None else None
+        start_steps, start_time = self.num_timesteps, time.perf_counter()
+        bar = tqdm(
+            total=target,
+            initial=self.num_timesteps,
+            disable=not progress_bar,
+            unit="step",
+            dynamic_ncols=True,
+        )
+        try:
+            while self.num_timesteps < target:
+                t0 = time.perf_counter()
+                stats = self._run_epoch()
+                self.num_timesteps += int(stats.pop("steps"))
+                self.epoch += 1
+                elapsed = time.perf_counter() - t0
+                stats.update(
+                    {
+                        "time/epoch": float(self.epoch),
+                        "time/total_timesteps": float(self.num_timesteps),
+                        "time/epoch_seconds": elapsed,
+                        "charts/SPS": (self.num_timesteps - start_steps) / (time.perf_counter() - start_time),
+                    }
+                )
+                if logger is not None:
+                    logger.record(stats, self.num_timesteps)
+                    if self.epoch % checkpoint_every == 0:
+                        self.save(Path(run_dir) / CHECKPOINT)
+                bar.update(self.num_timesteps - bar.n)
+                if "charts/episodic_return" in stats:
+                    bar.set_postfix(ret=f"{stats['charts/episodic_return']:.3f}", epoch=self.epoch)
+                if callback is not None and callback(self, stats) is False:
+                    break
+        finally:
+            bar.close()
+            if logger is not None:
+                logger.close()
+        return self
+
+    def save(self, path: str | os.PathLike) -> None:
+        """Write weights, optimiser states, settings, counters and RNG states to one file, atomically."""
+        payload = {
+            "format": _FORMAT,
+            "pamdp_version": pamdp.__version__,
+            "algo": type(self).__name__,
+            "config": self.config.to_dict(),
+            "env_id": self.env_id,
+            "env_kwargs": self.env_kwargs,
+            "num_timesteps": self.num_timesteps,
+            "epoch": self.epoch,
+            "rng": {"numpy": self.np_rng.bit_generator.state, "torch": self.torch_gen.get_state()},
+            "modules": {k: m.state_dict() for k, m in self._modules().items()},
+            "optimizers": {k: o.state_dict() for k, o in self._optimizers().items()},
+            "extra": self._extra_state(),
+        }
+        atomic_save(payload, path)
+
+    @classmethod
+    def load(cls, path: str | os.PathLike, env=None) -> Algorithm:
+        """Load a model saved by :meth:`save`, or the final model of a run directory written by ``pamdp train``.
+
+        ``env`` (an id, env or vector env) replaces the env recorded in the file.
+        """
+        payload = read_checkpoint(path)
+        if payload["algo"] != cls.__name__:
+            raise ValueError(f"{path} holds a {payload['algo']} model, not a {cls.__name__} one")
+        return cls._from_payload(payload, env)
+
+    @classmethod
+    def _from_payload(cls, payload: dict, env=None) -> Algorithm:
+        config = cls.config_class.from_dict(payload["config"])
+        if env is None:
+            if payload["env_id"] is None:
+                raise ValueError("this model was trained on an unregistered env; pass env= to load it")
+            algo = cls(payload["env_id"], config, env_kwargs=payload["env_kwargs"])
+        else:
+            algo = cls(env, config)
+        for name, module in algo._modules().items():
+            module.load_state_dict(payload["modules"][name])
+        for name, opt in algo._optimizers().items():
+            opt.load_state_dict(payload["optimizers"][name])
+        algo._load_extra_state(payload["extra"])
+        algo.num_timesteps = int(payload["num_timesteps"])
+        algo.epoch = int(payload["epoch"])
+        algo.np_rng.bit_generator.state = payload["rng"]["numpy"]
+        algo.torch_gen.set_state(payload["rng"]["torch"])
+        return algo

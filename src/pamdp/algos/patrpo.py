@@ -1,0 +1,342 @@
+"""PATRPO: Trust Region Policy Optimization of the hierarchical policy (Wei, Wicke & Luke 2018).
+
+One epoch, as section "Parameterized Actions TRPO" of the paper reads:
+
+1. Sample ``batch_size`` steps with ``(a, x) ~ pi_d(a|s) pi_c(x|s,a)`` from the batched env.
+2. Advantages by GAE(``gamma``, ``gae_lambda``) from the baseline; a step cut by the time limit (or by the
+   end of the epoch) bootstraps from the baseline, a true termination does not. Then refit the baseline.
+3. Maximise the surrogate ``E[pi(a,x|s) / pi_old(a,x|s) * A]`` subject to ``mean KL(pi_old || pi) <= delta``,
+   the joint KL estimated by ``kl_estimator`` (the chain rule splits it into the discrete KL plus the
+   parameter policy's KL): natural-gradient direction by conjugate gradient on the Fisher-vector product,
+   step length ``sqrt(2 delta / (d^T H d))``, backtracking line search.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import torch
+
+from pamdp.algos.base import AlgoConfig, Algorithm, EpisodeTracker, setting
+from pamdp.algos.trpo import FisherVectorProduct, backtracking_line_search, conjugate_gradient, flat_grad
+from pamdp.distributions import KL_ESTIMATORS, kl_divergence
+from pamdp.policies import ACTIVATIONS, HybridPolicy, ValueNetwork
+
+__all__ = ["PATRPO", "PATRPOConfig", "LinearFeatureBaseline", "gae"]
+
+
+@dataclasses.dataclass(frozen=True)
+class PATRPOConfig(AlgoConfig):
+    """PATRPO's settings; the defaults are the paper's preset (rllab's for what the paper leaves open)."""
+
+    hidden_sizes: tuple[int, ...] = setting(
+        (200, 100, 50), "Hidden layers of pi_d and pi_c (the paper's {200, 100, 50})."
+    )
+    activation: str = setting(
+        "relu", "Hidden activation of the policies: relu (paper), tanh, leaky_relu or elu."
+    )
+    init_log_std: float = setting(
+        0.0, "Initial log-std of the parameter noise, in [-1, 1] units (rllab: std 1)."
+    )
+    batch_size: int = setting(10_000, "Samples per epoch (one TRPO update per epoch); the paper uses 10 000.")
+    delta: float = setting(
+        0.005,
+        "Trust region: the bound on the mean KL(pi_old || pi). Paper: 0.005 (0.01, 0.05 in its step-size figure).",
+    )
+    kl_estimator: str = setting(
+        "chain_analytic",
+        "KL estimator for the constraint: joint_sample, chain_sample or chain_analytic (the paper's preferred).",
+    )
+    cg_iters: int = setting(10, "Conjugate-gradient iterations for the natural-gradient direction.")
+    cg_damping: float = setting(
+        1e-5, "Damping added to the Fisher-vector product; raise it if steps are erratic."
+    )
+    backtrack_ratio: float = setting(0.8, "Step shrink factor of the line search.")
+    max_backtracks: int = setting(
+        15, "Line-search tries before the update is abandoned (parameters restored)."
+    )
+    gamma: float = setting(0.99, "Discount factor.")
+    gae_lambda: float = setting(
+        1.0, "GAE lambda: 1.0 is rllab's (Monte-Carlo advantages); 0.95-0.99 lowers variance."
+    )
+    normalize_advantages: bool = setting(True, "Standardise advantages within the batch.")
+    baseline: str = setting(
+        "mlp",
+        "Baseline: mlp (a value network, the modern choice) or linear (rllab's linear-feature baseline).",
+    )
+    vf_hidden_sizes: tuple[int, ...] = setting((64, 64), "Hidden layers of the value network.")
+    vf_lr: float = setting(1e-3, "Adam learning rate of the value network.")
+    vf_epochs: int = setting(5, "Passes over each batch when fitting the value network.")
+    vf_batch_size: int = setting(256, "Minibatch size of the value network's fit.")
+
+    def __post_init__(self):
+        super().__post_init__()
+        self._check(
+            len(self.hidden_sizes) > 0 and all(h > 0 for h in self.hidden_sizes),
+            "hidden_sizes",
+            "positive layer sizes",
+        )
+        self._check(self.activation in ACTIVATIONS, "activation", f"one of {', '.join(ACTIVATIONS)}")
+        self._check(self.batch_size >= 1, "batch_size", "an integer >= 1")
+        self._check(self.delta > 0, "delta", "a positive KL bound")
+        self._check(self.kl_estimator in KL_ESTIMATORS, "kl_estimator", f"one of {', '.join(KL_ESTIMATORS)}")
+        self._check(self.cg_iters >= 1, "cg_iters", "an integer >= 1")
+        self._check(self.cg_damping >= 0, "cg_damping", "a non-negative number")
+        self._check(0 < self.backtrack_ratio < 1, "backtrack_ratio", "a number in (0, 1)")
+        self._check(self.max_backtracks >= 1, "max_backtracks", "an integer >= 1")
+        self._check(0 <= self.gamma <= 1, "gamma", "a number in [0, 1]")
+        self._check(0 <= self.gae_lambda <= 1, "gae_lambda", "a number in [0, 1]")
+        self._check(self.baseline in ("mlp", "linear"), "baseline", "'mlp' or 'linear'")
+        self._check(
+            self.vf_lr > 0 and self.vf_epochs >= 1 and self.vf_batch_size >= 1,
+            "vf_lr",
+            "a positive rate (with vf_epochs, vf_batch_size >= 1)",
+        )
+
+    @classmethod
+    def presets(cls) -> dict[str, PATRPOConfig]:
+        return {
+            "paper": cls(),
+            "tuned": cls(delta=0.02, gae_lambda=0.97, batch_size=5_000, init_log_std=-0.5),
+        }
+
+
+def gae(
+    rewards: np.ndarray,
+    values: np.ndarray,
+    next_values: np.ndarray,
+    terminated: np.ndarray,
+    done: np.ndarray,
+    gamma: float,
+    lam: float,
+) -> np.ndarray:
+    """Generalised advantage estimates over ``(T, N)`` arrays of ``N`` env copies stepped ``T`` times.
+
+    ``next_values[t]`` is the value of the observation returned by step ``t``: it is bootstrapped unless the
+    step ``terminated``; ``done`` (terminated or truncated) cuts the sum. The last row is always cut (the end
+    of the epoch acts as a truncation).
+    """
+    adv = np.zeros_like(rewards, dtype=np.float64)
+    last = np.zeros(rewards.shape[1])
+    for t in range(rewards.shape[0] - 1, -1, -1):
+        delta = rewards[t] + gamma * (1.0 - terminated[t]) * next_values[t] - values[t]
+        last = delta + gamma * lam * (1.0 - done[t]) * last
+        adv[t] = last
+    return adv
+
+
+class LinearFeatureBaseline:
+    """rllab's baseline: ridge regression of returns on ``[clip(s), s^2, t/100, (t/100)^2, (t/100)^3, 1]``."""
+
+    def __init__(self, obs_dim: int, reg: float = 1e-5):
+        self.coef = np.zeros(2 * obs_dim + 4)
+        self.reg = reg
+
+    @staticmethod
+    def features(obs: np.ndarray, t: np.ndarray) -> np.ndarray:
+        s = np.clip(obs, -10, 10)
+        tt = (np.asarray(t, dtype=np.float64) / 100.0)[:, None]
+        return np.concatenate([s, s**2, tt, tt**2, tt**3, np.ones_like(tt)], axis=1)
+
+    def predict(self, obs: np.ndarray, t: np.ndarray) -> np.ndarray:
+        return self.features(obs, t) @ self.coef
+
+    def fit(self, obs: np.ndarray, t: np.ndarray, returns: np.ndarray) -> float:
+        f = self.features(obs, t)
+        reg = self.reg
+        for _ in range(5):  # rllab raises the ridge term until the solve is finite
+            coef = np.linalg.lstsq(f.T @ f + reg * np.eye(f.shape[1]), f.T @ returns, rcond=None)[0]
+            if np.all(np.isfinite(coef)):
+                self.coef = coef
+                break
+            reg *= 10
+        return float(np.mean((self.predict(obs, t) - returns) ** 2))
+
+
+class PATRPO(Algorithm):
+    """Parameterized Actions TRPO. See the module docstring for the update and :class:`PATRPOConfig`."""
+
+    config_class = PATRPOConfig
+    config: PATRPOConfig
+
+    def _build(self) -> None:
+        cfg = self.config
+        self.policy = HybridPolicy(
+            self.obs_dim, self.hybrid, cfg.hidden_sizes, cfg.activation, cfg.init_log_std
+        )
+        if cfg.baseline == "mlp":
+            self.value = ValueNetwork(self.obs_dim, cfg.vf_hidden_sizes)
+            self.vf_optimizer = torch.optim.Adam(self.value.parameters(), lr=cfg.vf_lr)
+        else:
+            self.linear_baseline = LinearFeatureBaseline(self.obs_dim)
+        self.tracker = EpisodeTracker(cfg.num_envs)
+
+    def _modules(self):
+        return {"policy": self.policy, **({"value": self.value} if self.config.baseline == "mlp" else {})}
+
+    def _optimizers(self):
+        return {"value": self.vf_optimizer} if self.config.baseline == "mlp" else {}
+
+    def _extra_state(self):
+        if self.config.baseline == "linear":
+            return {"linear_baseline": torch.as_tensor(self.linear_baseline.coef)}
+        return {}
+
+    def _load_extra_state(self, state):
+        if self.config.baseline == "linear":
+            self.linear_baseline.coef = state["linear_baseline"].numpy()
+
+    def _act(self, obs, deterministic):
+        dist = self.policy(obs)
+        return dist.mode() if deterministic else dist.sample(self.torch_gen)
+
+    # -- baseline --------------------------------------------------------------------------------
+    def _values(self, obs: np.ndarray, t: np.ndarray) -> np.ndarray:
+        if self.config.baseline == "linear":
+            return self.linear_baseline.predict(obs, t)
+        with torch.no_grad():
+            return self.value(self._obs_tensor(obs)).double().numpy()
+
+    def _fit_baseline(self, obs: np.ndarray, t: np.ndarray, returns: np.ndarray) -> float:
+        cfg = self.config
+        if cfg.baseline == "linear":
+            return self.linear_baseline.fit(obs, t, returns)
+        obs_t, ret_t = self._obs_tensor(obs), torch.as_tensor(returns, dtype=torch.float32)
+        n = len(ret_t)
+        for _ in range(cfg.vf_epochs):
+            perm = torch.randperm(n, generator=self.torch_gen)
+            for start in range(0, n, cfg.vf_batch_size):
+                idx = perm[start : start + cfg.vf_batch_size]
+                loss = (self.value(obs_t[idx]) - ret_t[idx]).pow(2).mean()
+                self.vf_optimizer.zero_grad()
+                loss.backward()
+                self.vf_optimizer.step()
+        with torch.no_grad():
+            return float((self.value(obs_t) - ret_t).pow(2).mean())
+
+    # -- one epoch -------------------------------------------------------------------------------
+    def _collect(self) -> dict[str, np.ndarray]:
+        """Step the batched env until ``batch_size`` valid samples; returns ``(T, N, ...)`` arrays.
+
+        Gymnasium's vector envs reset a finished copy on the *next* step, ignoring its action: those
+        autoreset steps are marked invalid and carry no sample.
+        """
+        env = self.vec_env
+        n = env.num_envs
+        obs, _ = env.reset(seed=int(self.np_rng.integers(2**31 - 1)))
+        self.tracker = EpisodeTracker(n)
+        t_ep = np.zeros(n, dtype=np.int64)
+        prev_done = np.zeros(n, dtype=bool)
+        keys = ("obs", "a", "x", "reward", "terminated", "done", "valid", "next_obs", "t")
+        rows: dict[str, list] = {k: [] for k in keys}
+        n_valid = 0
+        while n_valid < self.config.batch_size:
+            with torch.no_grad():
+                a, x = self.policy(self._obs_tensor(obs)).sample(self.torch_gen)
+            next_obs, reward, terminated, truncated, _ = env.step(
+                self.hybrid.to_env_batch(a.numpy(), x.numpy())
+            )
+            valid = ~prev_done
+            done = (terminated | truncated) & valid
+            for k, v in zip(
+                keys, (obs, a.numpy(), x.numpy(), reward, terminated & valid, done, valid, next_obs, t_ep)
+            ):
+                rows[k].append(np.array(v))
+            self.tracker.step(np.asarray(reward, dtype=np.float64), done, valid)
+            n_valid += int(valid.sum())
+            t_ep = np.where(valid, t_ep + 1, 0)
+            prev_done, obs = done, next_obs
+        return {k: np.stack(v) for k, v in rows.items()}
+
+    def _run_epoch(self) -> dict[str, float]:
+        cfg = self.config
+        batch = self._collect()
+        T, N = batch["reward"].shape
+        flat = lambda arr: arr.reshape(T * N, *arr.shape[2:])  # noqa: E731
+        values = self._values(flat(batch["obs"]), flat(batch["t"])).reshape(T, N)
+        next_values = self._values(flat(batch["next_obs"]), flat(batch["t"]) + 1).reshape(T, N)
+        adv = gae(
+            batch["reward"],
+            values,
+            next_values,
+            batch["terminated"],
+            batch["done"],
+            cfg.gamma,
+            cfg.gae_lambda,
+        )
+        returns = adv + values
+
+        valid = flat(batch["valid"])
+        obs, t, a, x = (
+            flat(batch["obs"])[valid],
+            flat(batch["t"])[valid],
+            flat(batch["a"])[valid],
+            flat(batch["x"])[valid],
+        )
+        adv_v, ret_v, val_v = flat(adv)[valid], flat(returns)[valid], flat(values)[valid]
+        var_ret = np.var(ret_v)
+        explained_var = float(1 - np.var(ret_v - val_v) / var_ret) if var_ret > 0 else float("nan")
+        if cfg.normalize_advantages:
+            adv_v = (adv_v - adv_v.mean()) / (adv_v.std() + 1e-8)
+
+        stats = self._update_policy(
+            self._obs_tensor(obs),
+            torch.as_tensor(a),
+            torch.as_tensor(x),
+            torch.as_tensor(adv_v, dtype=torch.float32),
+        )
+        stats["losses/value_loss"] = self._fit_baseline(obs, t, ret_v)
+        stats["train/explained_variance"] = explained_var
+        freq = np.bincount(a, minlength=self.hybrid.n_actions) / len(a)
+        stats.update({f"train/action_freq_{k}": float(f) for k, f in enumerate(freq)})
+        stats.update(self.tracker.pop())
+        stats["steps"] = len(a)
+        return stats
+
+    def _update_policy(self, obs, a, x, adv) -> dict[str, float]:
+        """One natural-gradient step with line search on the surrogate (the paper's PATRPO update)."""
+        cfg = self.config
+        params = [p for p in self.policy.parameters() if p.requires_grad]
+        with torch.no_grad():
+            old = self.policy(obs).detach()
+            old_logp = old.log_prob(a, x)
+
+        def surrogate() -> torch.Tensor:
+            return (torch.exp(self.policy(obs).log_prob(a, x) - old_logp) * adv).mean()
+
+        def kl() -> torch.Tensor:
+            return kl_divergence(old, self.policy(obs), cfg.kl_estimator, a, x).mean()
+
+        g = flat_grad(surrogate(), params)
+        fvp = FisherVectorProduct(kl(), params, cfg.cg_damping)
+        direction = conjugate_gradient(fvp, g, cfg.cg_iters)
+        shs = float(direction @ fvp(direction))
+        stats = {"train/entropy": float(old.entropy().mean()), "train/grad_norm": float(g.norm())}
+        if not (np.isfinite(shs) and shs > 0):
+            stats.update(
+                {
+                    "train/line_search_success": 0.0,
+                    "train/backtracks": float(cfg.max_backtracks),
+                    "losses/surrogate_improvement": 0.0,
+                    "train/kl": 0.0,
+                }
+            )
+            return stats
+        full_step = np.sqrt(2.0 * cfg.delta / shs) * direction
+        result = backtracking_line_search(
+            params, full_step, surrogate, kl, cfg.delta, cfg.backtrack_ratio, cfg.max_backtracks
+        )
+        with torch.no_grad():
+            kl_after = float(kl_divergence(old, self.policy(obs), "chain_analytic").mean())
+        stats.update(
+            {
+                "train/line_search_success": float(result.success),
+                "train/backtracks": float(result.backtracks),
+                "losses/surrogate_improvement": result.improvement,
+                "train/kl": kl_after,
+                "train/kl_estimate": result.kl,
+                "train/param_std": float(self.policy.log_std.exp()[self.policy.mask].mean()),
+            }
+        )
+        return stats

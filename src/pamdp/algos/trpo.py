@@ -1,0 +1,137 @@
+"""Trust-region machinery shared by the TRPO-family algorithms (Schulman et al. 2015, appendix C).
+
+Each piece is a small function with its own unit test: flat parameter vectors, the Fisher-vector product
+by double back-propagation of the KL, conjugate gradient, and the backtracking line search.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import torch
+
+__all__ = [
+    "flat_params",
+    "set_flat_params",
+    "flat_grad",
+    "FisherVectorProduct",
+    "conjugate_gradient",
+    "LineSearchResult",
+    "backtracking_line_search",
+]
+
+
+def flat_params(params: Sequence[torch.Tensor]) -> torch.Tensor:
+    """All parameters as one detached vector."""
+    return torch.cat([p.detach().reshape(-1) for p in params])
+
+
+def set_flat_params(params: Sequence[torch.Tensor], flat: torch.Tensor) -> None:
+    """Write a flat vector back into the parameters, in place."""
+    offset = 0
+    with torch.no_grad():
+        for p in params:
+            n = p.numel()
+            p.copy_(flat[offset : offset + n].view_as(p))
+            offset += n
+    if offset != flat.numel():
+        raise ValueError(f"flat vector has {flat.numel()} entries, the parameters {offset}")
+
+
+def flat_grad(
+    output: torch.Tensor,
+    params: Sequence[torch.Tensor],
+    create_graph: bool = False,
+    retain_graph: bool | None = None,
+) -> torch.Tensor:
+    """``d output / d params`` as one vector (zeros for parameters the output does not depend on)."""
+    grads = torch.autograd.grad(
+        output, params, create_graph=create_graph, retain_graph=retain_graph, allow_unused=True
+    )
+    return torch.cat([(torch.zeros_like(p) if g is None else g).reshape(-1) for g, p in zip(grads, params)])
+
+
+class FisherVectorProduct:
+    """``v -> (H + damping I) v``, with ``H`` the Hessian of the mean KL at the current parameters.
+
+    The KL's gradient is built once with ``create_graph=True``; each product is then one more backward pass
+    of ``grad(KL) . v`` (double back-propagation). The old distribution inside ``kl`` must be detached, so
+    that at the current parameters the gradient is zero and the Hessian is the Fisher information.
+    """
+
+    def __init__(self, kl: torch.Tensor, params: Sequence[torch.Tensor], damping: float):
+        self.params = list(params)
+        self.damping = float(damping)
+        self.grad_kl = flat_grad(kl, self.params, create_graph=True)
+
+    def __call__(self, v: torch.Tensor) -> torch.Tensor:
+        return flat_grad(self.grad_kl @ v, self.params, retain_graph=True) + self.damping * v
+
+
+def conjugate_gradient(
+    matvec: Callable[[torch.Tensor], torch.Tensor],
+    b: torch.Tensor,
+    iters: int = 10,
+    residual_tol: float = 1e-10,
+) -> torch.Tensor:
+    """Approximately solve ``A x = b`` for symmetric positive-definite ``A`` given only ``x -> A x``."""
+    x = torch.zeros_like(b)
+    r = b.clone()
+    p = b.clone()
+    rr = r @ r
+    for _ in range(iters):
+        if rr < residual_tol:
+            break
+        Ap = matvec(p)
+        alpha = rr / (p @ Ap)
+        x += alpha * p
+        r -= alpha * Ap
+        rr_new = r @ r
+        p = r + (rr_new / rr) * p
+        rr = rr_new
+    return x
+
+
+@dataclass
+class LineSearchResult:
+    """Outcome of :func:`backtracking_line_search`.
+
+    Attributes:
+        success: whether a step was accepted (otherwise the parameters were restored).
+        backtracks: how many times the step was shrunk (the accepted one's index, or the maximum tried).
+        improvement: surrogate gain of the accepted step (0 if none).
+        kl: KL after the step (0 if none).
+    """
+
+    success: bool
+    backtracks: int
+    improvement: float
+    kl: float
+
+
+def backtracking_line_search(
+    params: Sequence[torch.Tensor],
+    full_step: torch.Tensor,
+    surrogate: Callable[[], torch.Tensor],
+    kl: Callable[[], torch.Tensor],
+    max_kl: float,
+    backtrack_ratio: float = 0.8,
+    max_backtracks: int = 15,
+) -> LineSearchResult:
+    """Try ``theta + ratio^k * full_step`` for ``k = 0, 1, ...``; keep the first that improves the surrogate
+    and keeps the KL within ``max_kl`` (rllab's rule), else restore ``theta``.
+
+    ``surrogate`` and ``kl`` evaluate the objective (to maximise) and the KL at the current parameters.
+    """
+    params = list(params)
+    theta = flat_params(params)
+    with torch.no_grad():
+        before = float(surrogate())
+        for k in range(max_backtracks):
+            set_flat_params(params, theta + backtrack_ratio**k * full_step)
+            gain, kl_value = float(surrogate()) - before, float(kl())
+            if gain > 0 and kl_value <= max_kl:
+                return LineSearchResult(True, k, gain, kl_value)
+        set_flat_params(params, theta)
+    return LineSearchResult(False, max_backtracks, 0.0, 0.0)

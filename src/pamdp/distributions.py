@@ -1,0 +1,136 @@
+"""The hierarchical (hybrid) action distribution ``pi(a, x | s) = pi_d(a | s) * pi_c(x | s, a)``.
+
+``pi_d`` is a categorical distribution over the K discrete actions. ``pi_c(. | s, a)`` is a diagonal
+Gaussian over the padded parameter vector ``x`` in ``[-1, 1]^m``, of which only the first ``m_a`` entries
+belong to action ``a`` (``mask[a]``); the others are ignored everywhere (sampled as zero, no
+log-probability, no entropy, no KL). The distribution holds the parameter means of *every* action, so that
+the chain-rule KL can be summed over actions without samples (the paper's preferred estimator).
+
+KL estimators, all of ``KL(old || new)`` per state (Wei, Wicke & Luke 2018, "Parameterized Actions TRPO"):
+
+- ``joint_sample``: ``log pi_old(a_t, x_t | s) - log pi_new(a_t, x_t | s)`` at the sampled action.
+- ``chain_sample``: ``KL(pi_d_old || pi_d_new)(s) + KL(pi_c_old(.|s,a_t) || pi_c_new(.|s,a_t))``.
+- ``chain_analytic``: ``KL(pi_d_old || pi_d_new)(s) + sum_a pi_d_old(a|s) KL(pi_c_old(.|s,a) || pi_c_new(.|s,a))``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import torch
+import torch.nn.functional as F
+
+__all__ = ["HybridDistribution", "KL_ESTIMATORS", "kl_divergence"]
+
+KL_ESTIMATORS = ("joint_sample", "chain_sample", "chain_analytic")
+_LOG_2PI = math.log(2.0 * math.pi)
+
+
+@dataclass
+class HybridDistribution:
+    """A batch of hybrid action distributions.
+
+    Attributes:
+        logits: ``(B, K)`` unnormalised log-probabilities of ``pi_d``.
+        means: ``(B, K, m)`` parameter means of ``pi_c(. | s, a)`` for every action ``a``.
+        log_std: ``(K, m)`` or ``(B, K, m)`` log standard deviations of ``pi_c``.
+        mask: ``(K, m)`` boolean, which padded entries each action uses.
+    """
+
+    logits: torch.Tensor
+    means: torch.Tensor
+    log_std: torch.Tensor
+    mask: torch.Tensor
+
+    def __post_init__(self):
+        self.log_std = self.log_std.expand_as(self.means)
+        self.mask = self.mask.to(self.means.dtype)
+
+    # -- pieces ------------------------------------------------------------------------------
+    @property
+    def log_probs_d(self) -> torch.Tensor:
+        """``(B, K)`` normalised ``log pi_d(a | s)``."""
+        return F.log_softmax(self.logits, dim=-1)
+
+    @property
+    def probs_d(self) -> torch.Tensor:
+        return F.softmax(self.logits, dim=-1)
+
+    def _at(self, tensor: torch.Tensor, a: torch.Tensor) -> torch.Tensor:
+        """Select action ``a``'s row of a ``(B, K, m)`` tensor: ``(B, m)``."""
+        return tensor.gather(1, a.long().view(-1, 1, 1).expand(-1, 1, tensor.shape[-1])).squeeze(1)
+
+    # -- sampling ----------------------------------------------------------------------------
+    def sample(self, generator: torch.Generator | None = None) -> tuple[torch.Tensor, torch.Tensor]:
+        """Draw ``a ~ pi_d`` then ``x ~ pi_c(. | s, a)``; unused parameter entries are zero."""
+        a = torch.multinomial(self.probs_d, 1, generator=generator).squeeze(-1)
+        mu, log_std = self._at(self.means, a), self._at(self.log_std, a)
+        noise = torch.randn(mu.shape, generator=generator, dtype=mu.dtype, device=mu.device)
+        return a, (mu + log_std.exp() * noise) * self.mask[a]
+
+    def mode(self) -> tuple[torch.Tensor, torch.Tensor]:
+        """The greedy action: ``argmax_a pi_d(a | s)`` with its mean parameters."""
+        a = self.logits.argmax(dim=-1)
+        return a, self._at(self.means, a) * self.mask[a]
+
+    # -- densities ---------------------------------------------------------------------------
+    def log_prob(self, a: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
+        """``log pi_d(a | s) + log pi_c(x | s, a)``, counting only action ``a``'s parameters."""
+        a = a.long()
+        mu, log_std = self._at(self.means, a), self._at(self.log_std, a)
+        z = (x - mu) / log_std.exp()
+        log_pc = (-0.5 * z.pow(2) - log_std - 0.5 * _LOG_2PI) * self.mask[a]
+        return self.log_probs_d.gather(1, a.view(-1, 1)).squeeze(1) + log_pc.sum(-1)
+
+    def entropy_c(self) -> torch.Tensor:
+        """``(B, K)``: the differential entropy of ``pi_c(. | s, a)`` for every action."""
+        return ((self.log_std + 0.5 * (1.0 + _LOG_2PI)) * self.mask).sum(-1)
+
+    def entropy(self) -> torch.Tensor:
+        """Exact joint entropy by the chain rule: ``H(pi_d) + sum_a pi_d(a) H(pi_c(. | s, a))``."""
+        p, logp = self.probs_d, self.log_probs_d
+        return -(p * logp).sum(-1) + (p * self.entropy_c()).sum(-1)
+
+    # -- divergences -------------------------------------------------------------------------
+    def kl_d(self, new: HybridDistribution) -> torch.Tensor:
+        """``(B,)``: ``KL(pi_d_self || pi_d_new)`` in closed form."""
+        return (self.probs_d * (self.log_probs_d - new.log_probs_d)).sum(-1)
+
+    def kl_c(self, new: HybridDistribution) -> torch.Tensor:
+        """``(B, K)``: the Gaussian ``KL(pi_c_self(. | s, a) || pi_c_new(. | s, a))`` for every action."""
+        var_ratio = (2.0 * (self.log_std - new.log_std)).exp()
+        mean_term = ((self.means - new.means) / new.log_std.exp()).pow(2)
+        per_dim = 0.5 * (var_ratio + mean_term - 1.0) - (self.log_std - new.log_std)
+        return (per_dim * self.mask).sum(-1)
+
+    def detach(self) -> HybridDistribution:
+        return HybridDistribution(self.logits.detach(), self.means.detach(), self.log_std.detach(), self.mask)
+
+    def __getitem__(self, index) -> HybridDistribution:
+        """A sub-batch (the state dimension only)."""
+        log_std = self.log_std[index]
+        return HybridDistribution(self.logits[index], self.means[index], log_std, self.mask)
+
+
+def kl_divergence(
+    old: HybridDistribution,
+    new: HybridDistribution,
+    estimator: str = "chain_analytic",
+    a: torch.Tensor | None = None,
+    x: torch.Tensor | None = None,
+) -> torch.Tensor:
+    """Per-state estimate ``(B,)`` of ``KL(old || new)`` by the named estimator.
+
+    ``a`` and ``x`` are the actions sampled from ``old`` (needed by the sample-based estimators).
+    """
+    if estimator == "chain_analytic":
+        return old.kl_d(new) + (old.probs_d * old.kl_c(new)).sum(-1)
+    if a is None or (estimator == "joint_sample" and x is None):
+        if estimator in KL_ESTIMATORS:
+            raise ValueError(f"the {estimator!r} KL estimator needs the sampled actions (a and x)")
+    if estimator == "chain_sample":
+        return old.kl_d(new) + old.kl_c(new).gather(1, a.long().view(-1, 1)).squeeze(1)
+    if estimator == "joint_sample":
+        return old.log_prob(a, x) - new.log_prob(a, x)
+    raise ValueError(f"unknown KL estimator {estimator!r}; expected one of {', '.join(KL_ESTIMATORS)}")
