@@ -55,9 +55,7 @@ class AlgoConfig:
     num_envs: int = setting(
         16, "Copies of the environment stepped together (batched when the env has a vector version)."
     )
-    torch_threads: int = setting(
-        1, "Torch intra-op threads; 1 is fastest for these small networks on a laptop CPU."
-    )
+    torch_threads: int = setting(1, "Torch intra-op threads; 1 is fastest for these small networks on a laptop CPU.")
 
     def __post_init__(self):
         for f in dataclasses.fields(self):
@@ -80,15 +78,12 @@ class AlgoConfig:
     def preset(cls, name: str) -> AlgoConfig:
         table = cls.presets()
         if name not in table:
-            raise ValueError(
-                f"unknown preset {name!r} for {cls.__name__}; expected one of {', '.join(table)}"
-            )
+            raise ValueError(f"unknown preset {name!r} for {cls.__name__}; expected one of {', '.join(table)}")
         return table[name]
 
     def to_dict(self) -> dict[str, Any]:
         return {
-            f.name: (list(v) if isinstance(v := getattr(self, f.name), tuple) else v)
-            for f in dataclasses.fields(self)
+            f.name: (list(v) if isinstance(v := getattr(self, f.name), tuple) else v) for f in dataclasses.fields(self)
         }
 
     @classmethod
@@ -313,9 +308,7 @@ class Algorithm:
     def __init__(self, env, config: AlgoConfig | None = None, env_kwargs: dict | None = None):
         config = self.config_class() if config is None else config
         if not isinstance(config, self.config_class):
-            raise ValueError(
-                f"{type(self).__name__} needs a {self.config_class.__name__}, got {type(config).__name__}"
-            )
+            raise ValueError(f"{type(self).__name__} needs a {self.config_class.__name__}, got {type(config).__name__}")
         self.config = config
         env_id, spec_kwargs, obs_space, act_space = _describe_env(env)
         self.env_id = env_id
@@ -374,9 +367,7 @@ class Algorithm:
                 self._vec_env = gymnasium.vector.SyncVectorEnv([lambda: env])
             mode = self._vec_env.metadata.get("autoreset_mode", AutoresetMode.NEXT_STEP)
             if AutoresetMode(mode) != AutoresetMode.NEXT_STEP:
-                raise ValueError(
-                    f"vector env with autoreset mode {mode!r}; pamdp expects {AutoresetMode.NEXT_STEP!r}"
-                )
+                raise ValueError(f"vector env with autoreset mode {mode!r}; pamdp expects {AutoresetMode.NEXT_STEP!r}")
         return self._vec_env
 
     def _obs_tensor(self, obs) -> torch.Tensor:
@@ -388,9 +379,7 @@ class Algorithm:
         obs = np.asarray(obs, dtype=np.float32)
         single = obs.ndim == 1
         if obs.shape[-1] != self.obs_dim or obs.ndim not in (1, 2):
-            raise ValueError(
-                f"observation of shape {obs.shape}; expected ({self.obs_dim},) or (N, {self.obs_dim})"
-            )
+            raise ValueError(f"observation of shape {obs.shape}; expected ({self.obs_dim},) or (N, {self.obs_dim})")
         with torch.no_grad():
             a, x = self._act(torch.as_tensor(obs.reshape(-1, self.obs_dim)), deterministic)
         a, x = a.numpy(), x.numpy()

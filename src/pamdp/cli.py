@@ -1,0 +1,244 @@
+"""The ``pamdp`` command: ``train``, ``evaluate``, ``render`` (and, with the experiments, ``reproduce``, ``plot``).
+
+``pamdp train patrpo`` trains PATRPO on Platform with the tuned preset, shows a progress bar and ends with
+a greedy evaluation. Every setting of the algorithm's config is also a flag (``--delta 0.01``,
+``--hidden-sizes 64,64``), and ``--config FILE`` (TOML or JSON) sets several; the order of precedence is
+preset, then file, then flags. A run writes into ``--out DIR``: ``run.json`` (what was asked),
+``progress.csv``, ``tb/`` (TensorBoard), ``checkpoint.pt`` after every epoch, ``final_model.pt`` and
+``evaluation.json``. Starting the same command again with the same ``--out`` resumes from the checkpoint.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import datetime as dt
+import json
+import sys
+import typing
+from importlib import import_module
+from pathlib import Path
+
+ALGORITHMS = {
+    "patrpo": "pamdp.algos.patrpo:PATRPO",
+    "pasvg0": "pamdp.algos.pasvg:PASVG0",
+    "paddpg": "pamdp.algos.paddpg:PADDPG",
+}
+DEFAULT_PRESET = "tuned"
+
+
+def algorithm_class(name: str):
+    """The class behind an algorithm's command-line name, or ``None`` if this install lacks it."""
+    module, _, cls = ALGORITHMS[name].partition(":")
+    try:
+        return getattr(import_module(module), cls)
+    except ModuleNotFoundError:
+        return None
+
+
+def _parse_value(text: str, hint):
+    """A command-line string as a value of the config field's type (tuples as comma-separated lists)."""
+    origin = typing.get_origin(hint)
+    if origin is tuple:
+        (item,) = {a for a in typing.get_args(hint) if a is not Ellipsis}
+        return [_parse_value(t, item) for t in text.split(",") if t.strip()]
+    if origin in (typing.Union, getattr(__import__("types"), "UnionType")):
+        if text.lower() == "none":
+            return None
+        hint = next(t for t in typing.get_args(hint) if t is not type(None))
+    if hint is bool:
+        if text.lower() in ("1", "true", "yes", "on"):
+            return True
+        if text.lower() in ("0", "false", "no", "off"):
+            return False
+        raise argparse.ArgumentTypeError(f"{text!r} is not a boolean; expected true or false")
+    try:
+        return hint(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a valid {hint.__name__}") from exc
+
+
+def _add_config_flags(parser: argparse.ArgumentParser, config_class) -> None:
+    group = parser.add_argument_group(f"{config_class.__name__} settings (override the preset)")
+    hints = config_class.field_types()
+    for f in dataclasses.fields(config_class):
+        if f.name == "seed":
+            continue
+        hint = hints[f.name]
+        group.add_argument(
+            "--" + f.name.replace("_", "-"),
+            dest="cfg_" + f.name,
+            type=lambda s, h=hint: _parse_value(s, h),
+            default=None,
+            metavar=f.name.upper(),
+            help=f.metadata.get("help", ""),
+        )
+
+
+def _read_config_file(path: str) -> dict:
+    text = Path(path).read_text()
+    if path.endswith(".json"):
+        return json.loads(text)
+    try:
+        import tomllib
+    except ModuleNotFoundError:  # Python 3.10
+        import tomli as tomllib
+    return tomllib.loads(text)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="pamdp", description="Reinforcement learning in parameterized action spaces.")
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    train = sub.add_parser("train", help="train an algorithm (default: on Platform) and evaluate it")
+    algos = train.add_subparsers(dest="algo", required=True, metavar="ALGO")
+    for name in ALGORITHMS:
+        cls = algorithm_class(name)
+        if cls is None:
+            continue
+        p = algos.add_parser(name, help=(cls.__doc__ or "").strip().splitlines()[0])
+        p.add_argument("--env", default="pamdp/Platform-v0", help="registered env id (default: %(default)s)")
+        p.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
+        p.add_argument("--total-steps", type=int, default=None, help="environment steps (default: the preset's)")
+        p.add_argument(
+            "--out", default=None, help="run directory (default: runs/ALGO-ENV-seedN-TIME); reuse it to resume"
+        )
+        p.add_argument(
+            "--preset",
+            default=None,
+            choices=list(cls.config_class.presets()),
+            help=f"settings preset (default: {DEFAULT_PRESET})",
+        )
+        p.add_argument("--config", default=None, help="TOML or JSON file of settings")
+        p.add_argument(
+            "--eval-episodes", type=int, default=1000, help="greedy evaluation episodes at the end (0: none)"
+        )
+        p.add_argument("--no-progress", action="store_true", help="no progress bar")
+        _add_config_flags(p, cls.config_class)
+
+    ev = sub.add_parser("evaluate", help="evaluate a trained model (a run directory or a model file)")
+    ev.add_argument("model", help="run directory written by `pamdp train`, or a saved model file")
+    ev.add_argument("--episodes", type=int, default=1000)
+    ev.add_argument("--seed", type=int, default=0)
+    ev.add_argument("--stochastic", action="store_true", help="sample actions instead of the greedy ones")
+    ev.add_argument("--json", action="store_true", help="print one JSON object")
+
+    rd = sub.add_parser("render", help="write one episode to a GIF (a trained model, or random actions in an env)")
+    rd.add_argument("source", help="run directory, model file, or a registered env id (random actions)")
+    rd.add_argument("--out", default="episode.gif")
+    rd.add_argument("--seed", type=int, default=0)
+    return parser
+
+
+# -- train -------------------------------------------------------------------------------------------
+DEFAULT_TOTAL_STEPS = {"patrpo": 500_000, "pasvg0": 1_000_000, "paddpg": 1_000_000}
+
+
+def _train_config(args, cls):
+    from pamdp.algos.base import AlgoConfig
+
+    file_values = _read_config_file(args.config) if args.config else {}
+    preset = (
+        args.preset
+        or file_values.pop("preset", None)
+        or (DEFAULT_PRESET if DEFAULT_PRESET in cls.config_class.presets() else next(iter(cls.config_class.presets())))
+    )
+    config: AlgoConfig = cls.config_class.preset(preset)
+    config = cls.config_class.from_dict(file_values, base=config)
+    flags = {k[4:]: v for k, v in vars(args).items() if k.startswith("cfg_") and v is not None}
+    config = cls.config_class.from_dict({**flags, "seed": args.seed}, base=config)
+    return preset, config
+
+
+def cmd_train(args) -> int:
+    from pamdp.algos.base import CHECKPOINT, FINAL_MODEL
+    from pamdp.evaluation import evaluate
+
+    cls = algorithm_class(args.algo)
+    preset, config = _train_config(args, cls)
+    total = args.total_steps if args.total_steps is not None else DEFAULT_TOTAL_STEPS[args.algo]
+    if total < 0:
+        raise ValueError(f"--total-steps {total}; expected a non-negative number of steps")
+    stamp = dt.datetime.now().strftime("%Y%m%d-%H%M%S")
+    out = Path(args.out or f"runs/{args.algo}-{args.env.split('/')[-1]}-seed{args.seed}-{stamp}")
+    run_info = {"algo": args.algo, "env": args.env, "preset": preset, "total_steps": total, "config": config.to_dict()}
+    run_file = out / "run.json"
+    if (out / CHECKPOINT).exists() or (out / FINAL_MODEL).exists():
+        recorded = json.loads(run_file.read_text()) if run_file.exists() else {}
+        differ = sorted(k for k in ("algo", "env", "config") if recorded.get(k) != run_info[k])
+        if differ:
+            raise ValueError(
+                f"{out} holds a run with other {', '.join(differ)}; resume it with the same settings or use another --out"
+            )
+        model = cls.load(out / CHECKPOINT if (out / CHECKPOINT).exists() else out / FINAL_MODEL)
+        print(f"resuming {out} at step {model.num_timesteps:,} of {total:,}", file=sys.stderr)
+    else:
+        out.mkdir(parents=True, exist_ok=True)
+        model = cls(args.env, config)
+    run_file.write_text(json.dumps({**run_info, "command": sys.argv}, indent=2))
+    remaining = max(total - model.num_timesteps, 0)
+    try:
+        model.learn(remaining, progress_bar=not args.no_progress, run_dir=out)
+    except KeyboardInterrupt:
+        print(f"\ninterrupted; the last checkpoint is in {out}: run the same command to resume", file=sys.stderr)
+        return 130
+    model.save(out / FINAL_MODEL)
+    print(f"trained {model.num_timesteps:,} steps; model in {out / FINAL_MODEL}", file=sys.stderr)
+    if args.eval_episodes > 0:
+        result = evaluate(model, episodes=args.eval_episodes, seed=10_000 + args.seed)
+        (out / "evaluation.json").write_text(json.dumps(result, indent=2))
+        print(_format_evaluation(result))
+    return 0
+
+
+# -- evaluate, render ----------------------------------------------------------------------------
+def _format_evaluation(result: dict) -> str:
+    text = (
+        f"greedy return over {result['episodes']} episodes: {result['mean_return']:.4f} +- {result['std_return']:.4f}"
+    )
+    text += f" (mean length {result['mean_length']:.1f} steps)"
+    if "goal_rate" in result:
+        text += f"; goal rate {result['goal_rate']:.3f}, {result['mean_steps_to_goal']:.1f} steps to goal"
+    return text
+
+
+def cmd_evaluate(args) -> int:
+    from pamdp.algos.base import load_model
+    from pamdp.evaluation import evaluate
+
+    model = load_model(args.model)
+    result = evaluate(model, episodes=args.episodes, seed=args.seed, deterministic=not args.stochastic)
+    print(json.dumps(result) if args.json else _format_evaluation(result))
+    return 0
+
+
+def cmd_render(args) -> int:
+    import gymnasium
+
+    import pamdp  # noqa: F401  (registers the envs)
+    from pamdp.algos.base import load_model
+    from pamdp.envs.rendering import record_episode
+
+    if args.source in gymnasium.registry:
+        env, policy = gymnasium.make(args.source, render_mode="rgb_array"), None
+    else:
+        model = load_model(args.source)
+        env = gymnasium.make(model.env_id, render_mode="rgb_array", **model.env_kwargs)
+        policy = model.predict
+    path, total = record_episode(env, policy, args.out, seed=args.seed)
+    print(f"wrote {path} (return {total:.4f})")
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    handlers = {"train": cmd_train, "evaluate": cmd_evaluate, "render": cmd_render}
+    try:
+        return handlers[args.command](args)
+    except (ValueError, FileNotFoundError) as exc:
+        print(f"pamdp {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,103 @@
+"""The command line: train writes a run directory, a killed run resumes, evaluate prints JSON."""
+
+import csv
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+from pamdp.cli import main
+
+TINY = ["--hidden-sizes", "16", "--vf-hidden-sizes", "16", "--batch-size", "500", "--num-envs", "4", "--no-progress"]
+
+
+def rows(path):
+    with open(path / "progress.csv", newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def test_train_writes_run_directory_and_evaluation(tmp_path, capsys):
+    out = tmp_path / "run"
+    code = main(["train", "patrpo", "--total-steps", "1000", "--out", str(out), "--eval-episodes", "20", *TINY])
+    assert code == 0
+    for name in ("run.json", "progress.csv", "checkpoint.pt", "final_model.pt", "evaluation.json"):
+        assert (out / name).exists(), name
+    assert any((out / "tb").iterdir())
+    assert len(rows(out)) == 2
+    printed = capsys.readouterr().out
+    assert "greedy return over 20 episodes" in printed
+    run = json.loads((out / "run.json").read_text())
+    assert run["config"]["hidden_sizes"] == [16] and run["preset"] == "tuned"
+
+    assert main(["evaluate", str(out), "--episodes", "30", "--json"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert result["episodes"] == 30 and {"mean_return", "std_return"} <= set(result)
+
+    # Asking for more steps in the same directory continues the run.
+    assert main(["train", "patrpo", "--total-steps", "1500", "--out", str(out), "--eval-episodes", "0", *TINY]) == 0
+    assert len(rows(out)) == 3
+    # Other settings in the same directory are refused, naming what differs.
+    assert main(["train", "patrpo", "--total-steps", "1500", "--out", str(out), "--delta", "0.5", *TINY]) == 2
+    assert "other config" in capsys.readouterr().err
+
+
+def test_config_file_and_flags(tmp_path):
+    cfg = tmp_path / "c.toml"
+    cfg.write_text('preset = "paper"\ndelta = 0.05\nkl_estimator = "chain_sample"\n')
+    out = tmp_path / "run"
+    argv = ["train", "patrpo", "--config", str(cfg), "--delta", "0.01", "--total-steps", "500", "--out", str(out)]
+    assert main([*argv, "--eval-episodes", "0", *TINY]) == 0
+    run = json.loads((out / "run.json").read_text())
+    assert run["preset"] == "paper"
+    assert run["config"]["delta"] == 0.01 and run["config"]["kl_estimator"] == "chain_sample"
+
+
+def test_bad_values_give_clear_errors(tmp_path, capsys):
+    assert main(["train", "patrpo", "--kl-estimator", "exact", "--out", str(tmp_path / "r")]) == 2
+    assert "kl_estimator = 'exact'" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        main(["train", "patrpo", "--batch-size", "lots"])
+    assert main(["evaluate", str(tmp_path / "nothing")]) == 2
+    assert "no pamdp model" in capsys.readouterr().err
+
+
+def test_killed_run_resumes_from_its_checkpoint(tmp_path):
+    out = tmp_path / "run"
+    cmd = [
+        sys.executable,
+        "-m",
+        "pamdp.cli",
+        "train",
+        "patrpo",
+        "--total-steps",
+        "4000",
+        "--out",
+        str(out),
+        "--eval-episodes",
+        "0",
+        *TINY,
+    ]
+    env = {**os.environ, "PYTHONUNBUFFERED": "1"}
+    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.time() + 120
+    while not (out / "checkpoint.pt").exists() and time.time() < deadline:
+        time.sleep(0.05)
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    assert (out / "checkpoint.pt").exists() and not (out / "final_model.pt").exists()
+    done = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    assert "resuming" in done.stderr
+    steps = [float(r["time/total_timesteps"]) for r in rows(out)]
+    assert steps == sorted(steps) and len(set(steps)) == len(steps)  # one clean log, no repeated epochs
+    assert steps[-1] >= 4000 and (out / "final_model.pt").exists()
+
+
+def test_render_writes_a_gif(tmp_path):
+    gif = tmp_path / "ep.gif"
+    assert main(["render", "pamdp/Platform-v0", "--out", str(gif)]) == 0
+    assert gif.read_bytes()[:6] in (b"GIF87a", b"GIF89a")
