@@ -42,7 +42,7 @@ def _parse_value(text: str, hint):
     if origin is tuple:
         (item,) = {a for a in typing.get_args(hint) if a is not Ellipsis}
         return [_parse_value(t, item) for t in text.split(",") if t.strip()]
-    if origin in (typing.Union, getattr(__import__("types"), "UnionType")):
+    if origin in (typing.Union, __import__("types").UnionType):
         if text.lower() == "none":
             return None
         hint = next(t for t in typing.get_args(hint) if t is not type(None))
@@ -168,7 +168,8 @@ def cmd_train(args) -> int:
         differ = sorted(k for k in ("algo", "env", "config") if recorded.get(k) != run_info[k])
         if differ:
             raise ValueError(
-                f"{out} holds a run with other {', '.join(differ)}; resume it with the same settings or use another --out"
+                f"{out} holds a run with other {', '.join(differ)}; "
+                "resume it with the same settings or use another --out"
             )
         model = cls.load(out / CHECKPOINT if (out / CHECKPOINT).exists() else out / FINAL_MODEL)
         print(f"resuming {out} at step {model.num_timesteps:,} of {total:,}", file=sys.stderr)

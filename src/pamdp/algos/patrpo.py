@@ -50,7 +50,7 @@ class PATRPOConfig(AlgoConfig):
     cg_iters: int = setting(10, "Conjugate-gradient iterations for the natural-gradient direction.")
     fvp_subsample: float = setting(
         1.0,
-        "Fraction of the batch used for Fisher-vector products (0.1-0.2 is a common speed-up; the line search uses all).",
+        "Fraction of the batch for Fisher-vector products (0.1-0.2 is a common speed-up; the line search uses all).",
     )
     cg_damping: float = setting(1e-5, "Damping added to the Fisher-vector product; raise it if steps are erratic.")
     backtrack_ratio: float = setting(0.8, "Step shrink factor of the line search.")
