@@ -30,8 +30,6 @@ from pamdp.envs.hfo_features import PROFILES, low_level_features_one, shaped_rew
 from pamdp.envs.hfo_interface import (
     ACTION_FORM,
     ACTION_NAMES,
-    PARAM_HIGH,
-    PARAM_LOW,
     PARAM_SIZES,
     check_options,
     draw_half_field,
@@ -39,6 +37,7 @@ from pamdp.envs.hfo_interface import (
     parse_reset_options,
 )
 from pamdp.envs.hfo_physics import GOAL, IN_GAME, OUT_OF_BOUNDS, OUT_OF_TIME, STATUS_NAMES, HFOGame
+from pamdp.envs.hfo_vector import HalfFieldOffenseVectorEnv
 
 __all__ = ["HalfFieldOffenseEnv", "HalfFieldOffenseVectorEnv", "hfo_action_space"]
 

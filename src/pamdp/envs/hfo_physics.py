@@ -116,6 +116,17 @@ def round_dash_direction(direction: float) -> float:
     return DASH_ANGLE_STEP * round(direction / DASH_ANGLE_STEP)
 
 
+def norm(x: float, y: float) -> float:
+    """Length of (x, y), computed as the batched env computes it (``np.hypot`` is slow)."""
+    return math.sqrt(x * x + y * y)
+
+
+#: Powers of ten 10**k for k in [-POW10_OFFSET, POW10_OFFSET], shared by both envs so that they round alike.
+POW10_OFFSET = 300
+POW10 = [10.0**k for k in range(-POW10_OFFSET, POW10_OFFSET + 1)]
+LOG10_2 = math.log10(2.0)
+
+
 def fullstate_value(x: float) -> float:
     """``x`` to the 6 significant digits in which the server prints fullstate information to the agent.
 
@@ -123,9 +134,14 @@ def fullstate_value(x: float) -> float:
     computed from them, and the recordings show rounding boundaries mattering (a turn moment 0.0005 from
     a multiple of 0.001 is rounded the other way when computed from the exact speed).
     """
-    if abs(x) < 1e-200:
-        return x  # (10 ** 300 would overflow) a decayed velocity this small is printed as is
-    scale = 10.0 ** (5 - math.floor(math.log10(abs(x))))
+    magnitude = abs(x)
+    if magnitude < 1e-200:
+        return x  # zero, or a decayed velocity too small to matter
+    # Decimal exponent from the binary one (cheaper than log10, and identical in the batched env).
+    exponent = math.floor((math.frexp(magnitude)[1] - 1) * LOG10_2)
+    if magnitude >= POW10[exponent + 1 + POW10_OFFSET]:
+        exponent += 1
+    scale = POW10[5 - exponent + POW10_OFFSET]
     return round(x * scale) / scale
 
 
@@ -197,10 +213,10 @@ class HFOGame:
         self.stamina, self.effort, self.recovery = STAMINA_MAX, 1.0, 1.0
         self.capacity = STAMINA_CAPACITY
         self.pax = self.pay = self.bax = self.bay = 0.0  # accumulated accelerations
-        if math.hypot(bx - px, by - py) < TOUCH_DISTANCE:
+        if norm(bx - px, by - py) < TOUCH_DISTANCE:
             self._resolve_overlap()
         self.prev_bx, self.prev_by = self.bx, self.by
-        near = math.hypot(self.bx - self.px, self.by - self.py) <= KICKABLE_AREA
+        near = norm(self.bx - self.px, self.by - self.py) <= KICKABLE_AREA
         self.holder = near
         self.untouched = 0 if near else COUNTERS_AT_FIRST_OBSERVATION
         self.cycles = COUNTERS_AT_FIRST_OBSERVATION
@@ -243,7 +259,7 @@ class HFOGame:
         """
         px, py, _, _, _, _, bx, by, _, _ = self.seen
         limit = KICKABLE_AREA if self.kicked else AGENT_KICKABLE_AREA
-        return math.hypot(bx - px, by - py) <= limit
+        return norm(bx - px, by - py) <= limit
 
     def dash(self, power: float, direction: float) -> None:
         """DASH(power, direction): librcsc's conservation of stamina and speed, then the server's dash.
@@ -261,11 +277,11 @@ class HFOGame:
             power = -available / 2.0
         accel_rate = rate * self.effort * DASH_POWER_RATE
         accel = abs(power * accel_rate)
-        if math.hypot(svx, svy) + accel > PLAYER_SPEED_MAX and accel_rate > 0.0:
+        if norm(svx, svy) + accel > PLAYER_SPEED_MAX and accel_rate > 0.0:
             # Only possible, never binding, with player_decay 0.4; part of librcsc's dash (spec 2.3.3).
             phi = math.radians(body + direction + (180.0 if power < 0.0 else 0.0))
             ux, uy = math.cos(phi), math.sin(phi)
-            if math.hypot(svx + accel * ux, svy + accel * uy) > PLAYER_SPEED_MAX:
+            if norm(svx + accel * ux, svy + accel * uy) > PLAYER_SPEED_MAX:
                 v_par = svx * ux + svy * uy
                 v_perp2 = svx**2 + svy**2 - v_par**2
                 accel = max(math.sqrt(max(PLAYER_SPEED_MAX**2 - v_perp2, 0.0)) - v_par, 0.0)
@@ -285,9 +301,9 @@ class HFOGame:
 
     def turn(self, direction: float) -> None:
         """TURN(direction): the agent pre-multiplies by the inertia factor the server divides by."""
-        seen_speed = math.hypot(self.seen[2], self.seen[3])
+        seen_speed = norm(self.seen[2], self.seen[3])
         moment = round_command(min(max(direction * (1.0 + INERTIA_MOMENT * seen_speed), -180.0), 180.0))
-        inertia = 1.0 + INERTIA_MOMENT * math.hypot(self.pvx, self.pvy)
+        inertia = 1.0 + INERTIA_MOMENT * norm(self.pvx, self.pvy)
         noise = 1.0 + self._uniform(-self.player_rand, self.player_rand) if self.player_rand else 1.0
         self.body = normalize_angle(self.body + noise * moment / inertia)
 
@@ -298,7 +314,7 @@ class HFOGame:
         power = round_command(min(max(power, 0.0), 100.0))
         direction = min(max(direction, -180.0), 180.0)
         dx, dy = self.bx - self.px, self.by - self.py
-        dist = math.hypot(dx, dy)
+        dist = norm(dx, dy)
         if dist > KICKABLE_AREA:
             return True
         dir_diff = abs(normalize_angle(heading(dx, dy) - self.body)) / 180.0  # delta / pi
@@ -308,7 +324,7 @@ class HFOGame:
         kx, ky = effective * math.cos(phi), effective * math.sin(phi)
         if self.kick_rand and power > 0.0:
             pos_rate = 0.5 + 0.25 * (dir_diff + gap)
-            speed_rate = 0.5 + 0.5 * math.hypot(self.bvx, self.bvy) / (BALL_SPEED_MAX * BALL_DECAY)
+            speed_rate = 0.5 + 0.5 * norm(self.bvx, self.bvy) / (BALL_SPEED_MAX * BALL_DECAY)
             max_noise = self.kick_rand * (power / 100.0) * (pos_rate + speed_rate)
             length, angle = self._uniform(0.0, max_noise), self._uniform(-math.pi, math.pi)
             kx += length * math.cos(angle)
@@ -333,7 +349,7 @@ class HFOGame:
         )  # fmt: skip
         self.pax = self.pay = self.bax = self.bay = 0.0
         self.collided_post = post_p
-        self.collided_ball = math.hypot(self.bx - self.px, self.by - self.py) < TOUCH_DISTANCE
+        self.collided_ball = norm(self.bx - self.px, self.by - self.py) < TOUCH_DISTANCE
         if self.collided_ball:
             self._resolve_overlap()
         status = self._referee()
@@ -344,15 +360,14 @@ class HFOGame:
     def _move(self, x, y, vx, vy, ax, ay, accel_max, speed_max, rand, decay, radius):
         """Spec 2.5.1 for one object; returns the new position, velocity and the post-collision flag."""
         if ax != 0.0 or ay != 0.0:
-            a = math.hypot(ax, ay)
-            if a > accel_max:
-                ax, ay = ax * accel_max / a, ay * accel_max / a
-            vx, vy = vx + ax, vy + ay
-            speed = math.hypot(vx, vy)
-            if speed > speed_max:
-                vx, vy = vx * speed_max / speed, vy * speed_max / speed
+            a = norm(ax, ay)
+            shrink = accel_max / a if a > accel_max else 1.0
+            vx, vy = vx + ax * shrink, vy + ay * shrink
+            speed = norm(vx, vy)
+            shrink = speed_max / speed if speed > speed_max else 1.0
+            vx, vy = vx * shrink, vy * shrink
         if rand and (vx != 0.0 or vy != 0.0):
-            length = self._uniform(0.0, rand * math.hypot(vx, vy))
+            length = self._uniform(0.0, rand * norm(vx, vy))
             angle = self._uniform(-math.pi, math.pi)
             vx, vy = vx + length * math.cos(angle), vy + length * math.sin(angle)
         x, y, vx, vy, collided = post_collisions(x, y, vx, vy, radius)
@@ -361,7 +376,7 @@ class HFOGame:
     def _resolve_overlap(self) -> None:
         """Push player and ball apart about their midpoint to touching distance; both velocities * -0.1."""
         dx, dy = self.bx - self.px, self.by - self.py
-        dist = math.hypot(dx, dy)
+        dist = norm(dx, dy)
         if dist > 0.0:
             nx, ny = dx / dist, dy / dist
         else:
@@ -387,7 +402,7 @@ class HFOGame:
             status = OUT_OF_TIME
         else:
             self.untouched += 1
-            if math.hypot(bx - self.px, by - self.py) <= KICKABLE_AREA:
+            if norm(bx - self.px, by - self.py) <= KICKABLE_AREA:
                 self.holder = True
                 self.untouched = 0
         self.prev_bx, self.prev_by = bx, by
@@ -429,7 +444,7 @@ def post_collisions(x: float, y: float, vx: float, vy: float, radius: float):
     collided = False
     cx, cy = math.copysign(POST_X, x), math.copysign(POST_Y, y)
     dx, dy = x - cx, y - cy
-    dist = math.hypot(dx, dy)
+    dist = norm(dx, dy)
     if dist < reach:
         nx, ny = (dx / dist, dy / dist) if dist > 0.0 else (math.copysign(1.0, x), 0.0)
         x, y = cx + nx * (reach + CONTACT_EPSILON), cy + ny * (reach + CONTACT_EPSILON)
