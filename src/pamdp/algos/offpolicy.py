@@ -1,0 +1,177 @@
+"""What PASVG(0) and PADDPG share: the collect-and-learn loop over a replay buffer, and target networks.
+
+:class:`OffPolicyLoop` steps the batched env with the algorithm's exploration policy, stores every valid
+transition in the :class:`~pamdp.algos.replay.ReplayBuffer`, and interleaves gradient updates: once the
+buffer holds ``learning_starts`` transitions, each new sample earns ``updates_per_step`` updates (the
+update-to-data ratio), so ``num_envs`` changes how samples are batched, not how much is learned per sample.
+
+Gymnasium's vector envs reset a finished copy on the *next* step and ignore that step's action: such
+autoreset steps are marked invalid and never stored. A true termination stores ``terminated = True`` (no
+bootstrap); a truncation by the time limit stores ``False``, so the target bootstraps from the final
+observation. Episodes carry across epochs; a resumed run starts new episodes (env states are not saved).
+
+With ``mc_returns`` the loop also writes each transition's discounted Monte-Carlo return-to-go into the
+buffer's ``"mc"`` field when its episode ends (``NaN`` until then), for PADDPG's mixed targets.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+import torch
+from torch import nn
+
+from pamdp.algos.base import EpisodeTracker
+from pamdp.algos.replay import ReplayBuffer
+
+__all__ = ["OffPolicyLoop", "soft_update", "hard_update", "discounted_returns"]
+
+# act(obs (N, d) tensor, global step, episode_start (N,) bool) -> (a (N,), x (N, m) in [-1, 1], extra fields)
+ActFn = Callable[[torch.Tensor, int, np.ndarray], tuple[torch.Tensor, torch.Tensor, dict[str, np.ndarray]]]
+UpdateFn = Callable[[], dict[str, float]]
+
+
+def soft_update(target: nn.Module, source: nn.Module, tau: float) -> None:
+    """Polyak averaging of target networks, as DDPG: ``theta' <- tau * theta + (1 - tau) * theta'``."""
+    with torch.no_grad():
+        for t, s in zip(target.parameters(), source.parameters()):
+            t.lerp_(s, tau)
+
+
+def hard_update(target: nn.Module, source: nn.Module) -> None:
+    target.load_state_dict(source.state_dict())
+
+
+def discounted_returns(rewards: np.ndarray, gamma: float, tail: float = 0.0) -> np.ndarray:
+    """Return-to-go ``G_t = r_t + gamma G_{t+1}`` of one episode, with ``G_T = tail`` after its last step."""
+    out = np.empty(len(rewards))
+    g = tail
+    for t in range(len(rewards) - 1, -1, -1):
+        g = rewards[t] + gamma * g
+        out[t] = g
+    return out
+
+
+class OffPolicyLoop:
+    """Collect-and-learn epochs for an off-policy algorithm (see the module docstring).
+
+    Args:
+        hybrid: the env's hybrid action space.
+        buffer: where transitions go; it needs the fields ``obs, a, x, reward, next_obs, terminated``, the
+            algorithm's extras, and ``mc`` when ``mc_returns``.
+        gamma: discount of the Monte-Carlo returns.
+        mc_returns: compute Monte-Carlo returns when episodes end.
+        tail_value: with ``mc_returns``, the value of a truncated episode's final observations
+            ``(B, d) -> (B,)``, which bootstraps its Monte-Carlo return; ``None`` treats the cut as an end.
+    """
+
+    def __init__(
+        self,
+        hybrid,
+        buffer: ReplayBuffer,
+        gamma: float = 0.99,
+        mc_returns: bool = False,
+        tail_value: Callable[[np.ndarray], np.ndarray] | None = None,
+    ):
+        self.hybrid = hybrid
+        self.buffer = buffer
+        self.gamma = gamma
+        self.mc_returns = mc_returns
+        self.tail_value = tail_value
+        self.update_credit = 0.0
+        self.obs: np.ndarray | None = None  # the env's current observations; None until the first reset
+
+    def _start(self, env, np_rng: np.random.Generator) -> None:
+        self.env = env
+        self.num_envs = env.num_envs
+        self.tracker = EpisodeTracker(self.num_envs)
+        self.prev_done = np.zeros(self.num_envs, dtype=bool)
+        self.episode_start = np.ones(self.num_envs, dtype=bool)
+        self._pending: list[tuple[list[int], list[float]]] = [([], []) for _ in range(self.num_envs)]
+        self.obs, _ = env.reset(seed=int(np_rng.integers(2**31 - 1)))
+
+    def run_epoch(
+        self,
+        env,
+        act: ActFn,
+        update: UpdateFn,
+        n_samples: int,
+        start_step: int,
+        learning_starts: int,
+        updates_per_step: float,
+        np_rng: np.random.Generator,
+    ) -> dict[str, float]:
+        """Collect at least ``n_samples`` valid transitions, updating as they arrive; returns the epoch's stats."""
+        if self.obs is None:
+            self._start(env, np_rng)
+        counts = np.zeros(self.hybrid.n_actions, dtype=np.int64)
+        sums: dict[str, float] = {}
+        n_updates = n_valid = 0
+        while n_valid < n_samples:
+            obs = np.asarray(self.obs, dtype=np.float32)
+            with torch.no_grad():
+                a, x, extras = act(torch.from_numpy(obs), start_step + n_valid, self.episode_start)
+            a, x = a.numpy(), x.numpy()
+            next_obs, reward, terminated, truncated, _ = self.env.step(self.hybrid.to_env_batch(a, x))
+            valid = ~self.prev_done
+            done = (terminated | truncated) & valid
+            self.tracker.step(np.asarray(reward, dtype=np.float64), done, valid)
+            if valid.any():
+                row = {
+                    "obs": obs[valid],
+                    "a": a[valid],
+                    "x": x[valid],
+                    "reward": np.asarray(reward, dtype=np.float32)[valid],
+                    "next_obs": np.asarray(next_obs, dtype=np.float32)[valid],
+                    "terminated": (terminated & valid)[valid],
+                    **{k: v[valid] for k, v in extras.items()},
+                }
+                if self.mc_returns:
+                    row["mc"] = np.full(int(valid.sum()), np.nan, dtype=np.float32)
+                counters = self.buffer.add(**row)
+                if self.mc_returns:
+                    self._finish_returns(counters, valid, reward, terminated, done, next_obs)
+                counts += np.bincount(a[valid], minlength=self.hybrid.n_actions)
+                n = int(valid.sum())
+                n_valid += n
+                if len(self.buffer) >= learning_starts:
+                    self.update_credit += updates_per_step * n
+                    while self.update_credit >= 1.0:
+                        self.update_credit -= 1.0
+                        for k, v in update().items():
+                            sums[k] = sums.get(k, 0.0) + v
+                        n_updates += 1
+            self.episode_start = ~valid
+            self.prev_done = done
+            self.obs = next_obs
+        stats = {k: v / n_updates for k, v in sums.items()}
+        stats["train/updates"] = float(n_updates)
+        stats["train/buffer_size"] = float(len(self.buffer))
+        stats.update({f"train/action_freq_{k}": float(c) / n_valid for k, c in enumerate(counts)})
+        stats.update(self.tracker.pop())
+        stats["steps"] = n_valid
+        return stats
+
+    def _finish_returns(self, counters, valid, reward, terminated, done, next_obs) -> None:
+        """Queue this step's transitions per env copy; write their Monte-Carlo returns when episodes end."""
+        ended = np.flatnonzero(done)
+        tails = np.zeros(self.num_envs)
+        cut = [i for i in ended if not terminated[i]]
+        if cut and self.tail_value is not None:
+            tails[cut] = self.tail_value(np.asarray(next_obs, dtype=np.float32)[cut])
+        for c, i in zip(counters, np.flatnonzero(valid)):
+            self._pending[i][0].append(int(c))
+            self._pending[i][1].append(float(reward[i]))
+        for i in ended:
+            stored, rewards = self._pending[i]
+            returns = discounted_returns(np.asarray(rewards), self.gamma, float(tails[i]))
+            self.buffer.write("mc", np.asarray(stored), returns.astype(np.float32))
+            self._pending[i] = ([], [])
+
+    def state_dict(self, include_buffer: bool) -> dict:
+        return {"buffer": self.buffer.state_dict(include_buffer), "update_credit": float(self.update_credit)}
+
+    def load_state_dict(self, state: dict) -> None:
+        self.buffer.load_state_dict(state["buffer"])
+        self.update_credit = float(state["update_credit"])

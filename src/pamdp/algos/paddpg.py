@@ -1,0 +1,314 @@
+"""PADDPG: DDPG over a parameterized action space (Hausknecht & Stone, ICLR 2016), the seed paper's baseline.
+
+The actor ``mu(s)`` outputs one vector: K action scores and the parameters of *every* action
+(``sum_a m_a`` values), all kept in ``[-1, 1]``. The executed action is the argmax of the scores with its
+own parameters; the critic ``Q(s, mu(s))`` sees the whole vector, so the actor is trained by DDPG's
+deterministic policy gradient ``dQ/dmu * dmu/dtheta`` through all of it.
+
+Bounded outputs (``bound``, the three options Hausknecht & Stone compared; spec "PADDPG"):
+
+- ``invert`` (the default, theirs): with ``g = dQ/dp`` at the actor's output, scale ``g`` by
+  ``(p_max - p) / (p_max - p_min)`` where it would increase ``p`` and by ``(p - p_min) / (p_max - p_min)``
+  where it would decrease it, so an output slows down as it nears a bound and is pushed back (the factor
+  turns negative) once it has crossed one. See :func:`invert_gradients`.
+- ``squash``: a Tanh output layer and the plain gradient.
+- ``zero``: the plain gradient, except that components pushing an output at or past a bound further out
+  are set to 0 (:func:`zero_gradients`).
+
+The bound handling edits ``dQ/dp`` for the whole batch before it is back-propagated into the actor.
+Exploration is epsilon-greedy over the whole output vector (uniform in ``[-1, 1]`` with probability
+epsilon, annealed linearly), optionally with Ornstein-Uhlenbeck noise on the actor's parameters. Targets
+may mix in on-policy Monte-Carlo returns, ``y = beta * MC + (1 - beta) * (r + gamma Q'(s', mu'(s')))``; a
+transition whose episode has not ended yet uses the TD target alone.
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+
+import numpy as np
+import torch
+import torch.nn.functional as F
+from torch import nn
+
+from pamdp.algos.base import AlgoConfig, Algorithm, setting
+from pamdp.algos.offpolicy import OffPolicyLoop, soft_update
+from pamdp.algos.replay import ReplayBuffer
+from pamdp.policies import ACTIVATIONS, mlp
+from pamdp.spaces import HybridActionSpace
+
+__all__ = ["PADDPG", "PADDPGConfig", "invert_gradients", "zero_gradients", "BOUNDS"]
+
+BOUNDS = ("invert", "squash", "zero")
+
+
+@dataclasses.dataclass(frozen=True)
+class PADDPGConfig(AlgoConfig):
+    """PADDPG's settings. The defaults are the seed paper's preset: Hausknecht & Stone's settings with the
+    hidden layers {400, 300} of DDPG (the paper used {400, 300, 200} on Half Field Offense: preset
+    ``paper_hfo``; Hausknecht & Stone's own 1024-512-256-128 towers: preset ``hausknecht_stone``)."""
+
+    num_envs: int = setting(
+        8, "Copies of the env stepped together; learning per sample is set by updates_per_step, not by this."
+    )
+    hidden_sizes: tuple[int, ...] = setting(
+        (400, 300), "Hidden layers of the actor and the critic (paper: {400, 300})."
+    )
+    activation: str = setting("leaky_relu", "Hidden activation: leaky_relu (slope 0.01, Hausknecht & Stone), relu, ...")
+    bound: str = setting("invert", "Keeping outputs in [-1, 1]: invert (inverting gradients), squash (Tanh) or zero.")
+    actor_lr: float = setting(1e-5, "Adam learning rate of the actor (Hausknecht & Stone: 1e-5).")
+    critic_lr: float = setting(1e-3, "Adam learning rate of the critic (Hausknecht & Stone: 1e-3).")
+    adam_beta1: float = setting(0.95, "Adam's beta1 for both networks (Hausknecht & Stone: 0.95).")
+    grad_clip: float = setting(10.0, "Clip each network's gradient norm to this; 0 turns clipping off (H&S: 10).")
+    batch_size: int = setting(32, "Transitions per gradient update (Hausknecht & Stone: 32).")
+    gamma: float = setting(0.99, "Discount factor.")
+    tau: float = setting(0.001, "Soft target-update rate: target <- tau * online + (1 - tau) * target.")
+    beta: float = setting(
+        0.2, "Weight of the Monte-Carlo return in the target (H&S: 0.2 to 0.5); 0 gives DDPG's pure TD target."
+    )
+    epsilon_start: float = setting(1.0, "Exploration rate at the start: the chance of a uniformly random output.")
+    epsilon_end: float = setting(0.1, "Exploration rate after the annealing.")
+    epsilon_steps: int = setting(100_000, "Environment samples over which epsilon falls linearly to epsilon_end.")
+    ou_sigma: float = setting(0.0, "Scale of Ornstein-Uhlenbeck noise on the actor's parameters; 0 turns it off.")
+    ou_theta: float = setting(0.15, "Mean reversion of the Ornstein-Uhlenbeck noise (DDPG's 0.15).")
+    buffer_size: int = setting(500_000, "Replay capacity (Hausknecht & Stone: 500 000).")
+    learning_starts: int = setting(
+        10_000, "Samples in the replay buffer before the first update (the seed paper: 10^4)."
+    )
+    updates_per_step: float = setting(1.0, "Update-to-data ratio: gradient updates per environment sample.")
+    epoch_steps: int = setting(10_000, "Samples per epoch, the unit of logging and checkpoints (paper: 10 000).")
+    save_replay: bool = setting(
+        False, "Store the replay contents in checkpoints (large); otherwise a resumed run refills the buffer."
+    )
+
+    def __post_init__(self):
+        super().__post_init__()
+        self._check(
+            len(self.hidden_sizes) > 0 and all(h > 0 for h in self.hidden_sizes), "hidden_sizes", "positive layer sizes"
+        )
+        self._check(self.activation in ACTIVATIONS, "activation", f"one of {', '.join(ACTIVATIONS)}")
+        self._check(self.bound in BOUNDS, "bound", f"one of {', '.join(BOUNDS)}")
+        self._check(self.actor_lr > 0, "actor_lr", "a positive learning rate")
+        self._check(self.critic_lr > 0, "critic_lr", "a positive learning rate")
+        self._check(0 <= self.adam_beta1 < 1, "adam_beta1", "a number in [0, 1)")
+        self._check(self.grad_clip >= 0, "grad_clip", "a non-negative norm (0: off)")
+        self._check(self.batch_size >= 1, "batch_size", "an integer >= 1")
+        self._check(0 <= self.gamma <= 1, "gamma", "a number in [0, 1]")
+        self._check(0 < self.tau <= 1, "tau", "a number in (0, 1]")
+        self._check(0 <= self.beta <= 1, "beta", "a number in [0, 1]")
+        self._check(0 <= self.epsilon_start <= 1, "epsilon_start", "a probability")
+        self._check(0 <= self.epsilon_end <= 1, "epsilon_end", "a probability")
+        self._check(self.epsilon_steps >= 1, "epsilon_steps", "an integer >= 1")
+        self._check(self.ou_sigma >= 0, "ou_sigma", "a non-negative scale")
+        self._check(0 < self.ou_theta <= 1, "ou_theta", "a number in (0, 1]")
+        self._check(self.buffer_size >= 1, "buffer_size", "an integer >= 1")
+        self._check(self.learning_starts >= 0, "learning_starts", "a non-negative integer")
+        self._check(self.updates_per_step > 0, "updates_per_step", "a positive ratio")
+        self._check(self.epoch_steps >= 1, "epoch_steps", "an integer >= 1")
+
+    @classmethod
+    def presets(cls) -> dict[str, PADDPGConfig]:
+        return {
+            "paper": cls(),
+            "paper_hfo": cls(hidden_sizes=(400, 300, 200)),
+            "hausknecht_stone": cls(hidden_sizes=(1024, 512, 256, 128)),
+        }
+
+
+def invert_gradients(grad: torch.Tensor, p: torch.Tensor, low: float = -1.0, high: float = 1.0) -> torch.Tensor:
+    """Hausknecht & Stone's inverting gradients, for an ascent direction ``grad = dQ/dp`` at outputs ``p``.
+
+    Components that would increase ``p`` are scaled by ``(high - p) / (high - low)``, those that would
+    decrease it by ``(p - low) / (high - low)``: 0 at the bound being approached, 1 at the far bound, and
+    negative (pushing back) once ``p`` is past it.
+    """
+    width = high - low
+    return grad * torch.where(grad > 0, (high - p) / width, (p - low) / width)
+
+
+def zero_gradients(grad: torch.Tensor, p: torch.Tensor, low: float = -1.0, high: float = 1.0) -> torch.Tensor:
+    """Zero the components of the ascent direction ``grad`` that push an output at or past a bound further out."""
+    leaving = ((grad > 0) & (p >= high)) | ((grad < 0) & (p <= low))
+    return torch.where(leaving, torch.zeros_like(grad), grad)
+
+
+class Actor(nn.Module):
+    """``mu(s)``: K scores then every action's parameters, ``K + sum_a m_a`` outputs (Tanh with ``squash``)."""
+
+    def __init__(self, obs_dim: int, hybrid: HybridActionSpace, hidden_sizes, activation: str, squash: bool):
+        super().__init__()
+        self.n_actions = hybrid.n_actions
+        out = hybrid.n_actions + hybrid.total_param_size
+        self.net = mlp(obs_dim, hidden_sizes, out, activation, nn.Tanh if squash else None)
+        # Where action a's padded parameter i sits in the output: K + offset_a + i (0 where unused).
+        offsets = np.concatenate([[0], np.cumsum(hybrid.param_sizes)[:-1]])
+        mask = hybrid.param_mask
+        index = np.where(mask, hybrid.n_actions + offsets[:, None] + np.arange(hybrid.max_param_size), 0)
+        self.register_buffer("param_index", torch.as_tensor(index, dtype=torch.long))
+        self.register_buffer("param_mask", torch.as_tensor(mask, dtype=torch.float32))
+
+    def forward(self, obs: torch.Tensor) -> torch.Tensor:
+        return self.net(obs)
+
+    def action(self, out: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        """The executed action for output vectors ``out``: argmax of the scores and its parameters, padded."""
+        a = out[:, : self.n_actions].argmax(-1)
+        x = out.gather(1, self.param_index[a]) * self.param_mask[a]
+        return a, x.clamp(-1.0, 1.0)
+
+
+class Critic(nn.Module):
+    """``Q(s, mu)`` on the state and the actor's whole output vector."""
+
+    def __init__(self, obs_dim: int, out_size: int, hidden_sizes, activation: str):
+        super().__init__()
+        self.net = mlp(obs_dim + out_size, hidden_sizes, 1, activation)
+
+    def forward(self, obs: torch.Tensor, out: torch.Tensor) -> torch.Tensor:
+        return self.net(torch.cat([obs, out], dim=-1)).squeeze(-1)
+
+
+class PADDPG(Algorithm):
+    """Parameterized-action DDPG with inverting gradients (Hausknecht & Stone). See :class:`PADDPGConfig`."""
+
+    config_class = PADDPGConfig
+    config: PADDPGConfig
+
+    def _build(self) -> None:
+        cfg, h = self.config, self.hybrid
+        self.out_size = h.n_actions + h.total_param_size
+        self.actor = Actor(self.obs_dim, h, cfg.hidden_sizes, cfg.activation, squash=cfg.bound == "squash")
+        self.critic = Critic(self.obs_dim, self.out_size, cfg.hidden_sizes, cfg.activation)
+        self.actor_target = copy.deepcopy(self.actor).requires_grad_(False)
+        self.critic_target = copy.deepcopy(self.critic).requires_grad_(False)
+        betas = (cfg.adam_beta1, 0.999)
+        self.actor_optimizer = torch.optim.Adam(self.actor.parameters(), lr=cfg.actor_lr, betas=betas, foreach=True)
+        self.critic_optimizer = torch.optim.Adam(self.critic.parameters(), lr=cfg.critic_lr, betas=betas, foreach=True)
+        d, m = self.obs_dim, h.max_param_size
+        fields = {
+            "obs": ((d,), np.float32),
+            "a": ((), np.int64),
+            "x": ((m,), np.float32),
+            "reward": ((), np.float32),
+            "next_obs": ((d,), np.float32),
+            "terminated": ((), np.bool_),
+            "out": ((self.out_size,), np.float32),  # the output vector the critic sees (after exploration)
+            "mc": ((), np.float32),  # Monte-Carlo return-to-go, NaN until the episode ends
+        }
+        self.replay = ReplayBuffer(cfg.buffer_size, fields)
+        self.loop = OffPolicyLoop(h, self.replay, cfg.gamma, mc_returns=cfg.beta > 0, tail_value=self._target_value)
+        self._ou: np.ndarray | None = None
+
+    def _modules(self):
+        return {
+            "actor": self.actor,
+            "critic": self.critic,
+            "actor_target": self.actor_target,
+            "critic_target": self.critic_target,
+        }
+
+    def _optimizers(self):
+        return {"actor": self.actor_optimizer, "critic": self.critic_optimizer}
+
+    def _extra_state(self):
+        return {"loop": self.loop.state_dict(self.config.save_replay)}
+
+    def _load_extra_state(self, state):
+        self.loop.load_state_dict(state["loop"])
+
+    def _act(self, obs, deterministic):
+        out = self.actor(obs).clamp(-1.0, 1.0)
+        if not deterministic:  # one epsilon-greedy draw at the final exploration rate
+            out = self._epsilon_greedy(out, self.config.epsilon_end)
+        return self.actor.action(out)
+
+    def epsilon(self, step: int) -> float:
+        """The exploration rate after ``step`` samples: linear from epsilon_start to epsilon_end."""
+        cfg = self.config
+        frac = min(step / cfg.epsilon_steps, 1.0)
+        return cfg.epsilon_start + frac * (cfg.epsilon_end - cfg.epsilon_start)
+
+    def _epsilon_greedy(self, out: torch.Tensor, eps: float) -> torch.Tensor:
+        random = self.np_rng.random(len(out)) < eps
+        uniform = self.np_rng.uniform(-1.0, 1.0, size=out.shape).astype(np.float32)
+        return torch.where(torch.from_numpy(random)[:, None], torch.from_numpy(uniform), out)
+
+    def _explore(self, obs: torch.Tensor, step: int, episode_start: np.ndarray):
+        cfg = self.config
+        out = self.actor(obs)
+        if cfg.ou_sigma > 0:
+            if self._ou is None or len(self._ou) != len(obs):
+                self._ou = np.zeros((len(obs), self.out_size - self.hybrid.n_actions))
+            self._ou[episode_start] = 0.0
+            self._ou += -cfg.ou_theta * self._ou + cfg.ou_sigma * self.np_rng.standard_normal(self._ou.shape)
+            noise = np.concatenate([np.zeros((len(obs), self.hybrid.n_actions)), self._ou], axis=1)
+            out = out + torch.from_numpy(noise.astype(np.float32))
+        out = self._epsilon_greedy(out.clamp(-1.0, 1.0), self.epsilon(step))
+        a, x = self.actor.action(out)
+        return a, x, {"out": out.numpy()}
+
+    def _target_value(self, obs: np.ndarray) -> np.ndarray:
+        """``Q'(s, mu'(s))``, the bootstrap of a truncated episode's Monte-Carlo return."""
+        with torch.no_grad():
+            o = torch.from_numpy(obs)
+            return self.critic_target(o, self.actor_target(o).clamp(-1.0, 1.0)).numpy()
+
+    def _run_epoch(self) -> dict[str, float]:
+        cfg = self.config
+        stats = self.loop.run_epoch(
+            self.vec_env,
+            self._explore,
+            self._update,
+            cfg.epoch_steps,
+            self.num_timesteps,
+            cfg.learning_starts,
+            cfg.updates_per_step,
+            self.np_rng,
+        )
+        stats["train/epsilon"] = self.epsilon(self.num_timesteps + stats["steps"])
+        return stats
+
+    def _step(self, optimizer: torch.optim.Optimizer, params) -> None:
+        if self.config.grad_clip > 0:
+            nn.utils.clip_grad_norm_(params, self.config.grad_clip)
+        optimizer.step()
+
+    def _update(self) -> dict[str, float]:
+        """One critic step on the mixed target and one actor step along the bounded ``dQ/dmu``."""
+        cfg = self.config
+        b = self.replay.sample(cfg.batch_size, self.np_rng)
+        obs, next_obs = b["obs"], b["next_obs"]
+        with torch.no_grad():
+            q_next = self.critic_target(next_obs, self.actor_target(next_obs).clamp(-1.0, 1.0))
+            y = b["reward"] + cfg.gamma * (~b["terminated"]).float() * q_next
+            if cfg.beta > 0:
+                known = ~torch.isnan(b["mc"])
+                y = torch.where(known, cfg.beta * b["mc"].nan_to_num() + (1 - cfg.beta) * y, y)
+        q = self.critic(obs, b["out"])
+        critic_loss = F.mse_loss(q, y)
+        self.critic_optimizer.zero_grad(set_to_none=True)
+        critic_loss.backward()
+        self._step(self.critic_optimizer, self.critic.parameters())
+
+        out = self.actor(obs)
+        p = out.detach().requires_grad_(True)
+        q_mu = self.critic(obs, p)
+        (dq_dp,) = torch.autograd.grad(q_mu.sum(), p)  # per-sample dQ/dp, the ascent direction
+        if cfg.bound == "invert":
+            dq_dp = invert_gradients(dq_dp, p.detach())
+        elif cfg.bound == "zero":
+            dq_dp = zero_gradients(dq_dp, p.detach())
+        self.actor_optimizer.zero_grad(set_to_none=True)
+        out.backward(-dq_dp / len(out))  # descend on -mean Q
+        self._step(self.actor_optimizer, self.actor.parameters())
+
+        soft_update(self.critic_target, self.critic, cfg.tau)
+        soft_update(self.actor_target, self.actor, cfg.tau)
+        outside = (out.detach().abs() > 1.0).float().mean()
+        return {
+            "losses/critic_loss": float(critic_loss.detach()),
+            "losses/actor_loss": float(-q_mu.detach().mean()),
+            "train/q_mean": float(q.detach().mean()),
+            "train/outputs_out_of_bounds": float(outside),
+        }

@@ -1,0 +1,312 @@
+"""PASVG(0): stochastic value gradients through a Gumbel-Softmax hierarchical policy (Wei, Wicke & Luke 2018).
+
+Section "Parameterized Actions SVG(0)" of the paper, in the reparameterised form
+
+    a = f(s, eta_a)     = onehot(argmax(log pi_d(.|s) + eta_a)), eta_a ~ Gumbel(0, 1)^K
+    x = g(s, a, eta_x)  = tanh(mu(s, a) + sigma_a * eta_x),       eta_x ~ N(0, 1)^m
+
+where the argmax is relaxed to ``softmax((log pi_d + eta_a) / temperature)`` for the backward pass (the
+straight-through estimator; with ``straight_through=False`` the critic sees the soft sample itself), and
+``pi_c``'s mean ``mu`` is conditioned on that sample. The objective
+``J = E_s E_eta [Q(s, f(s, eta_a), g(s, f(s, eta_a), eta_x))]`` is differentiable in both policies, so one
+loss ``-Q`` trains ``pi_d`` and ``pi_c`` together. The noise ``eta = (eta_a, eta_x)`` drawn while acting is
+recorded with the transition: as the paper notes, the policy gradient at a replayed state reuses it, with no
+inference of ``p(eta | s, a, x)``.
+
+The critic ``Q(s, a, x)`` (the action as a one-hot, or the soft sample) is trained by TD from replay against
+target networks updated softly, as in DDPG; the next action in the target is drawn from the target policy
+with fresh noise, so ``Q`` estimates the value of the stochastic policy being optimised.
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+
+import numpy as np
+import torch
+import torch.nn.functional as F
+from torch import nn
+
+from pamdp.algos.base import AlgoConfig, Algorithm, setting
+from pamdp.algos.offpolicy import OffPolicyLoop, soft_update
+from pamdp.algos.replay import ReplayBuffer
+from pamdp.policies import ACTIVATIONS, mlp
+from pamdp.spaces import HybridActionSpace
+
+__all__ = ["PASVG0", "PASVG0Config", "GumbelHybridPolicy", "gumbel_noise", "gumbel_softmax_sample"]
+
+LOG_STD_MIN, LOG_STD_MAX = -5.0, 2.0
+
+
+@dataclasses.dataclass(frozen=True)
+class PASVG0Config(AlgoConfig):
+    """PASVG(0)'s settings; the defaults are the paper's preset (DDPG's where the paper says nothing)."""
+
+    num_envs: int = setting(
+        8, "Copies of the env stepped together; learning per sample is set by updates_per_step, not by this."
+    )
+    hidden_sizes: tuple[int, ...] = setting(
+        (400, 300), "Hidden layers of pi_d, pi_c and the critic (paper: {400, 300})."
+    )
+    activation: str = setting("relu", "Hidden activation: relu (paper), tanh, leaky_relu or elu.")
+    temperature: float = setting(
+        1.0, "Gumbel-Softmax temperature t (paper: 1.0, fixed); lower is less biased, higher less noisy."
+    )
+    straight_through: bool = setting(
+        True,
+        "The critic sees the hard one-hot (straight-through gradient); false: the soft Gumbel-Softmax sample.",
+    )
+    init_log_std: float = setting(
+        -0.5, "Initial log-std of the parameter noise, added before pi_c's Tanh (so x stays in [-1, 1])."
+    )
+    learn_std: bool = setting(True, "Train the parameter noise's log-std by the value gradient too (SVG); else fixed.")
+    entropy_coef: float = setting(
+        0.0, "Weight of pi_d's entropy in the policy loss (0 in the paper); keeps the discrete choice exploring."
+    )
+    critic_lr: float = setting(1e-3, "Adam learning rate of the critic (paper: 1e-3).")
+    policy_lr: float = setting(1e-5, "Adam learning rate of pi_d and pi_c (paper: 1e-5, which learns slowly).")
+    batch_size: int = setting(64, "Transitions per gradient update (DDPG's 64; the paper does not say).")
+    gamma: float = setting(0.99, "Discount factor.")
+    tau: float = setting(0.001, "Soft target-update rate (DDPG's 0.001): target <- tau * online + (1 - tau) * target.")
+    grad_clip: float = setting(0.0, "Clip each network's gradient norm to this before a step; 0 turns clipping off.")
+    buffer_size: int = setting(
+        10_000_000, "Replay capacity (paper: 10^7); memory grows with the contents, not the capacity."
+    )
+    learning_starts: int = setting(10_000, "Samples in the replay buffer before the first update (paper: 10^4).")
+    updates_per_step: float = setting(
+        1.0, "Update-to-data ratio: gradient updates (critic and policy) per environment sample."
+    )
+    epoch_steps: int = setting(10_000, "Samples per epoch, the unit of logging and checkpoints (paper: 10 000).")
+    save_replay: bool = setting(
+        False, "Store the replay contents in checkpoints (large); otherwise a resumed run refills the buffer."
+    )
+
+    def __post_init__(self):
+        super().__post_init__()
+        self._check(
+            len(self.hidden_sizes) > 0 and all(h > 0 for h in self.hidden_sizes), "hidden_sizes", "positive layer sizes"
+        )
+        self._check(self.activation in ACTIVATIONS, "activation", f"one of {', '.join(ACTIVATIONS)}")
+        self._check(self.temperature > 0, "temperature", "a positive number")
+        self._check(
+            LOG_STD_MIN <= self.init_log_std <= LOG_STD_MAX, "init_log_std", f"in [{LOG_STD_MIN}, {LOG_STD_MAX}]"
+        )
+        self._check(self.entropy_coef >= 0, "entropy_coef", "a non-negative number")
+        self._check(self.critic_lr > 0, "critic_lr", "a positive learning rate")
+        self._check(self.policy_lr > 0, "policy_lr", "a positive learning rate")
+        self._check(self.batch_size >= 1, "batch_size", "an integer >= 1")
+        self._check(0 <= self.gamma <= 1, "gamma", "a number in [0, 1]")
+        self._check(0 < self.tau <= 1, "tau", "a number in (0, 1]")
+        self._check(self.grad_clip >= 0, "grad_clip", "a non-negative norm (0: off)")
+        self._check(self.buffer_size >= 1, "buffer_size", "an integer >= 1")
+        self._check(self.learning_starts >= 0, "learning_starts", "a non-negative integer")
+        self._check(self.updates_per_step > 0, "updates_per_step", "a positive ratio")
+        self._check(self.epoch_steps >= 1, "epoch_steps", "an integer >= 1")
+
+    @classmethod
+    def presets(cls) -> dict[str, PASVG0Config]:
+        return {
+            "paper": cls(),
+            "tuned": cls(
+                hidden_sizes=(256, 256),
+                policy_lr=1e-4,
+                tau=0.005,
+                batch_size=128,
+                entropy_coef=0.01,
+                buffer_size=1_000_000,
+            ),
+        }
+
+
+def gumbel_noise(shape: tuple[int, ...], generator: torch.Generator) -> torch.Tensor:
+    """Standard Gumbel samples ``-log(-log U)`` from ``generator`` (torch's own sampler uses the global RNG)."""
+    u = torch.rand(shape, generator=generator).clamp_(1e-10, 1.0 - 1e-7)
+    return -torch.log(-torch.log(u))
+
+
+def gumbel_softmax_sample(
+    logits: torch.Tensor, eta: torch.Tensor, temperature: float, hard: bool
+) -> tuple[torch.Tensor, torch.Tensor]:
+    """The Gumbel-Softmax sample for noise ``eta``: ``(index, sample)``.
+
+    ``index = argmax(logits + eta)`` is an exact draw from ``softmax(logits)`` (the Gumbel-max trick).
+    ``sample`` is ``softmax((logits + eta) / temperature)``, or with ``hard`` the one-hot of ``index`` in the
+    forward pass carrying the softmax's gradient in the backward pass (straight-through).
+    """
+    z = logits.log_softmax(-1) + eta
+    soft = torch.softmax(z / temperature, dim=-1)
+    index = z.argmax(-1)
+    if not hard:
+        return index, soft
+    onehot = F.one_hot(index, logits.shape[-1]).to(soft.dtype)
+    return index, onehot - soft.detach() + soft
+
+
+class GumbelHybridPolicy(nn.Module):
+    """``pi_d`` (logits over K actions) and ``pi_c`` (pre-Tanh means of ``m`` parameters given ``[s, a]``).
+
+    The parameter noise has a state-independent log-std per action and parameter; parameters an action does
+    not use (its entries beyond ``m_a``) are set to 0 so they carry no noise into the critic.
+    """
+
+    def __init__(self, obs_dim: int, hybrid: HybridActionSpace, hidden_sizes, activation: str, init_log_std: float):
+        super().__init__()
+        self.n_actions, self.param_size = hybrid.n_actions, hybrid.max_param_size
+        self.pi_d = mlp(obs_dim, hidden_sizes, self.n_actions, activation)
+        self.pi_c = mlp(obs_dim + self.n_actions, hidden_sizes, self.param_size, activation)
+        self.log_std = nn.Parameter(torch.full((self.n_actions, self.param_size), float(init_log_std)))
+        self.register_buffer("mask", torch.as_tensor(hybrid.param_mask, dtype=torch.float32))
+        # Small final layers start pi_d near uniform and pi_c near the centre of the parameter box.
+        for head in (self.pi_d[-1], self.pi_c[-1]):
+            nn.init.uniform_(head.weight, -3e-3, 3e-3)
+            nn.init.zeros_(head.bias)
+
+    def forward(
+        self, obs: torch.Tensor, eta_a: torch.Tensor, eta_x: torch.Tensor, temperature: float, hard: bool
+    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+        """``(index, a, x)`` for the noise ``(eta_a, eta_x)``; ``a`` is the critic's action input."""
+        index, a = gumbel_softmax_sample(self.pi_d(obs), eta_a, temperature, hard)
+        std = self.log_std.clamp(LOG_STD_MIN, LOG_STD_MAX).exp()[index]
+        x = torch.tanh(self.pi_c(torch.cat([obs, a], dim=-1)) + std * eta_x) * self.mask[index]
+        return index, a, x
+
+    def mode(self, obs: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        """The greedy action: the most probable discrete action and its mean parameters."""
+        index = self.pi_d(obs).argmax(-1)
+        onehot = F.one_hot(index, self.n_actions).to(obs.dtype)
+        return index, torch.tanh(self.pi_c(torch.cat([obs, onehot], dim=-1))) * self.mask[index]
+
+
+class Critic(nn.Module):
+    """``Q(s, a, x)`` with the discrete action as a one-hot (or soft sample) ``a``."""
+
+    def __init__(self, obs_dim: int, n_actions: int, param_size: int, hidden_sizes, activation: str):
+        super().__init__()
+        self.net = mlp(obs_dim + n_actions + param_size, hidden_sizes, 1, activation)
+
+    def forward(self, obs: torch.Tensor, a: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
+        return self.net(torch.cat([obs, a, x], dim=-1)).squeeze(-1)
+
+
+class PASVG0(Algorithm):
+    """Parameterized Actions SVG(0). See the module docstring for the update and :class:`PASVG0Config`."""
+
+    config_class = PASVG0Config
+    config: PASVG0Config
+
+    def _build(self) -> None:
+        cfg, h = self.config, self.hybrid
+        self.policy = GumbelHybridPolicy(self.obs_dim, h, cfg.hidden_sizes, cfg.activation, cfg.init_log_std)
+        self.policy.log_std.requires_grad_(cfg.learn_std)
+        self.critic = Critic(self.obs_dim, h.n_actions, h.max_param_size, cfg.hidden_sizes, cfg.activation)
+        self.policy_target = copy.deepcopy(self.policy).requires_grad_(False)
+        self.critic_target = copy.deepcopy(self.critic).requires_grad_(False)
+        self.policy_optimizer = torch.optim.Adam(
+            [p for p in self.policy.parameters() if p.requires_grad], lr=cfg.policy_lr, foreach=True
+        )
+        self.critic_optimizer = torch.optim.Adam(self.critic.parameters(), lr=cfg.critic_lr, foreach=True)
+        K, m, d = h.n_actions, h.max_param_size, self.obs_dim
+        fields = {
+            "obs": ((d,), np.float32),
+            "a": ((), np.int64),
+            "x": ((m,), np.float32),
+            "reward": ((), np.float32),
+            "next_obs": ((d,), np.float32),
+            "terminated": ((), np.bool_),
+            "a_in": ((K,), np.float32),  # the critic's action input: one-hot, or the soft sample
+            "eta_a": ((K,), np.float32),
+            "eta_x": ((m,), np.float32),
+        }
+        self.replay = ReplayBuffer(cfg.buffer_size, fields)
+        self.loop = OffPolicyLoop(h, self.replay, cfg.gamma)
+
+    def _modules(self):
+        return {
+            "policy": self.policy,
+            "critic": self.critic,
+            "policy_target": self.policy_target,
+            "critic_target": self.critic_target,
+        }
+
+    def _optimizers(self):
+        return {"policy": self.policy_optimizer, "critic": self.critic_optimizer}
+
+    def _extra_state(self):
+        return {"loop": self.loop.state_dict(self.config.save_replay)}
+
+    def _load_extra_state(self, state):
+        self.loop.load_state_dict(state["loop"])
+
+    def _noise(self, batch: int) -> tuple[torch.Tensor, torch.Tensor]:
+        eta_a = gumbel_noise((batch, self.hybrid.n_actions), self.torch_gen)
+        eta_x = torch.randn((batch, self.hybrid.max_param_size), generator=self.torch_gen)
+        return eta_a, eta_x
+
+    def _act(self, obs, deterministic):
+        if deterministic:
+            return self.policy.mode(obs)
+        index, _, x = self.policy(obs, *self._noise(len(obs)), self.config.temperature, True)
+        return index, x
+
+    def _explore(self, obs: torch.Tensor, step: int, episode_start: np.ndarray):
+        eta_a, eta_x = self._noise(len(obs))
+        index, a_in, x = self.policy(obs, eta_a, eta_x, self.config.temperature, self.config.straight_through)
+        return index, x, {"a_in": a_in.numpy(), "eta_a": eta_a.numpy(), "eta_x": eta_x.numpy()}
+
+    def _run_epoch(self) -> dict[str, float]:
+        cfg = self.config
+        return self.loop.run_epoch(
+            self.vec_env,
+            self._explore,
+            self._update,
+            cfg.epoch_steps,
+            self.num_timesteps,
+            cfg.learning_starts,
+            cfg.updates_per_step,
+            self.np_rng,
+        )
+
+    def _step(self, optimizer: torch.optim.Optimizer, loss: torch.Tensor, params) -> None:
+        optimizer.zero_grad(set_to_none=True)
+        loss.backward()
+        if self.config.grad_clip > 0:
+            nn.utils.clip_grad_norm_(params, self.config.grad_clip)
+        optimizer.step()
+
+    def _update(self) -> dict[str, float]:
+        """One critic TD step and one value-gradient step of both policies on a replayed minibatch."""
+        cfg = self.config
+        b = self.replay.sample(cfg.batch_size, self.np_rng)
+        obs, next_obs = b["obs"], b["next_obs"]
+        with torch.no_grad():
+            _, a_next, x_next = self.policy_target(
+                next_obs, *self._noise(len(obs)), cfg.temperature, cfg.straight_through
+            )
+            q_next = self.critic_target(next_obs, a_next, x_next)
+            y = b["reward"] + cfg.gamma * (~b["terminated"]).float() * q_next
+        q = self.critic(obs, b["a_in"], b["x"])
+        critic_loss = F.mse_loss(q, y)
+        self._step(self.critic_optimizer, critic_loss, self.critic.parameters())
+
+        # The recorded noise, pushed through the current policy: a = f(s, eta_a), x = g(s, a, eta_x).
+        _, a, x = self.policy(obs, b["eta_a"], b["eta_x"], cfg.temperature, cfg.straight_through)
+        self.critic.requires_grad_(False)  # the policy loss differentiates Q in (a, x) only
+        q_pi = self.critic(obs, a, x)
+        self.critic.requires_grad_(True)
+        logits = self.policy.pi_d(obs)
+        entropy = -(logits.softmax(-1) * logits.log_softmax(-1)).sum(-1).mean()
+        actor_loss = -q_pi.mean() - cfg.entropy_coef * entropy
+        self._step(self.policy_optimizer, actor_loss, self.policy.parameters())
+
+        soft_update(self.critic_target, self.critic, cfg.tau)
+        soft_update(self.policy_target, self.policy, cfg.tau)
+        mask = self.policy.mask.bool()
+        return {
+            "losses/critic_loss": float(critic_loss.detach()),
+            "losses/actor_loss": float(actor_loss.detach()),
+            "train/q_mean": float(q.detach().mean()),
+            "train/q_pi_mean": float(q_pi.detach().mean()),
+            "train/entropy": float(entropy.detach()),
+            "train/param_std": float(self.policy.log_std.detach().exp()[mask].mean()),
+        }

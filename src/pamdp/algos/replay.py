@@ -1,0 +1,111 @@
+"""The replay buffer shared by the off-policy algorithms (PASVG(0), PADDPG).
+
+One preallocated NumPy array per field, written as a ring: the newest transition overwrites the oldest once
+``capacity`` is reached. Arrays are created with ``np.empty``, which reserves address space without
+touching it, so the paper's capacity of 10^7 costs memory only as it fills (10^7 Platform transitions
+hold about 0.9 GB once full) and never allocates a Python object per slot.
+
+Fields are declared by the algorithm (``{"obs": ((9,), np.float32), "eta_a": ((3,), np.float32), ...}``),
+so algorithm-specific extras such as PASVG(0)'s recorded noise ``eta`` or PADDPG's Monte-Carlo returns
+live beside the usual ``obs, reward, next_obs, terminated``.
+
+Saving the contents in a checkpoint is optional (``state_dict(include_data=...)``): a full buffer is
+large. When a checkpoint holds no contents, a resumed run starts with an empty buffer and refills it,
+waiting for ``learning_starts`` fresh samples before it updates again, so it is not bit-identical to an
+uninterrupted run.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+import torch
+
+__all__ = ["ReplayBuffer"]
+
+FieldSpec = Mapping[str, tuple[tuple[int, ...], type | np.dtype]]
+
+
+class ReplayBuffer:
+    """A ring buffer of transitions in preallocated NumPy arrays.
+
+    Args:
+        capacity: the most transitions held; older ones are overwritten.
+        fields: name -> (shape of one item, dtype).
+    """
+
+    def __init__(self, capacity: int, fields: FieldSpec):
+        if capacity < 1:
+            raise ValueError(f"capacity = {capacity!r}; expected an integer >= 1")
+        if not fields:
+            raise ValueError("a replay buffer needs at least one field")
+        self.capacity = int(capacity)
+        self.fields = {name: (tuple(shape), np.dtype(dtype)) for name, (shape, dtype) in fields.items()}
+        self.data = {name: np.empty((self.capacity, *shape), dtype) for name, (shape, dtype) in self.fields.items()}
+        self.added = 0  # transitions ever added; the next one goes to slot added % capacity
+
+    def __len__(self) -> int:
+        return min(self.added, self.capacity)
+
+    def add(self, **batch: np.ndarray) -> np.ndarray:
+        """Append a batch (every field, same leading length ``n``); returns the insertion counters used.
+
+        The counter ``c`` of a transition locates it (slot ``c % capacity``) for as long as
+        :meth:`holds` says it has not been overwritten.
+        """
+        if set(batch) != set(self.fields):
+            raise ValueError(f"add() got fields {sorted(batch)}; expected {sorted(self.fields)}")
+        n = len(next(iter(batch.values())))
+        if n > self.capacity:  # only the last `capacity` would survive anyway
+            batch = {k: np.asarray(v)[-self.capacity :] for k, v in batch.items()}
+            self.added += n - self.capacity
+            n = self.capacity
+        counters = np.arange(self.added, self.added + n)
+        slots = counters % self.capacity
+        for name, value in batch.items():
+            value = np.asarray(value)
+            if len(value) != n:
+                raise ValueError(f"field {name!r} has {len(value)} rows; expected {n}")
+            self.data[name][slots] = value.reshape((n, *self.fields[name][0]))
+        self.added += n
+        return counters
+
+    def holds(self, counters: np.ndarray) -> np.ndarray:
+        """Which insertion counters still refer to their own transition (not yet overwritten)."""
+        return np.asarray(counters) >= self.added - self.capacity
+
+    def write(self, name: str, counters: np.ndarray, values: np.ndarray) -> None:
+        """Set field ``name`` of already stored transitions, skipping any that have been overwritten."""
+        counters, values = np.asarray(counters), np.asarray(values)
+        keep = self.holds(counters)
+        self.data[name][counters[keep] % self.capacity] = values[keep]
+
+    def sample(self, batch_size: int, rng: np.random.Generator) -> dict[str, torch.Tensor]:
+        """``batch_size`` transitions drawn uniformly with replacement, as tensors sharing no memory with the buffer."""
+        if len(self) == 0:
+            raise ValueError("cannot sample from an empty replay buffer")
+        idx = rng.integers(0, len(self), size=batch_size)
+        return {name: torch.from_numpy(arr[idx]) for name, arr in self.data.items()}
+
+    # -- checkpoints ------------------------------------------------------------------------------
+    def state_dict(self, include_data: bool) -> dict:
+        """Plain data for a checkpoint; the contents only with ``include_data`` (they can be gigabytes)."""
+        state: dict = {"added": self.added, "has_data": bool(include_data)}
+        if include_data:
+            n = len(self)
+            state["data"] = {name: torch.from_numpy(arr[:n].copy()) for name, arr in self.data.items()}
+        return state
+
+    def load_state_dict(self, state: dict) -> None:
+        """Restore contents saved with ``include_data``; otherwise leave the buffer empty (to be refilled)."""
+        if not state.get("has_data"):
+            self.added = 0
+            return
+        n = None
+        for name, tensor in state["data"].items():
+            if name not in self.data:
+                raise ValueError(f"replay state has unknown field {name!r}")
+            n = len(tensor)
+            self.data[name][:n] = tensor.numpy()
+        self.added = int(state["added"]) if n == self.capacity else int(n or 0)
