@@ -55,7 +55,8 @@ class HalfFieldOffenseEnv(gymnasium.Env):
             instead of ``truncated``. The untouched and trial clocks are not in the observation, so by
             default they count as truncation.
         body_reset: ``"carry"`` keeps the body angle from the end of the previous episode, as the real
-            server does (the first episode faces the goal); ``"uniform"`` draws it in (-180, 180].
+            server does (the first episode faces the goal, and so does a reset with a seed, so that a
+            seed reproduces an episode); ``"uniform"`` draws it in (-180, 180].
         first_step_reward: difference the first transition against the reset state. H&S's and
             gym-soccer's code start differencing after the first action, so by default the first
             transition pays only the goal bonus.
@@ -106,6 +107,8 @@ class HalfFieldOffenseEnv(gymnasium.Env):
         game = self.game
         game.set_rng(self.np_random)  # a seed replaces the generator
         bx, by, px, py = game.draw_placement()
+        if seed is not None:
+            game.body = 0.0  # a seed starts a new server run, whose first episode faces the goal
         if self.body_reset == "uniform":
             game.body = phys.normalize_angle(360.0 * self.np_random.random() - 180.0)
         if "ball" in placement:

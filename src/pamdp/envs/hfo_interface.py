@@ -3,6 +3,8 @@ settings and reset options, and the top-down drawing for ``render_mode="rgb_arra
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from gymnasium import spaces
 
@@ -89,31 +91,49 @@ def _to_px(x: float, y: float) -> tuple[float, float]:
     return (x - _X_MIN) * _PX_PER_M, (y + _Y_MAX) * _PX_PER_M
 
 
+@functools.lru_cache(maxsize=1)
+def _field_image() -> np.ndarray:
+    """The static part of every frame: grass, touch and goal lines, penalty box, goal and posts."""
+    canvas = Canvas(int((_X_MAX - _X_MIN) * _PX_PER_M), int(2 * _Y_MAX * _PX_PER_M), _GRASS)
+
+    def hline(x0, x1, y, width=1.6):
+        (a, b), (c, _) = _to_px(x0, y), _to_px(x1, y)
+        canvas.rect(a, b - width / 2, c, b + width / 2, _LINE)
+
+    def vline(x, y0, y1, width=1.6):
+        (a, b), (_, d) = _to_px(x, y0), _to_px(x, y1)
+        canvas.rect(a - width / 2, b, a + width / 2, d, _LINE)
+
+    L, W = phys.PITCH_HALF_LENGTH, phys.PITCH_HALF_WIDTH
+    gw = phys.GOAL_HALF_WIDTH
+    canvas.rect(*_to_px(L, -gw), *_to_px(L + 2.44, gw), _GOAL)
+    hline(0, L, -W, 2.0)
+    hline(0, L, W, 2.0)
+    vline(0, -W, W, 2.0)
+    vline(L, -W, W, 2.0)
+    pa_x, pa_w = phys.PENALTY_AREA_X, phys.PENALTY_AREA_HALF_WIDTH
+    vline(pa_x, -pa_w, pa_w)
+    hline(pa_x, L, -pa_w)
+    hline(pa_x, L, pa_w)
+    for sy in (-1.0, 1.0):
+        canvas.circle(*_to_px(phys.POST_X, sy * phys.POST_Y), 2.0, (20, 20, 20))
+    canvas.image.flags.writeable = False
+    return canvas.image
+
+
 def draw_half_field(px: float, py: float, body: float, bx: float, by: float) -> np.ndarray:
     """An ``(H, W, 3)`` uint8 top view of the attacked half: lines, goal, posts, penalty box, ball, player.
 
     The player is a blue disc with a white line along its body direction; y grows downwards as in the
     server's frame.
     """
-    canvas = Canvas(int((_X_MAX - _X_MIN) * _PX_PER_M), int(2 * _Y_MAX * _PX_PER_M), _GRASS)
-    w = 1.0
-
-    def line(x0, y0, x1, y1, color=_LINE, width=w):
-        canvas.line(*_to_px(x0, y0), *_to_px(x1, y1), color, width)
-
-    L, W = phys.PITCH_HALF_LENGTH, phys.PITCH_HALF_WIDTH
-    for x0, y0, x1, y1 in [(0, -W, L, -W), (0, W, L, W), (0, -W, 0, W), (L, -W, L, W)]:
-        line(x0, y0, x1, y1, width=2.0)
-    pa_x, pa_w = phys.PENALTY_AREA_X, phys.PENALTY_AREA_HALF_WIDTH
-    for x0, y0, x1, y1 in [(pa_x, -pa_w, pa_x, pa_w), (pa_x, -pa_w, L, -pa_w), (pa_x, pa_w, L, pa_w)]:
-        line(x0, y0, x1, y1)
-    gw = phys.GOAL_HALF_WIDTH
-    canvas.rect(*_to_px(L, -gw), *_to_px(L + 2.44, gw), _GOAL)
-    for sy in (-1.0, 1.0):
-        canvas.circle(*_to_px(phys.POST_X, sy * phys.POST_Y), 2.0, (20, 20, 20))
-    canvas.circle(*_to_px(bx, by), max(phys.BALL_SIZE * _PX_PER_M, 2.5), _BALL)
-    canvas.circle(*_to_px(bx, by), max(phys.BALL_SIZE * _PX_PER_M, 2.5), (0, 0, 0), outline=1.0)
+    field = _field_image()
+    canvas = Canvas(field.shape[1], field.shape[0])
+    canvas.image[:] = field
+    radius = max(phys.BALL_SIZE * _PX_PER_M, 2.5)
+    canvas.circle(*_to_px(bx, by), radius, _BALL)
+    canvas.circle(*_to_px(bx, by), radius, (0, 0, 0), outline=1.0)
     canvas.circle(*_to_px(px, py), max(phys.PLAYER_SIZE * _PX_PER_M, 4.0), _PLAYER)
     theta = np.radians(body)
-    line(px, py, px + 1.2 * np.cos(theta), py + 1.2 * np.sin(theta), _LINE, 2.0)
+    canvas.line(*_to_px(px, py), *_to_px(px + 1.2 * np.cos(theta), py + 1.2 * np.sin(theta)), _LINE, 2.0)
     return canvas.image

@@ -188,6 +188,8 @@ class HalfFieldOffenseVectorEnv(gymnasium.vector.VectorEnv):
     # --- Gymnasium API ------------------------------------------------------------------------
     def reset(self, *, seed: int | None = None, options: dict | None = None):
         super().reset(seed=seed)
+        if seed is not None:
+            self.body[:] = 0.0  # a new server run, as in the scalar env
         placement = _per_game_options(options, self.num_envs)
         self._place(np.ones(self.num_envs, dtype=bool), placement)
         self._needs_reset[:] = False

@@ -1,0 +1,240 @@
+"""The HFO env's interface: spaces, features, reward, seeding, reset options, errors, rendering, baseline."""
+
+from __future__ import annotations
+
+import math
+
+import gymnasium
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+
+import pamdp  # noqa: F401  (registers the envs)
+from pamdp.envs import hfo_features as feat
+from pamdp.envs.hfo import HalfFieldOffenseEnv
+from pamdp.envs.hfo_baseline import scripted_scorer
+from pamdp.envs.rendering import record_episode
+
+TURN0 = (1, (np.zeros(2, np.float32), np.zeros(1, np.float32), np.zeros(2, np.float32)))
+
+
+def dash(power=100.0, direction=0.0):
+    return 0, (np.array([power, direction], np.float32), np.zeros(1, np.float32), np.zeros(2, np.float32))
+
+
+def test_registered_and_passes_gymnasium_checker():
+    env = gymnasium.make("pamdp/HalfFieldOffense-v0")
+    assert isinstance(env.unwrapped, HalfFieldOffenseEnv)
+    check_env(env.unwrapped, skip_render_check=True)
+    space = env.action_space
+    assert [s.shape for s in space.spaces[1].spaces] == [(2,), (1,), (2,)]
+    assert space.spaces[0].n == 3
+
+
+@pytest.mark.parametrize("profile, size", [("hfo2016", 58), ("hfo2017", 59), ("hfo2019", 59)])
+def test_feature_vector_length_and_range(profile, size):
+    env = HalfFieldOffenseEnv(profile=profile)
+    env.action_space.seed(0)
+    obs, _ = env.reset(seed=0)
+    assert obs.shape == (size,) and obs.dtype == np.float32
+    for _ in range(300):
+        obs, _, terminated, truncated, _ = env.step(env.action_space.sample())
+        assert obs.shape == (size,) and np.all(np.abs(obs) <= 1.0)
+        if terminated or truncated:
+            obs, _ = env.reset()
+
+
+def test_reward_feature_indices_mean_what_the_reward_assumes():
+    env = HalfFieldOffenseEnv(deterministic=True, profile="hfo2017")
+    player, ball = (20.0, 10.0), (30.0, 4.0)
+    obs, _ = env.reset(options={"player": player, "ball": ball, "body": 90.0})
+    dmax = math.hypot(52.5, 34.0)
+    d_ball, d_goal = math.dist(player, ball), math.dist(player, (52.5, 0.0))
+    assert obs[feat.BALL_PROXIMITY] == pytest.approx(1 - 2 * d_ball / dmax, abs=1e-6)
+    assert obs[feat.GOAL_PROXIMITY] == pytest.approx(1 - 2 * d_goal / dmax, abs=1e-6)
+    ball_bearing = math.degrees(math.atan2(ball[1] - player[1], ball[0] - player[0])) - 90.0
+    assert math.degrees(math.atan2(obs[feat.BALL_SIN], obs[feat.BALL_COS])) == pytest.approx(ball_bearing, abs=1e-4)
+    goal_bearing = math.degrees(math.atan2(-player[1], 52.5 - player[0])) - 90.0
+    assert math.degrees(math.atan2(obs[feat.GOAL_SIN], obs[feat.GOAL_COS])) == pytest.approx(goal_bearing, abs=1e-4)
+    assert obs[feat.KICKABLE] == -1.0
+    assert feat.ball_to_goal(obs[None].astype(float))[0] == pytest.approx(2 * math.dist(ball, (52.5, 0)) / dmax)
+    obs, _ = env.reset(options={"player": (29.5, 4.0), "ball": ball})
+    assert obs[feat.KICKABLE] == 1.0
+
+
+def test_reward_scale_is_2_over_dmax_per_metre():
+    for profile, dmax in (("hfo2017", math.hypot(52.5, 34.0)), ("hfo2019", math.hypot(52.5, 68.0))):
+        env = HalfFieldOffenseEnv(deterministic=True, profile=profile, first_step_reward=True)
+        env.reset(options={"player": (10.0, 0.0), "ball": (30.0, 0.0), "body": 0.0})
+        _, reward, *_ = env.step(dash())
+        assert reward == pytest.approx(0.6 * 2.0 / dmax, rel=1e-4)  # 0.6 m closer to the ball
+
+
+def test_first_transition_pays_nothing_by_default():
+    env = HalfFieldOffenseEnv(deterministic=True)
+    env.reset(options={"player": (10.0, 0.0), "ball": (30.0, 0.0), "body": 0.0})
+    _, reward, *_ = env.step(dash())
+    assert reward == 0.0
+    _, reward, *_ = env.step(dash())
+    assert reward == pytest.approx(0.84 * 2 / math.hypot(52.5, 34.0), rel=1e-4)
+
+
+def test_kick_bonus_once_and_goal_bonus_alone_on_the_terminal_step():
+    env = HalfFieldOffenseEnv(deterministic=True)
+    obs, _ = env.reset(options={"player": (44.0, 0.0), "ball": (46.0, 0.0), "body": 0.0})
+    rewards, statuses = [], []
+    for _ in range(40):
+        obs, reward, terminated, truncated, info = env.step(scripted_scorer(obs))
+        rewards.append(reward)
+        statuses.append(info["status"])
+        if terminated or truncated:
+            break
+    assert statuses[-1] == "GOAL" and terminated
+    assert rewards[-1] == 5.0
+    assert sum(r > 0.9 for r in rewards[:-1]) == 1  # the +1 for first reaching the ball
+
+
+def test_terminal_observation_is_the_true_terminal_state():
+    env = HalfFieldOffenseEnv(deterministic=True)
+    obs, _ = env.reset(options={"player": (44.0, 0.0), "ball": (46.0, 0.0), "body": 0.0})
+    while True:
+        obs, _, terminated, truncated, info = env.step(scripted_scorer(obs))
+        if terminated or truncated:
+            break
+    assert env.game.bx > 52.5  # the ball is in the goal in the state returned with GOAL
+    assert obs[feat.BALL_PROXIMITY] == pytest.approx(1 - 2 * math.dist((env.game.px, env.game.py), (env.game.bx, env.game.by)) / math.hypot(52.5, 34), abs=1e-5)  # fmt: skip
+
+
+def test_seeded_episodes_are_reproducible_with_noise():
+    def run(seed):
+        env = HalfFieldOffenseEnv()
+        env.action_space.seed(seed)
+        obs, _ = env.reset(seed=seed)
+        trajectory = [obs]
+        for _ in range(150):
+            obs, reward, terminated, truncated, _ = env.step(env.action_space.sample())
+            trajectory.append(np.append(obs, reward))
+            if terminated or truncated:
+                trajectory.append(env.reset()[0])
+        return trajectory
+
+    a, b, c = run(3), run(3), run(4)
+    assert all(np.array_equal(x, y) for x, y in zip(a, b))
+    assert not all(np.array_equal(x, y) for x, y in zip(a, c))
+
+
+def test_noise_is_on_unless_deterministic():
+    results = []
+    for deterministic in (True, False):
+        env = HalfFieldOffenseEnv(deterministic=deterministic)
+        env.reset(seed=0, options={"player": (10.0, 0.0), "ball": (30.0, 0.0), "body": 0.0})
+        env.step(dash())
+        results.append(env.game.px)
+    assert results[0] == pytest.approx(10.6) and results[1] != pytest.approx(10.6, abs=1e-6)
+
+
+def test_reset_distribution_and_body_carry_over():
+    env = HalfFieldOffenseEnv()
+    env.reset(seed=0)
+    assert env.game.body == 0.0  # the first episode faces the goal
+    distances = []
+    for _ in range(300):
+        env.step(TURN0 if env.game.cycles % 2 else (1, (np.zeros(2), np.array([37.0]), np.zeros(2))))
+        body = env.game.body
+        env.reset()
+        g = env.game
+        assert g.body == body  # carried over
+        assert 0.0 <= g.bx <= 10.5 and abs(g.by) <= 27.2 + 1e-9 and -0.1 <= g.px <= 52.5 and abs(g.py) <= 27.2 + 1e-9
+        distances.append(math.dist((g.px, g.py), (g.bx, g.by)))
+    assert 15.0 < np.mean(distances) < 24.0  # spec 2.7: mean 19.5 m
+    env = HalfFieldOffenseEnv(body_reset="uniform")
+    bodies = {env.reset(seed=s)[1]["step"] or env.game.body for s in range(20)}
+    assert len(bodies) == 20
+
+
+def test_reset_options_place_ball_player_and_body():
+    env = HalfFieldOffenseEnv()
+    env.reset(seed=0, options={"ball": (40.0, -5.0), "player": (35.0, 3.0), "body": 270.0})
+    g = env.game
+    assert (g.bx, g.by, g.px, g.py, g.body) == (40.0, -5.0, 35.0, 3.0, -90.0)
+    assert (g.pvx, g.bvx, g.stamina) == (0.0, 0.0, 8000.0)
+    env.reset(seed=0, options={"ball": (1.0, 2.0)})
+    assert (env.game.bx, env.game.by) == (1.0, 2.0)
+
+
+@pytest.mark.parametrize(
+    "options, words",
+    [
+        ({"ball": (60.0, 0.0)}, ["ball", "60.0", "outside"]),
+        ({"ball": (-1.0, 0.0)}, ["ball", "outside"]),
+        ({"player": (0.0, 40.0)}, ["player", "40.0"]),
+        ({"ball": (1.0,)}, ["ball", "pair"]),
+        ({"ball": "middle"}, ["ball", "pair"]),
+        ({"player": (np.nan, 1.0)}, ["player", "finite"]),
+        ({"body": "north"}, ["body", "angle"]),
+        ({"ball_pos": (1.0, 1.0)}, ["ball_pos", "expected"]),
+        ([1, 2], ["dict"]),
+    ],
+)
+def test_bad_reset_options_raise_clear_errors(options, words):
+    env = HalfFieldOffenseEnv()
+    with pytest.raises(ValueError) as error:
+        env.reset(seed=0, options=options)
+    assert all(w in str(error.value) for w in words), str(error.value)
+
+
+@pytest.mark.parametrize(
+    "action, words",
+    [
+        (3, ["malformed", "expected"]),
+        ((5, (np.zeros(2), np.zeros(1), np.zeros(2))), ["5", "DASH"]),
+        ((1.5, (np.zeros(2), np.zeros(1), np.zeros(2))), ["1.5"]),
+        ((0, (np.zeros(2), np.zeros(1))), ["malformed", "DASH"]),
+        ((0, (np.zeros(3), np.zeros(1), np.zeros(2))), ["DASH", "2 number"]),
+        ((2, (np.zeros(2), np.zeros(1), np.array([np.nan, 0.0]))), ["KICK", "finite"]),
+        ((1, (np.zeros(2), np.array([np.inf]), np.zeros(2))), ["TURN", "finite"]),
+    ],
+)
+def test_bad_actions_raise_clear_errors(action, words):
+    env = HalfFieldOffenseEnv()
+    env.reset(seed=0)
+    with pytest.raises(ValueError) as error:
+        env.step(action)
+    assert all(w in str(error.value) for w in words), str(error.value)
+
+
+def test_out_of_box_parameters_are_clamped_as_hfo_does():
+    env = HalfFieldOffenseEnv(deterministic=True)
+    env.reset(options={"player": (10.0, 0.0), "ball": (30.0, 0.0), "body": 0.0})
+    env.step(dash(power=500.0, direction=10.0))
+    assert env.game.px == pytest.approx(10.6)
+
+
+def test_bad_constructor_arguments():
+    with pytest.raises(ValueError, match="hfo2020"):
+        HalfFieldOffenseEnv(profile="hfo2020")
+    with pytest.raises(ValueError, match="random"):
+        HalfFieldOffenseEnv(body_reset="random")
+
+
+def test_render_and_gif(tmp_path):
+    env = HalfFieldOffenseEnv(render_mode="rgb_array")
+    env.reset(seed=0)
+    frame = env.render()
+    assert frame.dtype == np.uint8 and frame.ndim == 3 and frame.shape[2] == 3
+    assert len(np.unique(frame.reshape(-1, 3), axis=0)) >= 4  # grass, lines, ball, player
+    path, _ = record_episode(env, scripted_scorer, tmp_path / "hfo.gif", seed=0, max_steps=60)
+    assert (tmp_path / "hfo.gif").stat().st_size > 0 and str(path).endswith("hfo.gif")
+
+
+def test_scripted_scorer_scores_usually():
+    env = HalfFieldOffenseEnv()
+    goals = 0
+    for seed in range(10):
+        obs, _ = env.reset(seed=seed)
+        while True:
+            obs, _, terminated, truncated, info = env.step(scripted_scorer(obs))
+            if terminated or truncated:
+                goals += info["status"] == "GOAL"
+                break
+    assert goals >= 8
