@@ -101,8 +101,10 @@ def test_terminal_observation_is_the_true_terminal_state():
         obs, _, terminated, truncated, info = env.step(scripted_scorer(obs))
         if terminated or truncated:
             break
-    assert env.game.bx > 52.5  # the ball is in the goal in the state returned with GOAL
-    assert obs[feat.BALL_PROXIMITY] == pytest.approx(1 - 2 * math.dist((env.game.px, env.game.py), (env.game.bx, env.game.by)) / math.hypot(52.5, 34), abs=1e-5)  # fmt: skip
+    g = env.game
+    assert g.bx > 52.5  # the ball is in the goal in the state returned with GOAL
+    distance = math.dist((g.px, g.py), (g.bx, g.by))
+    assert obs[feat.BALL_PROXIMITY] == pytest.approx(1 - 2 * distance / math.hypot(52.5, 34), abs=1e-5)
 
 
 def test_seeded_episodes_are_reproducible_with_noise():
