@@ -16,24 +16,9 @@ import datetime as dt
 import json
 import sys
 import typing
-from importlib import import_module
 from pathlib import Path
 
-ALGORITHMS = {
-    "patrpo": "pamdp.algos.patrpo:PATRPO",
-    "pasvg0": "pamdp.algos.pasvg:PASVG0",
-    "paddpg": "pamdp.algos.paddpg:PADDPG",
-}
-DEFAULT_PRESET = "tuned"
-
-
-def algorithm_class(name: str):
-    """The class behind an algorithm's command-line name, or ``None`` if this install lacks it."""
-    module, _, cls = ALGORITHMS[name].partition(":")
-    try:
-        return getattr(import_module(module), cls)
-    except ModuleNotFoundError:
-        return None
+from pamdp.experiments.runner import ALGORITHMS, DEFAULT_PRESET, RunSpec, algorithm_class, train_run
 
 
 def _parse_value(text: str, hint):
@@ -123,6 +108,20 @@ def build_parser() -> argparse.ArgumentParser:
     ev.add_argument("--stochastic", action="store_true", help="sample actions instead of the greedy ones")
     ev.add_argument("--json", action="store_true", help="print one JSON object")
 
+    rp = sub.add_parser("reproduce", help="run one of the paper's experiments (all settings and seeds) and plot it")
+    rp.add_argument("name", help="platform, step-size, kl-estimators, soccer, or an experiment TOML file")
+    rp.add_argument("--seeds", default=None, help="comma-separated seeds (default: the experiment's)")
+    rp.add_argument("--scale", type=float, default=1.0, help="multiply the step budget, e.g. 0.1 for a quick look")
+    rp.add_argument("--workers", type=int, default=1, help="runs side by side in processes (one torch thread each)")
+    rp.add_argument("--out", default="results", help="results root (default: %(default)s)")
+    rp.add_argument("--backend", choices=["local", "ray"], default="local", help="local processes or a Ray cluster")
+    rp.add_argument("--address", default=None, help="Ray cluster address HOST:PORT (with --backend ray)")
+
+    pl = sub.add_parser("plot", help="learning curves (PNG, SVG) and a results table from run directories")
+    pl.add_argument("dirs", nargs="+", help="directories holding run directories (grouped by parent: one curve each)")
+    pl.add_argument("--out", default=None, help="where to write curves.png/.svg, curves.csv, results.md")
+    pl.add_argument("--title", default="")
+
     rd = sub.add_parser("render", help="write one episode to a GIF (a trained model, or random actions in an env)")
     rd.add_argument("source", help="run directory, model file, or a registered env id (random actions)")
     rd.add_argument("--out", default="episode.gif")
@@ -134,61 +133,68 @@ def build_parser() -> argparse.ArgumentParser:
 DEFAULT_TOTAL_STEPS = {"patrpo": 500_000, "pasvg0": 1_000_000, "paddpg": 1_000_000}
 
 
-def _train_config(args, cls):
-    from pamdp.algos.base import AlgoConfig
-
+def _train_spec(args, cls) -> RunSpec:
     file_values = _read_config_file(args.config) if args.config else {}
-    preset = (
-        args.preset
-        or file_values.pop("preset", None)
-        or (DEFAULT_PRESET if DEFAULT_PRESET in cls.config_class.presets() else next(iter(cls.config_class.presets())))
-    )
-    config: AlgoConfig = cls.config_class.preset(preset)
-    config = cls.config_class.from_dict(file_values, base=config)
+    preset = args.preset or file_values.pop("preset", None)
     flags = {k[4:]: v for k, v in vars(args).items() if k.startswith("cfg_") and v is not None}
-    config = cls.config_class.from_dict({**flags, "seed": args.seed}, base=config)
-    return preset, config
-
-
-def cmd_train(args) -> int:
-    from pamdp.algos.base import CHECKPOINT, FINAL_MODEL
-    from pamdp.evaluation import evaluate
-
-    cls = algorithm_class(args.algo)
-    preset, config = _train_config(args, cls)
     total = args.total_steps if args.total_steps is not None else DEFAULT_TOTAL_STEPS[args.algo]
     if total < 0:
         raise ValueError(f"--total-steps {total}; expected a non-negative number of steps")
+    settings = {**file_values, **flags}
+    return RunSpec(args.algo, args.env, total, args.seed, preset, tuple(sorted(settings.items())), args.eval_episodes)
+
+
+def cmd_train(args) -> int:
+    cls = algorithm_class(args.algo)
+    spec = _train_spec(args, cls)
+    spec.config()  # validate the settings before creating any directory
     stamp = dt.datetime.now().strftime("%Y%m%d-%H%M%S")
     out = Path(args.out or f"runs/{args.algo}-{args.env.split('/')[-1]}-seed{args.seed}-{stamp}")
-    run_info = {"algo": args.algo, "env": args.env, "preset": preset, "total_steps": total, "config": config.to_dict()}
-    run_file = out / "run.json"
-    if (out / CHECKPOINT).exists() or (out / FINAL_MODEL).exists():
-        recorded = json.loads(run_file.read_text()) if run_file.exists() else {}
-        differ = sorted(k for k in ("algo", "env", "config") if recorded.get(k) != run_info[k])
-        if differ:
-            raise ValueError(
-                f"{out} holds a run with other {', '.join(differ)}; "
-                "resume it with the same settings or use another --out"
-            )
-        model = cls.load(out / CHECKPOINT if (out / CHECKPOINT).exists() else out / FINAL_MODEL)
-        print(f"resuming {out} at step {model.num_timesteps:,} of {total:,}", file=sys.stderr)
-    else:
-        out.mkdir(parents=True, exist_ok=True)
-        model = cls(args.env, config)
-    run_file.write_text(json.dumps({**run_info, "command": sys.argv}, indent=2))
-    remaining = max(total - model.num_timesteps, 0)
     try:
-        model.learn(remaining, progress_bar=not args.no_progress, run_dir=out)
+        result = train_run(spec, out, progress_bar=not args.no_progress, log=lambda m: print(m, file=sys.stderr))
     except KeyboardInterrupt:
         print(f"\ninterrupted; the last checkpoint is in {out}: run the same command to resume", file=sys.stderr)
         return 130
-    model.save(out / FINAL_MODEL)
-    print(f"trained {model.num_timesteps:,} steps; model in {out / FINAL_MODEL}", file=sys.stderr)
-    if args.eval_episodes > 0:
-        result = evaluate(model, episodes=args.eval_episodes, seed=10_000 + args.seed)
-        (out / "evaluation.json").write_text(json.dumps(result, indent=2))
+    if result:
         print(_format_evaluation(result))
+    return 0
+
+
+# -- reproduce, plot --------------------------------------------------------------------------------
+def cmd_reproduce(args) -> int:
+    from pamdp.experiments import load_experiment
+    from pamdp.experiments.plots import write_report
+
+    exp = load_experiment(args.name)
+    seeds = [int(s) for s in args.seeds.split(",")] if args.seeds else None
+    jobs = [(spec, str(exp.run_dir(args.out, spec))) for spec in exp.specs(seeds, args.scale)]
+    for spec, _ in jobs:
+        spec.config()  # every setting is checked before the first run starts
+    print(f"{exp.name}: {exp.description}; {len(jobs)} runs of {jobs[0][0].total_steps:,} steps", file=sys.stderr)
+    if args.backend == "ray":
+        from pamdp.experiments.ray_backend import run_all_ray
+
+        outcomes = run_all_ray(jobs, address=args.address, log=lambda m: print(m, file=sys.stderr))
+    else:
+        from pamdp.experiments.runner import run_all
+
+        outcomes = run_all(jobs, workers=args.workers, log=lambda m: print(m, file=sys.stderr))
+    failed = [o for o in outcomes if o.error is not None]
+    report = write_report([Path(args.out) / exp.name], Path(args.out) / exp.name, exp.description)
+    print(report["table"].read_text())
+    print(f"figures: {report['png']}, {report['svg']}", file=sys.stderr)
+    if failed:
+        print(f"{len(failed)} of {len(outcomes)} runs failed: {', '.join(o.out for o in failed)}", file=sys.stderr)
+        return 1
+    return 0
+
+
+def cmd_plot(args) -> int:
+    from pamdp.experiments.plots import write_report
+
+    report = write_report(args.dirs, args.out or args.dirs[0], args.title)
+    print(report["table"].read_text())
+    print(f"figures: {report['png']}, {report['svg']}", file=sys.stderr)
     return 0
 
 
@@ -233,7 +239,13 @@ def cmd_render(args) -> int:
 
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
-    handlers = {"train": cmd_train, "evaluate": cmd_evaluate, "render": cmd_render}
+    handlers = {
+        "train": cmd_train,
+        "evaluate": cmd_evaluate,
+        "render": cmd_render,
+        "reproduce": cmd_reproduce,
+        "plot": cmd_plot,
+    }
     try:
         return handlers[args.command](args)
     except (ValueError, FileNotFoundError) as exc:

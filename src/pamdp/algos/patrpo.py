@@ -57,6 +57,9 @@ class PATRPOConfig(AlgoConfig):
     max_backtracks: int = setting(15, "Line-search tries before the update is abandoned (parameters restored).")
     gamma: float = setting(0.99, "Discount factor.")
     gae_lambda: float = setting(1.0, "GAE lambda: 1.0 is rllab's (Monte-Carlo advantages); 0.95-0.99 lowers variance.")
+    entropy_coef: float = setting(
+        0.0, "Weight of the policy entropy added to the surrogate (not in the paper); keeps exploring longer."
+    )
     normalize_advantages: bool = setting(True, "Standardise advantages within the batch.")
     baseline: str = setting(
         "mlp",
@@ -85,6 +88,7 @@ class PATRPOConfig(AlgoConfig):
         self._check(self.max_backtracks >= 1, "max_backtracks", "an integer >= 1")
         self._check(0 <= self.gamma <= 1, "gamma", "a number in [0, 1]")
         self._check(0 <= self.gae_lambda <= 1, "gae_lambda", "a number in [0, 1]")
+        self._check(self.entropy_coef >= 0, "entropy_coef", "a non-negative weight")
         self._check(self.baseline in ("mlp", "linear"), "baseline", "'mlp' or 'linear'")
         self._check(
             self.vf_lr > 0 and self.vf_epochs >= 1 and self.vf_batch_size >= 1,
@@ -295,7 +299,9 @@ class PATRPO(Algorithm):
             old_logp = old.log_prob(a, x)
 
         def surrogate() -> torch.Tensor:
-            return (torch.exp(self.policy(obs).log_prob(a, x) - old_logp) * adv).mean()
+            new = self.policy(obs)
+            gain = (torch.exp(new.log_prob(a, x) - old_logp) * adv).mean()
+            return gain + cfg.entropy_coef * new.entropy().mean() if cfg.entropy_coef else gain
 
         def kl() -> torch.Tensor:
             return kl_divergence(old, self.policy(obs), cfg.kl_estimator, a, x).mean()

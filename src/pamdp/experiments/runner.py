@@ -1,0 +1,168 @@
+"""Single training runs and the multi-seed runner behind ``pamdp train`` and ``pamdp reproduce``.
+
+A run lives in one directory: ``run.json`` (what was asked), ``progress.csv``, ``tb/``, ``checkpoint.pt``,
+``final_model.pt`` and ``evaluation.json``. :func:`train_run` is resumable: a directory with a final model
+and an evaluation is done and skipped; one with a checkpoint continues from it; settings that differ from
+the recorded ones are refused rather than mixed into one log.
+
+:func:`run_all` executes many runs, side by side in worker processes (one torch thread each), and reports
+a failed run with its error while the others finish.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import dataclasses
+import json
+import multiprocessing
+import os
+import sys
+import time
+import traceback
+from pathlib import Path
+from typing import Any
+
+__all__ = ["RunSpec", "train_run", "run_all", "algorithm_class", "ALGORITHMS", "DEFAULT_PRESET"]
+
+ALGORITHMS = {
+    "patrpo": "pamdp.algos.patrpo:PATRPO",
+    "pasvg0": "pamdp.algos.pasvg:PASVG0",
+    "paddpg": "pamdp.algos.paddpg:PADDPG",
+}
+DEFAULT_PRESET = "tuned"
+
+
+def algorithm_class(name: str):
+    """The class behind an algorithm's command-line name, or ``None`` if this install lacks it."""
+    from importlib import import_module
+
+    if name not in ALGORITHMS:
+        raise ValueError(f"unknown algorithm {name!r}; expected one of {', '.join(ALGORITHMS)}")
+    module, _, cls = ALGORITHMS[name].partition(":")
+    try:
+        return getattr(import_module(module), cls)
+    except ModuleNotFoundError as exc:
+        if exc.name == module:
+            return None
+        raise
+
+
+@dataclasses.dataclass(frozen=True)
+class RunSpec:
+    """One training run: an algorithm with settings, on an env, for a seed."""
+
+    algo: str
+    env: str
+    total_steps: int
+    seed: int = 0
+    preset: str | None = None
+    settings: tuple[tuple[str, Any], ...] = ()
+    eval_episodes: int = 1000
+    label: str = ""
+
+    def config(self):
+        cls = algorithm_class(self.algo)
+        if cls is None:
+            raise ValueError(f"algorithm {self.algo!r} is not available in this install")
+        presets = cls.config_class.presets()
+        preset = self.preset or (DEFAULT_PRESET if DEFAULT_PRESET in presets else next(iter(presets)))
+        base = cls.config_class.preset(preset)
+        return cls, preset, cls.config_class.from_dict({**dict(self.settings), "seed": self.seed}, base=base)
+
+
+def train_run(spec: RunSpec, out: str | os.PathLike, progress_bar: bool = True, log=print) -> dict:
+    """Train (or resume, or skip) one run in ``out``; returns its evaluation (or ``{}`` without one)."""
+    from pamdp.algos.base import CHECKPOINT, FINAL_MODEL
+    from pamdp.evaluation import evaluate
+
+    cls, preset, config = spec.config()
+    out = Path(out)
+    run_info = {
+        "algo": spec.algo,
+        "env": spec.env,
+        "preset": preset,
+        "total_steps": spec.total_steps,
+        "config": config.to_dict(),
+    }
+    run_file, eval_file = out / "run.json", out / "evaluation.json"
+    model = None
+    if (out / CHECKPOINT).exists() or (out / FINAL_MODEL).exists():
+        recorded = json.loads(run_file.read_text()) if run_file.exists() else {}
+        differ = sorted(k for k in ("algo", "env", "config") if recorded.get(k) != run_info[k])
+        if differ:
+            raise ValueError(
+                f"{out} holds a run with other {', '.join(differ)}; "
+                "resume it with the same settings or use another output directory"
+            )
+        done = (out / FINAL_MODEL).exists() and recorded.get("total_steps") == spec.total_steps
+        if done and (eval_file.exists() or spec.eval_episodes == 0):
+            log(f"{out}: already finished")
+            return json.loads(eval_file.read_text()) if eval_file.exists() else {}
+        model = cls.load(out / CHECKPOINT if (out / CHECKPOINT).exists() else out / FINAL_MODEL)
+        log(f"resuming {out} at step {model.num_timesteps:,} of {spec.total_steps:,}")
+    else:
+        out.mkdir(parents=True, exist_ok=True)
+        model = cls(spec.env, config)
+    run_file.write_text(json.dumps({**run_info, "command": sys.argv}, indent=2))
+    start = time.time()
+    model.learn(max(spec.total_steps - model.num_timesteps, 0), progress_bar=progress_bar, run_dir=out)
+    model.save(out / FINAL_MODEL)
+    log(f"trained {model.num_timesteps:,} steps in {time.time() - start:.0f} s; model in {out / FINAL_MODEL}")
+    if spec.eval_episodes <= 0:
+        return {}
+    result = evaluate(model, episodes=spec.eval_episodes, seed=10_000 + spec.seed)
+    eval_file.write_text(json.dumps(result, indent=2))
+    return result
+
+
+def _worker(spec: RunSpec, out: str) -> dict:
+    import torch
+
+    torch.set_num_threads(1)
+    log_file = Path(out) / "stdout.log"
+    Path(out).mkdir(parents=True, exist_ok=True)
+    with open(log_file, "a") as f:
+        return train_run(spec, out, progress_bar=False, log=lambda msg: print(msg, file=f, flush=True))
+
+
+@dataclasses.dataclass
+class RunOutcome:
+    spec: RunSpec
+    out: str
+    result: dict | None
+    error: str | None
+    seconds: float
+
+
+def run_all(jobs: list[tuple[RunSpec, str]], workers: int = 1, log=print) -> list[RunOutcome]:
+    """Run ``(spec, out_dir)`` jobs, ``workers`` at a time in separate processes (1: in this process)."""
+    outcomes: list[RunOutcome] = []
+    if workers <= 1:
+        for spec, out in jobs:
+            t0 = time.time()
+            try:
+                outcomes.append(RunOutcome(spec, out, _worker(spec, out), None, time.time() - t0))
+            except Exception:
+                outcomes.append(RunOutcome(spec, out, None, traceback.format_exc(), time.time() - t0))
+            log(_describe(outcomes[-1]))
+        return outcomes
+    ctx = multiprocessing.get_context("spawn")
+    with cf.ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
+        started = {pool.submit(_worker, spec, out): (spec, out, time.time()) for spec, out in jobs}
+        for fut in cf.as_completed(started):
+            spec, out, t0 = started[fut]
+            try:
+                outcome = RunOutcome(spec, out, fut.result(), None, time.time() - t0)
+            except Exception as exc:
+                detail = "".join(traceback.format_exception(exc))
+                outcome = RunOutcome(spec, out, None, detail, time.time() - t0)
+            outcomes.append(outcome)
+            log(_describe(outcome))
+    return outcomes
+
+
+def _describe(o: RunOutcome) -> str:
+    if o.error is not None:
+        return f"FAILED {o.out} after {o.seconds:.0f} s:\n{o.error}"
+    ret = o.result.get("mean_return") if o.result else None
+    return f"done {o.out} in {o.seconds:.0f} s" + (f": greedy return {ret:.3f}" if ret is not None else "")

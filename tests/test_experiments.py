@@ -1,0 +1,109 @@
+"""The experiment runner end to end on tiny budgets: layout, aggregation, figures, resume, failures."""
+
+import csv
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+from pamdp.cli import main
+from pamdp.experiments import available_experiments, load_experiment
+
+TINY_SETTINGS = "settings = { hidden_sizes = [16], vf_hidden_sizes = [16], batch_size = 200, num_envs = 4 }"
+
+
+def write_experiment(path, extra_run=""):
+    path.write_text(f"""
+description = "tiny"
+env = "pamdp/Platform-v0"
+total_steps = 600
+seeds = [0, 1]
+eval_episodes = 10
+
+[[runs]]
+label = "small delta"
+algo = "patrpo"
+preset = "paper"
+{TINY_SETTINGS}
+{extra_run}
+""")
+    return path
+
+
+def test_the_papers_experiments_are_available_with_its_settings():
+    assert {"platform", "step-size", "kl-estimators", "soccer"} <= set(available_experiments())
+    exp = load_experiment("step-size")
+    assert exp.total_steps == 1_000_000 and exp.seeds == (0, 1, 2, 3, 4)
+    deltas = sorted(dict(s.settings)["delta"] for s in exp.specs(seeds=[0]))
+    assert deltas == [0.01, 0.05]
+    kl = load_experiment("kl-estimators")
+    assert {dict(s.settings)["kl_estimator"] for s in kl.specs()} == {"joint_sample", "chain_sample", "chain_analytic"}
+    soccer = load_experiment("soccer")
+    assert soccer.seeds == (0, 1, 2) and soccer.total_steps == 100 * 50_000
+    with pytest.raises(ValueError, match="unknown experiment 'nope'"):
+        load_experiment("nope")
+
+
+def test_tiny_experiment_end_to_end(tmp_path, capsys):
+    exp = write_experiment(tmp_path / "tiny.toml")
+    out = tmp_path / "results"
+    assert main(["reproduce", str(exp), "--out", str(out), "--workers", "2"]) == 0
+    for seed in (0, 1):
+        run = out / "tiny" / "small_delta" / f"seed{seed}"
+        for name in ("run.json", "progress.csv", "final_model.pt", "evaluation.json"):
+            assert (run / name).exists(), run / name
+    for name in ("curves.png", "curves.svg", "curves.csv", "results.md"):
+        assert (out / "tiny" / name).exists(), name
+    assert (out / "tiny" / "curves.png").stat().st_size < 1_000_000
+    with open(out / "tiny" / "curves.csv", newline="") as f:
+        agg = list(csv.DictReader(f))
+    assert {r["setting"] for r in agg} == {"small_delta"} and all(r["seeds"] == "2" for r in agg)
+    table = capsys.readouterr().out
+    assert "| small_delta | 2 |" in table
+    # A second call skips the finished runs.
+    assert main(["reproduce", str(exp), "--out", str(out)]) == 0
+    assert "already finished" in (out / "tiny" / "small_delta" / "seed0" / "stdout.log").read_text()
+    # `pamdp plot` redraws from the directories.
+    assert main(["plot", str(out / "tiny"), "--out", str(tmp_path / "fig")]) == 0
+    assert (tmp_path / "fig" / "curves.svg").exists()
+
+
+def test_a_failing_run_is_reported_and_the_others_finish(tmp_path, capsys):
+    broken = f"""
+[[runs]]
+label = "broken"
+algo = "patrpo"
+env = "pamdp/NoSuchEnv-v0"
+{TINY_SETTINGS}
+"""
+    exp = write_experiment(tmp_path / "mixed.toml", broken)
+    out = tmp_path / "results"
+    assert main(["reproduce", str(exp), "--out", str(out), "--seeds", "0"]) == 1
+    err = capsys.readouterr().err
+    assert "FAILED" in err and "NoSuchEnv" in err and "1 of 2 runs failed" in err
+    assert (out / "mixed" / "small_delta" / "seed0" / "evaluation.json").exists()
+
+
+def test_resume_after_a_killed_worker(tmp_path):
+    exp = write_experiment(tmp_path / "tiny.toml")
+    exp.write_text(exp.read_text().replace("total_steps = 600", "total_steps = 3000"))
+    out = tmp_path / "results"
+    cmd = [sys.executable, "-m", "pamdp.cli", "reproduce", str(exp), "--out", str(out), "--workers", "2"]
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    ckpt = out / "tiny" / "small_delta" / "seed0" / "checkpoint.pt"
+    deadline = time.time() + 120
+    while not ckpt.exists() and time.time() < deadline:
+        time.sleep(0.05)
+    os.killpg(proc.pid, signal.SIGKILL)  # the runner and its workers
+    proc.wait()
+    assert ckpt.exists()
+    done = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    log = (out / "tiny" / "small_delta" / "seed0" / "stdout.log").read_text()
+    assert "resuming" in log
+    with open(out / "tiny" / "small_delta" / "seed0" / "progress.csv", newline="") as f:
+        steps = [float(r["time/total_timesteps"]) for r in csv.DictReader(f)]
+    assert steps == sorted(set(steps)) and steps[-1] >= 3000
