@@ -1,0 +1,277 @@
+"""Agent steps per second on Platform with random actions: pamdp's scalar and batched envs against the
+PyPI package ``hybrid-platform`` (imports as ``gym_platform``; a Gymnasium port of the reference, with
+numba), measured side by side in the same run. Writes ``benchmarks/platform_speed.md``.
+
+The peer is installed in its own virtual environment, never in pamdp's dependencies::
+
+    python3 -m venv /tmp/peer && /tmp/peer/bin/pip install hybrid-platform numba /path/to/pamdp
+    .venv/bin/python benchmarks/bench_platform.py --peer-python /tmp/peer/bin/python
+
+Every measurement runs in a fresh subprocess pinned to one core (``taskset -c 0``, where available);
+the configurations are interleaved within each repeat, so a slow spell of a shared machine hits all of
+them alike, and the table reports medians over the repeats. Random actions are sampled before the
+timed loop (seeded), so the figures are the environments' own cost; the peer's numba functions are
+compiled during an untimed warm-up.
+
+Before timing, the script checks that both implement the same dynamics: it drives the peer and
+``pamdp.envs.platform.PlatformEnv`` with the same ``numpy.random.RandomState`` and the same actions and
+compares observations (the peer's are float32), rewards, sub-step counts and termination flags exactly.
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime
+import json
+import os
+import platform
+import shutil
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SCRIPT_ACTIONS = [(1, 480), (0, 30), (0, 0), (1, 720), (1, 480), (0, 5), (0, 5), (1, 720), (0, 5), (0, 30)]
+PARAM_MAX = (30.0, 720.0, 430.0)
+
+
+# --- workers (run in a subprocess, in pamdp's venv or the peer's) --------------------------------------
+def _check_actions(seed: int) -> list:
+    """Actions for the dynamics check: half the episodes follow the spec's scripted policy with jittered
+    parameters (so they reach platforms 2 and 3 and meet enemy 2), half are uniformly random (including
+    out-of-box parameters, to check the clipping)."""
+    rng = np.random.default_rng(10_000 + seed)
+    actions = []
+    for t in range(40):
+        if seed % 2 == 0 and t < len(SCRIPT_ACTIONS):
+            a, p = SCRIPT_ACTIONS[t]
+            p = p * rng.uniform(0.9, 1.05)
+        else:
+            a = int(rng.integers(3))
+            p = rng.uniform(-0.1, 1.1) * PARAM_MAX[a]
+        params = [rng.uniform(0, 1) * m for m in PARAM_MAX]
+        params[a] = p
+        actions.append((a, [float(np.float32(v)) for v in params]))
+    return actions
+
+
+def _as_env_action(action):
+    a, params = action
+    return a, tuple(np.array([v], dtype=np.float32) for v in params)
+
+
+def worker_peer_trajectories(n_seeds: int) -> dict:
+    """Run the peer with ``RandomState(seed)`` noise on :func:`_check_actions`; return the trajectories."""
+    import gym_platform  # noqa: F401  (registers Platform-v0)
+    import gymnasium
+
+    out = []
+    for seed in range(n_seeds):
+        env = gymnasium.make("Platform-v0").unwrapped
+        # The peer's entities take the env's generator at reset, so it is replaced before reset.
+        env.np_random = np.random.RandomState(seed)
+        env.reset()
+        traj = []
+        for action in _check_actions(seed):
+            (obs, k), r, terminated, _, _ = env.step(_as_env_action(action))
+            traj.append(
+                {
+                    "obs": np.asarray(obs, dtype=np.float32).tolist(),
+                    "k": int(k),
+                    "r": float(r),
+                    "terminated": bool(terminated),
+                }
+            )
+            if terminated:
+                break
+        out.append(traj)
+    return {"trajectories": out}
+
+
+def compare_with_peer(peer: dict) -> tuple[int, int, int]:
+    """Replay the peer's trajectories in pamdp's env; return (episodes, steps, mismatching steps)."""
+    from pamdp.envs.platform import PlatformEnv
+
+    steps = bad = 0
+    for seed, traj in enumerate(peer["trajectories"]):
+        env = PlatformEnv()
+        env.reset()
+        env.np_random = np.random.RandomState(seed)
+        for action, ref in zip(_check_actions(seed), traj):
+            obs, r, terminated, _, info = env.step(_as_env_action(action))
+            steps += 1
+            same = (
+                np.array_equal(obs.astype(np.float32), np.array(ref["obs"], dtype=np.float32))
+                and r == ref["r"]
+                and info["substeps"] == ref["k"]
+                and terminated == ref["terminated"]
+            )
+            if not same:
+                bad += 1
+                break
+    return len(peer["trajectories"]), steps, bad
+
+
+def worker_speed(kind: str, num_envs: int, seconds: float) -> dict:
+    """Agent steps per second of one configuration, with pre-sampled random actions."""
+    import gymnasium
+
+    if kind == "peer":
+        import gym_platform  # noqa: F401
+
+        env = gymnasium.make("Platform-v0")
+    else:
+        import pamdp  # noqa: F401
+
+        env = (
+            gymnasium.make("pamdp/Platform-v0")
+            if kind == "scalar"
+            else gymnasium.make_vec("pamdp/Platform-v0", num_envs=num_envs, vectorization_mode="vector_entry_point")
+        )
+    env.reset(seed=0)
+    env.action_space.seed(0)
+    pool = [env.action_space.sample() for _ in range(1024 if kind != "vector" else 32)]
+    per_step = 1 if kind != "vector" else num_envs
+
+    def run(n_calls: int) -> None:
+        for i in range(n_calls):
+            out = env.step(pool[i % len(pool)])
+            if per_step == 1 and (out[2] or out[3]):
+                env.reset()
+
+    run(200 if kind != "vector" else 5)  # warm-up (compiles the peer's numba functions)
+    n_calls, elapsed = 16, 0.0
+    while elapsed < seconds / 4:  # calibrate to roughly `seconds`
+        n_calls *= 2
+        t0 = time.perf_counter()
+        run(n_calls)
+        elapsed = time.perf_counter() - t0
+    n_calls = max(1, int(n_calls * seconds / elapsed))
+    t0 = time.perf_counter()
+    run(n_calls)
+    elapsed = time.perf_counter() - t0
+    return {"steps_per_second": n_calls * per_step / elapsed}
+
+
+def worker_versions() -> dict:
+    import gymnasium
+
+    versions = {"python": platform.python_version(), "numpy": np.__version__, "gymnasium": gymnasium.__version__}
+    try:
+        import numba
+
+        versions["numba"] = numba.__version__
+    except ImportError:
+        pass
+    return versions
+
+
+# --- driver ------------------------------------------------------------------------------------------
+def _call(python: str, args: list[str], pin: bool) -> dict:
+    cmd = [python, os.path.abspath(__file__), "--worker", *args]
+    if pin and shutil.which("taskset"):
+        cmd = ["taskset", "-c", "0", *cmd]
+    env = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1", MKL_NUM_THREADS="1", NUMBA_NUM_THREADS="1")
+    res = subprocess.run(cmd, capture_output=True, text=True, env=env, check=False)
+    if res.returncode != 0:
+        raise RuntimeError(f"worker {' '.join(cmd)} failed:\n{res.stderr}")
+    return json.loads(res.stdout.strip().splitlines()[-1])
+
+
+def _cpu_model() -> str:
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or "unknown"
+
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--peer-python", default="/tmp/peer/bin/python", help="python of the venv with hybrid-platform")
+    parser.add_argument("--repeats", type=int, default=5, help="measurements per configuration (medians reported)")
+    parser.add_argument("--seconds", type=float, default=3.0, help="timed duration of one measurement")
+    parser.add_argument("--check-seeds", type=int, default=200, help="episodes of the dynamics check")
+    parser.add_argument("--no-pin", action="store_true", help="do not pin workers to core 0")
+    parser.add_argument("--out", default=os.path.join(HERE, "platform_speed.md"))
+    parser.add_argument("--worker", nargs="*", help=argparse.SUPPRESS)
+    args = parser.parse_args(argv)
+
+    if args.worker is not None:
+        what, *rest = args.worker
+        if what == "speed":
+            result = worker_speed(rest[0], int(rest[1]), float(rest[2]))
+        elif what == "peer-trajectories":
+            result = worker_peer_trajectories(int(rest[0]))
+        else:
+            result = worker_versions()
+        print(json.dumps(result))
+        return
+
+    pin = not args.no_pin
+    ours, peer = sys.executable, args.peer_python
+    print("checking the dynamics against the peer ...", flush=True)
+    episodes, steps, bad = compare_with_peer(_call(peer, ["peer-trajectories", str(args.check_seeds)], pin))
+    print(f"  {episodes} episodes, {steps} steps, {bad} mismatching", flush=True)
+
+    configs = [("hybrid-platform (peer)", peer, "peer", 1), ("pamdp PlatformEnv", ours, "scalar", 1)] + [
+        (f"pamdp PlatformVectorEnv, N={n}", ours, "vector", n) for n in (1, 64, 1024)
+    ]
+    results: dict[str, list[float]] = {name: [] for name, *_ in configs}
+    for rep in range(args.repeats):
+        for name, python, kind, n in configs:
+            sps = _call(python, ["speed", kind, str(n), str(args.seconds)], pin)["steps_per_second"]
+            results[name].append(sps)
+            print(f"  repeat {rep + 1}/{args.repeats}  {name:32s} {sps:12,.0f} steps/s", flush=True)
+
+    peer_median = float(np.median(results[configs[0][0]]))
+    rows = []
+    for name, *_ in configs:
+        v = np.array(results[name])
+        rows.append(
+            f"| {name} | {np.median(v):,.0f} | {v.min():,.0f} – {v.max():,.0f} | {np.median(v) / peer_median:.1f}x |"
+        )
+    vo, vp = _call(ours, ["versions"], False), _call(peer, ["versions"], False)
+    scalar_ratio = np.median(results["pamdp PlatformEnv"]) / peer_median
+    vec_ratio = np.median(results["pamdp PlatformVectorEnv, N=1024"]) / peer_median
+    load = os.getloadavg() if hasattr(os, "getloadavg") else None
+    command = " ".join([os.path.relpath(sys.executable), os.path.relpath(__file__), *(argv or sys.argv[1:])])
+    text = f"""# Platform speed: agent steps per second, random actions
+
+Written by `benchmarks/bench_platform.py` on {datetime.datetime.now().strftime("%Y-%m-%d %H:%M")}.
+
+| environment | median steps/s | range over {args.repeats} repeats | vs peer |
+|---|---:|---:|---:|
+{chr(10).join(rows)}
+
+Targets (per core): scalar at least 5x the peer (measured **{scalar_ratio:.1f}x**), batched at N = 1024 at
+least 100x the peer (measured **{vec_ratio:.1f}x**).
+
+- Command: `{command}`
+- Machine: {_cpu_model()}, {os.cpu_count()} logical CPUs; every measurement in a fresh process pinned to
+  core 0 (`taskset -c 0`: {"yes" if pin and shutil.which("taskset") else "no"}), one thread.
+  Load average at the end of the run: {", ".join(f"{x:.2f}" for x in load) if load else "n/a"}.
+  The machine is shared (other engineers' jobs may run on the other core, and compete for memory
+  bandwidth and caches), hence {args.repeats} interleaved repeats of {args.seconds:g} s and medians.
+- pamdp: Python {vo["python"]}, NumPy {vo["numpy"]}, Gymnasium {vo["gymnasium"]}; pure NumPy, no numba.
+- Peer: `hybrid-platform` 0.1.0 in a separate venv, Python {vp["python"]}, NumPy {vp["numpy"]},
+  Gymnasium {vp["gymnasium"]}, numba {vp.get("numba", "n/a")}.
+- Scalar envs are made with `gymnasium.make` (so both carry the same TimeLimit/checker wrappers) and reset on
+  episode end; the batched env with `gymnasium.make_vec(..., vectorization_mode="vector_entry_point")`, which
+  auto-resets. One agent step of a random policy runs ~72 physics sub-steps.
+- Same dynamics: driven by the same `numpy.random.RandomState` and actions, pamdp's `PlatformEnv` and the peer
+  agreed exactly (observations as float32, rewards, sub-step counts, termination) on {steps - bad} of {steps}
+  steps over {episodes} episodes ({bad} mismatching).
+"""
+    with open(args.out, "w") as f:
+        f.write(text)
+    print(text)
+
+
+if __name__ == "__main__":
+    main()
