@@ -1,0 +1,226 @@
+"""PADDPG: bounded-output gradients by hand, the action mapping, exploration, MC targets, save/load, the CLI."""
+
+import dataclasses
+import json
+
+import numpy as np
+import pytest
+import torch
+from torch import nn
+
+import pamdp
+from pamdp import PADDPG
+from pamdp.algos.paddpg import Actor, PADDPGConfig, invert_gradients, zero_gradients
+from pamdp.cli import main
+from pamdp.spaces import HybridActionSpace
+
+SMALL = PADDPGConfig(
+    hidden_sizes=(16, 16),
+    num_envs=4,
+    epoch_steps=200,
+    learning_starts=100,
+    batch_size=16,
+    buffer_size=5_000,
+    epsilon_steps=300,
+)
+HYBRID = HybridActionSpace(
+    (np.array([-1.0]), np.array([0.0, 0.0]), np.array([-2.0])), (np.array([1.0]), np.array([1.0, 3.0]), np.array([2.0]))
+)
+
+
+def test_inverting_gradients_by_hand():
+    p = torch.tensor([0.5, 0.5, -1.0, 1.0, 0.0, 1.2, -1.0, -0.6])
+    g = torch.tensor([2.0, -2.0, -3.0, 3.0, 4.0, 1.0, 3.0, 1.0])
+    expected = [
+        2.0 * (1 - 0.5) / 2,  # increasing: scaled by (p_max - p) / (p_max - p_min)
+        -2.0 * (0.5 + 1) / 2,  # decreasing: scaled by (p - p_min) / (p_max - p_min)
+        0.0,  # at the lower bound, pushing down: stopped
+        0.0,  # at the upper bound, pushing up: stopped
+        2.0,  # in the middle: halved either way
+        -0.1,  # past the upper bound, pushing up: inverted, (1 - 1.2) / 2 = -0.1
+        3.0,  # at the lower bound, pushing up (inwards): untouched
+        1.0 * (1 + 0.6) / 2,
+    ]
+    torch.testing.assert_close(invert_gradients(g, p), torch.tensor(expected))
+    # Other bounds: [0, 4], p = 3, increasing by 2 -> 2 * (4 - 3) / 4.
+    assert invert_gradients(torch.tensor([2.0]), torch.tensor([3.0]), 0.0, 4.0).item() == pytest.approx(0.5)
+
+
+def test_zeroing_gradients_by_hand():
+    p = torch.tensor([1.0, 1.0, -1.0, 0.3, 1.5, -1.2])
+    g = torch.tensor([1.0, -1.0, -1.0, 5.0, -2.0, 0.5])
+    # Only components pushing an output at or past a bound further out are zeroed; the rest is untouched.
+    torch.testing.assert_close(zero_gradients(g, p), torch.tensor([0.0, -1.0, 0.0, 5.0, -2.0, 0.5]))
+
+
+# Not "zero": it only removes the gradient at the bound, and Adam's momentum carries the outputs well past
+# it, which is why Hausknecht & Stone found zeroing unreliable.
+@pytest.mark.parametrize("bound", ["invert", "squash"])
+def test_actor_chasing_an_unbounded_critic_stays_in_bounds(bound):
+    class Greedy(nn.Module):  # a critic that wants every output as large as possible
+        def __init__(self):
+            super().__init__()
+            self.w = nn.Parameter(torch.ones(()))
+
+        def forward(self, obs, out):
+            return 10.0 * self.w * out.sum(-1)
+
+    cfg = dataclasses.replace(SMALL, bound=bound, actor_lr=3e-2, grad_clip=0.0, learning_starts=10**6)
+    model = PADDPG("pamdp/Platform-v0", cfg)
+    model.learn(100, progress_bar=False)
+    model.critic = Greedy()
+    model.critic_target = Greedy().requires_grad_(False)
+    model.critic_optimizer = torch.optim.SGD(model.critic.parameters(), lr=0.0)
+    for _ in range(200):
+        model._update()
+    with torch.no_grad():
+        out = model.actor(torch.from_numpy(model.replay.data["obs"][:100]))
+    assert out.mean() > 0.9, bound  # pushed up to the bound...
+    assert out.max() <= (1.0 if bound == "squash" else 1.05), bound  # ...and not (much) past it
+
+
+def test_squash_uses_a_tanh_output_layer():
+    squash = Actor(4, HYBRID, (8,), "relu", squash=True)
+    assert isinstance(squash.net[-1], nn.Tanh)
+    assert not isinstance(Actor(4, HYBRID, (8,), "relu", squash=False).net[-1], nn.Tanh)
+    for p in squash.parameters():
+        p.data.mul_(100)
+    assert squash(torch.randn(100, 4)).abs().max() <= 1.0
+
+
+def test_executed_action_is_the_argmax_with_its_own_parameters():
+    actor = Actor(4, HYBRID, (8,), "relu", squash=False)
+    # Scores for 3 actions, then parameters: action 0 -> [p0], action 1 -> [p1, p2], action 2 -> [p3].
+    out = torch.tensor(
+        [
+            [0.9, 0.1, 0.0, 0.5, -0.2, 0.3, 0.7],
+            [0.0, 0.8, 0.1, 0.5, -0.2, 0.3, 0.7],
+            [0.0, 0.1, 0.2, 0.5, -0.2, 1.4, 0.7],
+        ]
+    )
+    a, x = actor.action(out)
+    np.testing.assert_array_equal(a, [0, 1, 2])
+    torch.testing.assert_close(x, torch.tensor([[0.5, 0.0], [-0.2, 0.3], [0.7, 0.0]]))
+
+
+def test_epsilon_is_annealed_linearly():
+    model = PADDPG("pamdp/Platform-v0", dataclasses.replace(SMALL, epsilon_steps=1000))
+    assert model.epsilon(0) == 1.0
+    assert model.epsilon(500) == pytest.approx(0.55)
+    assert model.epsilon(10**6) == pytest.approx(0.1)
+
+
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        ({"bound": "clip"}, "bound = 'clip'"),
+        ({"beta": 1.5}, "beta = 1.5"),
+        ({"epsilon_end": -0.1}, "epsilon_end = -0.1"),
+        ({"batch_size": 0}, "batch_size = 0"),
+        ({"hidden_sizes": (0,)}, "hidden_sizes"),
+    ],
+)
+def test_bad_settings_raise_clear_errors(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        PADDPGConfig(**kwargs)
+
+
+def test_presets():
+    presets = PADDPGConfig.presets()
+    assert presets["paper"].hidden_sizes == (400, 300) and presets["paper_hfo"].hidden_sizes == (400, 300, 200)
+    hs = presets["hausknecht_stone"]
+    assert hs.hidden_sizes == (1024, 512, 256, 128) and hs.activation == "leaky_relu"
+    assert (hs.adam_beta1, hs.actor_lr, hs.critic_lr, hs.grad_clip, hs.tau, hs.gamma) == (
+        0.95,
+        1e-5,
+        1e-3,
+        10,
+        1e-3,
+        0.99,
+    )
+    assert (hs.buffer_size, hs.batch_size, hs.beta, hs.bound) == (500_000, 32, 0.2, "invert")
+
+
+def test_epoch_stores_monte_carlo_returns_and_explores():
+    model = PADDPG("pamdp/Platform-v0", dataclasses.replace(SMALL, ou_sigma=0.2))
+    stats = []
+    model.learn(400, progress_bar=False, callback=lambda m, s: stats.append(s))
+    n = len(model.replay)
+    assert n == model.num_timesteps
+    r, mc, term = (model.replay.data[k][:n] for k in ("reward", "mc", "terminated"))
+    # The last step of a terminated episode has return-to-go = its reward; most episodes have ended.
+    np.testing.assert_allclose(mc[term], r[term], rtol=1e-6)
+    assert np.isfinite(mc).mean() > 0.9
+    assert np.all(mc[np.isfinite(mc)] >= r[np.isfinite(mc)] - 1e-6)  # Platform's rewards are non-negative
+    out = model.replay.data["out"][:n]
+    assert np.abs(out).max() <= 1.0
+    np.testing.assert_array_equal(out[:, :3].argmax(1), model.replay.data["a"][:n])
+    assert stats[-1]["train/updates"] > 0 and stats[-1]["train/epsilon"] < 1.0
+    for key in ("losses/critic_loss", "losses/actor_loss", "train/q_mean", "train/action_freq_0"):
+        assert np.isfinite(stats[-1][key]), key
+
+
+def flat_params(model):
+    return torch.cat([p.detach().flatten() for m in (model.actor, model.critic) for p in m.parameters()])
+
+
+def test_same_seed_gives_identical_first_epoch():
+    runs = []
+    for seed in (0, 0, 1):
+        model = PADDPG("pamdp/Platform-v0", dataclasses.replace(SMALL, seed=seed))
+        model.learn(200, progress_bar=False)
+        runs.append(flat_params(model))
+    torch.testing.assert_close(runs[0], runs[1], rtol=0, atol=0)
+    assert not torch.equal(runs[0], runs[2])
+
+
+def test_save_load_predict_round_trip(tmp_path):
+    model = PADDPG("pamdp/Platform-v0", SMALL)
+    model.learn(200, progress_bar=False)
+    model.save(tmp_path / "m.pt")
+    loaded = PADDPG.load(tmp_path / "m.pt")
+    assert loaded.config == model.config and loaded.num_timesteps == model.num_timesteps
+    obs = np.random.default_rng(0).uniform(0, 1, size=(32, 9))
+    for deterministic in (True, False):
+        a1, p1 = model.predict(obs, deterministic=deterministic)
+        a2, p2 = loaded.predict(obs, deterministic=deterministic)
+        np.testing.assert_array_equal(a1, a2)
+        for x, y in zip(p1, p2):
+            np.testing.assert_array_equal(x, y)
+    for name, module in model._modules().items():
+        for p, q in zip(module.state_dict().values(), loaded._modules()[name].state_dict().values()):
+            assert torch.equal(p, q), name
+
+
+def test_critic_loss_falls_on_a_fixed_batch():
+    model = PADDPG("pamdp/Platform-v0", dataclasses.replace(SMALL, learning_starts=10**6, hidden_sizes=(64, 64)))
+    model.learn(200, progress_bar=False)
+    b = model.replay.sample(128, np.random.default_rng(0))
+    losses = []
+    for _ in range(150):
+        loss = (model.critic(b["obs"], b["out"]) - b["reward"]).pow(2).mean()
+        model.critic_optimizer.zero_grad()
+        loss.backward()
+        model.critic_optimizer.step()
+        losses.append(loss.item())
+    assert losses[-1] < 0.2 * losses[0]
+
+
+@pytest.mark.parametrize("algo", ["paddpg", "pasvg0"])
+def test_cli_trains_resumes_and_evaluates(tmp_path, capsys, algo):
+    out = tmp_path / "run"
+    tiny = ["--hidden-sizes", "16", "--num-envs", "4", "--epoch-steps", "200", "--learning-starts", "100"]
+    tiny += ["--batch-size", "16", "--buffer-size", "5000", "--no-progress"]
+    assert main(["train", algo, "--total-steps", "200", "--out", str(out), "--eval-episodes", "20", *tiny]) == 0
+    for name in ("run.json", "progress.csv", "checkpoint.pt", "final_model.pt", "evaluation.json"):
+        assert (out / name).exists(), name
+    assert "greedy return over 20 episodes" in capsys.readouterr().out
+    assert json.loads((out / "run.json").read_text())["config"]["hidden_sizes"] == [16]
+    assert main(["train", algo, "--total-steps", "400", "--out", str(out), "--eval-episodes", "0", *tiny]) == 0
+    assert "resuming" in capsys.readouterr().err
+    assert main(["evaluate", str(out), "--episodes", "10", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["episodes"] == 10
+
+
+def test_top_level_import():
+    assert pamdp.PADDPG is PADDPG

@@ -1,0 +1,201 @@
+"""PASVG(0): the Gumbel-Softmax sample, the reparameterised gradient, replay, reproducibility, save/load."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+import torch
+
+import pamdp
+from pamdp import PASVG0
+from pamdp.algos.pasvg import GumbelHybridPolicy, PASVG0Config, gumbel_noise, gumbel_softmax_sample
+from pamdp.spaces import HybridActionSpace
+
+SMALL = PASVG0Config(
+    hidden_sizes=(16, 16), num_envs=4, epoch_steps=200, learning_starts=100, batch_size=16, buffer_size=5_000
+)
+HYBRID = HybridActionSpace(
+    (np.array([-1.0]), np.array([0.0, 0.0]), np.array([-2.0])), (np.array([1.0]), np.array([1.0, 3.0]), np.array([2.0]))
+)
+
+
+def test_straight_through_sample_is_one_hot_with_gradient_to_the_logits():
+    logits = torch.tensor([[0.3, -0.2, 1.0], [2.0, 0.0, -1.0]], requires_grad=True)
+    eta = gumbel_noise((2, 3), torch.Generator().manual_seed(0))
+    index, sample = gumbel_softmax_sample(logits, eta, temperature=1.0, hard=True)
+    torch.testing.assert_close(sample.detach(), torch.nn.functional.one_hot(index, 3).float())
+    np.testing.assert_array_equal(index, (logits.log_softmax(-1) + eta).argmax(-1))
+    (sample * torch.tensor([1.0, 2.0, 3.0])).sum().backward()
+    assert logits.grad.abs().sum() > 0
+    # The backward pass is the soft sample's.
+    soft_logits = logits.detach().clone().requires_grad_(True)
+    _, soft = gumbel_softmax_sample(soft_logits, eta, 1.0, hard=False)
+    (soft * torch.tensor([1.0, 2.0, 3.0])).sum().backward()
+    torch.testing.assert_close(logits.grad, soft_logits.grad)
+
+
+def test_gumbel_max_draws_follow_the_softmax():
+    logits = torch.tensor([0.5, -1.0, 1.5]).expand(40_000, 3)
+    index, _ = gumbel_softmax_sample(logits, gumbel_noise((40_000, 3), torch.Generator().manual_seed(1)), 1.0, True)
+    freq = np.bincount(index.numpy(), minlength=3) / 40_000
+    np.testing.assert_allclose(freq, torch.softmax(logits[0], -1).numpy(), atol=0.01)
+
+
+def toy_critic(obs, a, x):
+    """A smooth stand-in for Q(s, a, x), non-linear in every input."""
+    w = torch.tensor([0.7, -1.3, 2.1], dtype=obs.dtype)
+    return torch.sin(obs.sum(-1)) * (a @ w) + (a @ w) * (x - 0.3).pow(2).sum(-1) + torch.cos(3 * x[:, 0])
+
+
+@pytest.mark.parametrize("hard", [False, True])
+def test_reparameterised_gradient_matches_finite_differences(hard):
+    torch.manual_seed(0)
+    policy = GumbelHybridPolicy(4, HYBRID, (8,), "tanh", init_log_std=-0.7).double()
+    for p in policy.parameters():  # undo the near-zero output layers, so that every term matters
+        p.data.normal_(0, 0.5)
+    gen = torch.Generator().manual_seed(2)
+    obs = torch.randn(6, 4, generator=gen, dtype=torch.float64)
+    eta_a = gumbel_noise((6, 3), gen).double()
+    eta_x = torch.randn(6, 2, generator=gen, dtype=torch.float64)
+
+    def objective():
+        _, a, x = policy(obs, eta_a, eta_x, 0.8, hard)
+        return toy_critic(obs, a, x).mean()
+
+    params = dict(policy.named_parameters())
+    grads = dict(zip(params, torch.autograd.grad(objective(), list(params.values()))))
+    # With soft samples J is smooth in every parameter. With hard samples the forward pass is piecewise
+    # constant in pi_d (straight-through is a biased estimator by design), but exact for pi_c and the std.
+    names = list(params) if not hard else [n for n in params if not n.startswith("pi_d")]
+    rng = np.random.default_rng(3)
+    h = 1e-6
+    for name in names:
+        p = params[name]
+        for flat in rng.choice(p.numel(), size=min(4, p.numel()), replace=False):
+            with torch.no_grad():
+                orig = p.view(-1)[flat].item()
+                p.view(-1)[flat] = orig + h
+                up = objective().item()
+                p.view(-1)[flat] = orig - h
+                down = objective().item()
+                p.view(-1)[flat] = orig
+            fd = (up - down) / (2 * h)
+            assert grads[name].view(-1)[flat].item() == pytest.approx(fd, rel=1e-5, abs=1e-8), name
+    if hard:
+        assert grads["pi_d.0.weight"].abs().sum() > 0  # the straight-through gradient reaches pi_d
+
+
+def test_parameters_stay_in_bounds_and_unused_ones_are_zero():
+    policy = GumbelHybridPolicy(4, HYBRID, (8,), "relu", init_log_std=1.5)
+    gen = torch.Generator().manual_seed(0)
+    index, _, x = policy(
+        torch.randn(500, 4, generator=gen), gumbel_noise((500, 3), gen), torch.randn(500, 2) * 5, 1.0, True
+    )
+    assert x.abs().max() <= 1.0
+    mask = torch.as_tensor(HYBRID.param_mask)[index]
+    assert torch.all(x[~mask] == 0)
+
+
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        ({"temperature": 0.0}, "temperature = 0.0"),
+        ({"tau": 1.5}, "tau = 1.5"),
+        ({"updates_per_step": -1.0}, "updates_per_step = -1.0"),
+        ({"activation": "swish"}, "activation = 'swish'"),
+        ({"policy_lr": float("inf")}, "policy_lr = inf"),
+    ],
+)
+def test_bad_settings_raise_clear_errors(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        PASVG0Config(**kwargs)
+
+
+def test_paper_preset_is_the_papers():
+    cfg = PASVG0Config.preset("paper")
+    assert (cfg.hidden_sizes, cfg.critic_lr, cfg.policy_lr, cfg.temperature) == ((400, 300), 1e-3, 1e-5, 1.0)
+    assert (cfg.buffer_size, cfg.learning_starts, cfg.epoch_steps) == (10_000_000, 10_000, 10_000)
+    assert "tuned" in PASVG0Config.presets()
+
+
+def flat_params(model):
+    return torch.cat([p.detach().flatten() for m in (model.policy, model.critic) for p in m.parameters()])
+
+
+def test_epoch_stores_valid_transitions_with_their_noise_and_learns():
+    model = PASVG0("pamdp/Platform-v0", SMALL)
+    stats = []
+    model.learn(400, progress_bar=False, callback=lambda m, s: stats.append(s))
+    n = len(model.replay)
+    assert n == model.num_timesteps >= 400  # autoreset steps are not stored
+    a, a_in, eta_a = (model.replay.data[k][:n] for k in ("a", "a_in", "eta_a"))
+    np.testing.assert_array_equal(a_in.argmax(1), a)
+    np.testing.assert_array_equal(a_in.max(1), 1.0)  # straight-through: the critic sees one-hots
+    assert np.all(np.isfinite(eta_a)) and np.abs(model.replay.data["eta_x"][:n]).max() > 0
+    assert stats[-1]["train/updates"] > 0
+    for key in ("losses/critic_loss", "losses/actor_loss", "train/q_mean", "train/action_freq_2"):
+        assert np.isfinite(stats[-1][key]), key
+    # With the recorded noise, the current policy reproduces the stored action until it is updated.
+    fresh = PASVG0("pamdp/Platform-v0", dataclasses.replace(SMALL, learning_starts=10**6))
+    fresh.learn(100, progress_bar=False)
+    k = len(fresh.replay)
+    with torch.no_grad():
+        index, _, x = fresh.policy(
+            torch.from_numpy(fresh.replay.data["obs"][:k]),
+            torch.from_numpy(fresh.replay.data["eta_a"][:k]),
+            torch.from_numpy(fresh.replay.data["eta_x"][:k]),
+            1.0,
+            True,
+        )
+    np.testing.assert_array_equal(index.numpy(), fresh.replay.data["a"][:k])
+    np.testing.assert_allclose(x.numpy(), fresh.replay.data["x"][:k], atol=1e-6)
+
+
+def test_same_seed_gives_identical_first_epoch():
+    runs = []
+    for seed in (0, 0, 1):
+        model = PASVG0("pamdp/Platform-v0", dataclasses.replace(SMALL, seed=seed))
+        model.learn(200, progress_bar=False)
+        runs.append(flat_params(model))
+    torch.testing.assert_close(runs[0], runs[1], rtol=0, atol=0)
+    assert not torch.equal(runs[0], runs[2])
+
+
+@pytest.mark.parametrize("save_replay", [False, True])
+def test_save_load_predict_round_trip(tmp_path, save_replay):
+    model = PASVG0("pamdp/Platform-v0", dataclasses.replace(SMALL, save_replay=save_replay))
+    model.learn(200, progress_bar=False)
+    model.save(tmp_path / "m.pt")
+    loaded = PASVG0.load(tmp_path / "m.pt")
+    assert loaded.config == model.config and loaded.num_timesteps == model.num_timesteps
+    obs = np.random.default_rng(0).uniform(0, 1, size=(32, 9))
+    for deterministic in (True, False):  # stochastic actions continue the same random stream
+        a1, p1 = model.predict(obs, deterministic=deterministic)
+        a2, p2 = loaded.predict(obs, deterministic=deterministic)
+        np.testing.assert_array_equal(a1, a2)
+        for x, y in zip(p1, p2):
+            np.testing.assert_array_equal(x, y)
+    assert len(loaded.replay) == (len(model.replay) if save_replay else 0)
+    if save_replay:
+        np.testing.assert_array_equal(loaded.replay.data["eta_a"][:200], model.replay.data["eta_a"][:200])
+    loaded.learn(200, progress_bar=False)  # resumes: refills (or keeps) the buffer and goes on
+    assert loaded.num_timesteps >= 400
+
+
+def test_critic_loss_falls_on_a_fixed_batch():
+    model = PASVG0("pamdp/Platform-v0", dataclasses.replace(SMALL, learning_starts=10**6, hidden_sizes=(64, 64)))
+    model.learn(200, progress_bar=False)
+    b = model.replay.sample(128, np.random.default_rng(0))
+    target = b["reward"]  # a fixed regression target: the one-step reward
+    losses = []
+    for _ in range(150):
+        loss = (model.critic(b["obs"], b["a_in"], b["x"]) - target).pow(2).mean()
+        model.critic_optimizer.zero_grad()
+        loss.backward()
+        model.critic_optimizer.step()
+        losses.append(loss.item())
+    assert losses[-1] < 0.2 * losses[0]
+
+
+def test_top_level_import():
+    assert pamdp.PASVG0 is PASVG0

@@ -1,0 +1,104 @@
+"""The replay buffer (wrap-around, contents, checkpoints) and the shared off-policy loop."""
+
+import time
+
+import numpy as np
+import pytest
+import torch
+from torch import nn
+
+from pamdp.algos.offpolicy import discounted_returns, soft_update
+from pamdp.algos.replay import ReplayBuffer
+
+FIELDS = {"obs": ((2,), np.float32), "a": ((), np.int64), "eta": ((3,), np.float32)}
+
+
+def rows(ids):
+    ids = np.asarray(ids)
+    return {
+        "obs": np.stack([ids, -ids], axis=1).astype(np.float32),
+        "a": ids.astype(np.int64),
+        "eta": np.repeat(ids[:, None], 3, axis=1).astype(np.float32),
+    }
+
+
+def test_wraps_around_and_keeps_the_newest():
+    buf = ReplayBuffer(5, FIELDS)
+    np.testing.assert_array_equal(buf.add(**rows([0, 1, 2])), [0, 1, 2])
+    assert len(buf) == 3
+    np.testing.assert_array_equal(buf.add(**rows([3, 4, 5, 6])), [3, 4, 5, 6])
+    assert len(buf) == 5 and buf.added == 7
+    # Slots 0 and 1 were overwritten by transitions 5 and 6; 2, 3, 4 are untouched.
+    np.testing.assert_array_equal(buf.data["a"], [5, 6, 2, 3, 4])
+    np.testing.assert_array_equal(buf.data["obs"][:, 1], [-5, -6, -2, -3, -4])
+    np.testing.assert_array_equal(buf.holds(np.arange(7)), [False, False, True, True, True, True, True])
+    # A batch longer than the capacity keeps its last `capacity` rows, in ring order.
+    buf.add(**rows(range(10, 22)))
+    assert buf.added == 19 and sorted(buf.data["a"]) == [17, 18, 19, 20, 21]
+    assert buf.data["a"][19 % 5 - 1] == 21
+
+
+def test_write_skips_overwritten_transitions():
+    buf = ReplayBuffer(4, {"r": ((), np.float32), "mc": ((), np.float32)})
+    first = buf.add(r=np.ones(3), mc=np.full(3, np.nan))
+    buf.add(r=np.ones(2), mc=np.full(2, np.nan))  # overwrites transition 0
+    buf.write("mc", first, np.array([7.0, 8.0, 9.0]))
+    np.testing.assert_array_equal(buf.data["mc"][[1, 2]], [8.0, 9.0])
+    assert np.isnan(buf.data["mc"][0])  # now transition 4's slot: left alone
+
+
+def test_sampling_returns_stored_rows_from_the_given_rng():
+    buf = ReplayBuffer(100, FIELDS)
+    buf.add(**rows(range(30)))
+    batch = buf.sample(500, np.random.default_rng(0))
+    ids = batch["a"].numpy()
+    assert set(ids) <= set(range(30)) and len(set(ids)) > 25
+    np.testing.assert_array_equal(batch["obs"].numpy(), np.stack([ids, -ids], axis=1))
+    np.testing.assert_array_equal(batch["eta"].numpy()[:, 2], ids)
+    again = buf.sample(500, np.random.default_rng(0))
+    assert torch.equal(again["a"], batch["a"])
+    batch["a"][:] = -1  # a sample shares no memory with the buffer
+    assert buf.data["a"][:30].min() == 0
+
+
+def test_large_capacity_is_cheap_until_filled():
+    t = time.perf_counter()
+    buf = ReplayBuffer(10_000_000, {"obs": ((9,), np.float32), "next_obs": ((9,), np.float32), "a": ((), np.int64)})
+    assert time.perf_counter() - t < 1.0
+    buf.add(obs=np.ones((4, 9)), next_obs=np.ones((4, 9)), a=np.arange(4))
+    assert len(buf) == 4
+
+
+def test_state_dict_with_and_without_contents():
+    buf = ReplayBuffer(5, FIELDS)
+    buf.add(**rows(range(7)))
+    full = ReplayBuffer(5, FIELDS)
+    full.load_state_dict(buf.state_dict(include_data=True))
+    assert full.added == 7
+    for name in FIELDS:
+        np.testing.assert_array_equal(full.data[name], buf.data[name])
+    empty = ReplayBuffer(5, FIELDS)
+    empty.load_state_dict(buf.state_dict(include_data=False))
+    assert len(empty) == 0
+
+
+def test_bad_arguments_raise():
+    with pytest.raises(ValueError, match="capacity = 0"):
+        ReplayBuffer(0, FIELDS)
+    buf = ReplayBuffer(5, FIELDS)
+    with pytest.raises(ValueError, match="got fields"):
+        buf.add(obs=np.zeros((1, 2)))
+    with pytest.raises(ValueError, match="empty"):
+        buf.sample(2, np.random.default_rng(0))
+
+
+def test_discounted_returns_by_hand():
+    np.testing.assert_allclose(discounted_returns(np.array([1.0, 2.0, 3.0]), 0.5), [1 + 0.5 * 2 + 0.25 * 3, 2 + 1.5, 3])
+    np.testing.assert_allclose(discounted_returns(np.array([1.0]), 0.5, tail=4.0), [3.0])
+
+
+def test_soft_update_is_polyak_averaging():
+    target, source = nn.Linear(2, 1), nn.Linear(2, 1)
+    before = target.weight.detach().clone()
+    soft_update(target, source, 0.25)
+    torch.testing.assert_close(target.weight.detach(), 0.75 * before + 0.25 * source.weight.detach())
