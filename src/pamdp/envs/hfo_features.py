@@ -72,35 +72,121 @@ SELF_SPEED_MAX = 0.46
 BALL_SPEED_MAX = 5.0
 
 
-def _unit(x, y):
-    """Unit vector of (x, y) and its length; the zero vector's direction is heading 0, i.e. (1, 0)."""
-    length = np.sqrt(x * x + y * y)  # not np.hypot: several times slower, and the scalar twin must agree
-    nonzero = length > 0.0
-    safe = np.where(nonzero, length, 1.0)
-    return np.where(nonzero, x / safe, 1.0), np.where(nonzero, y / safe, 0.0), length
+def _directions(x, y):
+    """Unit vectors of the velocities (x, y) and their lengths; the zero vector's direction is (1, 0).
 
-
-def _velocity_direction(x, y):
-    """Like :func:`_unit`, but exact for velocities decayed to 1e-160 and below, whose squares underflow.
-
-    (A held player's velocity decays by 0.4 per cycle for hundreds of cycles; HFO takes its direction
-    with atan2, which has no such trouble.)
+    Exact for velocities decayed to 1e-160 and below, whose squares underflow: the components are first
+    divided by the larger one. (A held player's velocity decays by 0.4 per cycle for hundreds of
+    cycles; HFO takes its direction with atan2, which has no such trouble.)
     """
     m = np.maximum(np.abs(x), np.abs(y))
-    nonzero = m > 0.0
-    safe = np.where(nonzero, m, 1.0)
-    ux, uy, length = _unit(x / safe, y / safe)
-    return np.where(nonzero, ux, 1.0), np.where(nonzero, uy, 0.0), length * m
+    any_zero = not m.min() > 0.0
+    zero = m == 0.0 if any_zero else None
+    safe = m + zero if any_zero else m  # m + 0.0 is m: only the zero vectors divide by 1
+    ux, uy = x / safe, y / safe
+    length = ux * ux
+    length += uy * uy
+    np.sqrt(length, out=length)  # >= 1 where m > 0: the larger component is now +-1
+    if any_zero:
+        np.add(length, zero, out=safe)
+        ux /= safe
+        uy /= safe
+        ux[zero], uy[zero] = 1.0, 0.0
+    else:
+        ux /= length
+        uy /= length
+    length *= m
+    return ux, uy, length
 
 
-def _scaled(x, lo, hi):
-    """Spec 2.8's normalised scalar: [lo, hi] onto [-1, 1], clipping."""
-    return 2.0 * (np.clip(x, lo, hi) - lo) / (hi - lo) - 1.0
+def _scaled_into(x, hi, out):
+    """Spec 2.8's normalised scalar for lo = 0: [0, hi] onto [-1, 1], clipping, written to ``out``."""
+    np.maximum(x, 0.0, out=out)
+    np.minimum(out, hi, out=out)
+    out *= 2.0
+    out /= hi
+    out -= 1.0
 
 
-def _proximity(d, n):
-    """1 when touching, -1 at distance ``n`` or farther."""
-    return 1.0 - 2.0 * np.clip(d / n, 0.0, 1.0)
+def _proximity_into(q, out=None):
+    """1 when touching, -1 at distance ``n`` or farther, from ``q = d / n`` (overwritten unless ``out``)."""
+    out = q if out is None else out
+    np.maximum(q, 0.0, out=out)
+    np.minimum(out, 1.0, out=out)
+    out *= -2.0  # 1 - 2q and 1 + (-2q) are the same number: negation and doubling are exact
+    out += 1.0
+    return out
+
+
+_LANDMARK_X, _LANDMARK_Y = LANDMARKS[:, :1].copy(), LANDMARKS[:, 1:].copy()
+_FLAG_ROWS = (9, 11, 12, LAST_ACTION_OK)
+_CONSTANT_ROWS = ((0, 1.0), (1, 1.0), (8, -1.0), (10, -1.0), (50, 1.0), (54, 1.0))
+
+
+def feature_rows(
+    px, py, bx, by, vx, vy, stamina, cos_t, sin_t, kickable, collided_ball, collided_post, last_action_ok,
+    profile: FeatureProfile, out: np.ndarray,
+) -> np.ndarray:  # fmt: skip
+    """The features of N states as the rows of ``out``, shape ``(profile.n_features, N)``, float64.
+
+    The batched env's layout: one contiguous row per feature, so every operation runs over N games
+    at once. ``vx, vy`` hold the player's (row 0) and the ball's (row 1) velocity, shape ``(2, N)``;
+    ``cos_t, sin_t`` are the cosine and sine of the body angle (the caller keeps them from one turn to
+    the next); the rest as :func:`low_level_features`. Every number equals the scalar twin's.
+    """
+    for row, value in _CONSTANT_ROWS:
+        out[row] = value
+    for row, flag in zip(_FLAG_ROWS, (collided_ball, collided_post, kickable, last_action_ok)):
+        if row < profile.n_features:
+            np.multiply(flag, 2.0, out=out[row])
+            out[row] -= 1.0
+    out[5], out[6] = sin_t, cos_t
+    # Own and ball velocity in one pass: direction and speed.
+    ux, uy, speed = _directions(vx, vy)
+    # Own velocity direction relative to the body, as body minus velocity heading (sign order of HFO).
+    np.multiply(sin_t, ux[0], out=out[2])
+    out[2] -= cos_t * uy[0]
+    np.multiply(cos_t, ux[0], out=out[3])
+    out[3] += sin_t * uy[0]
+    _scaled_into(speed[0], SELF_SPEED_MAX, out[4])
+    _scaled_into(stamina, STAMINA_MAX, out[7])
+    _scaled_into(speed[1], BALL_SPEED_MAX, out[55])
+    out[56], out[57] = uy[1], ux[1]  # a ball at rest has heading 0: (sin, cos) = (0, 1)
+    # Landmarks (rows 0-10) and the ball (row 11): bearing heading(L - p) - body as (sin, cos), proximity.
+    n = px.shape[0]
+    dx, dy = np.empty((12, n)), np.empty((12, n))
+    np.subtract(_LANDMARK_X, px, out=dx[:11])
+    np.subtract(bx, px, out=dx[11])
+    np.subtract(_LANDMARK_Y, py, out=dy[:11])
+    np.subtract(by, py, out=dy[11])
+    dist = dx * dx
+    dist += dy * dy
+    np.sqrt(dist, out=dist)
+    zero = None if dist.min() > 0.0 else dist == 0.0
+    safe = dist if zero is None else dist + zero
+    dx /= safe
+    dy /= safe
+    if zero is not None:  # the player exactly on a landmark or the ball: heading 0
+        dx[zero], dy[zero] = 1.0, 0.0
+    a, b = dy * cos_t, dx * sin_t
+    np.subtract(a[:11], b[:11], out=out[13:46:3])
+    np.subtract(a[11], b[11], out=out[51])
+    np.multiply(dx, cos_t, out=a)
+    np.multiply(dy, sin_t, out=b)
+    np.add(a[:11], b[:11], out=out[14:46:3])
+    np.add(a[11], b[11], out=out[52])
+    dist /= profile.max_dist
+    _proximity_into(dist)
+    out[15:46:3], out[53] = dist[:11], dist[11]
+    # Out-of-bounds proximities.
+    oob = out[46:50]
+    oob[0] = px
+    np.subtract(PITCH_HALF_LENGTH, px, out=oob[1])
+    np.add(PITCH_HALF_WIDTH, py, out=oob[2])
+    np.subtract(PITCH_HALF_WIDTH, py, out=oob[3])
+    oob /= np.array([[profile.oob_x], [profile.oob_x], [profile.oob_y], [profile.oob_y]])
+    _proximity_into(oob)
+    return out
 
 
 def low_level_features(
@@ -112,74 +198,53 @@ def low_level_features(
     Angles are in degrees; flags are booleans (``kickable`` is the agent's own test, see
     ``HFOGame.agent_kickable``). Every feature lies in [-1, 1].
     """
-    n = np.shape(px)[0]
-    out = np.empty((n, profile.n_features))
     theta = np.radians(body)
-    cos_t, sin_t = np.cos(theta), np.sin(theta)
-    out[:, 0:2] = 1.0  # self position and velocity are valid under fullstate
-    # Own velocity direction relative to the body, as body minus velocity heading (sign order of HFO).
-    ux, uy, speed = _velocity_direction(pvx, pvy)
-    out[:, 2] = sin_t * ux - cos_t * uy
-    out[:, 3] = cos_t * ux + sin_t * uy
-    out[:, 4] = _scaled(speed, 0.0, SELF_SPEED_MAX)
-    out[:, 5] = sin_t
-    out[:, 6] = cos_t
-    out[:, 7] = _scaled(stamina, 0.0, STAMINA_MAX)
-    out[:, 8] = -1.0  # frozen
-    out[:, 9] = np.where(collided_ball, 1.0, -1.0)
-    out[:, 10] = -1.0  # colliding with a player
-    out[:, 11] = np.where(collided_post, 1.0, -1.0)
-    # Landmarks and the ball: bearing heading(L - p) - body as (sin, cos), and proximity.
-    targets_x = np.concatenate([np.broadcast_to(LANDMARKS[:, 0], (n, 11)), np.reshape(bx, (n, 1))], axis=1)
-    targets_y = np.concatenate([np.broadcast_to(LANDMARKS[:, 1], (n, 11)), np.reshape(by, (n, 1))], axis=1)
-    lx, ly, dist = _unit(targets_x - np.reshape(px, (n, 1)), targets_y - np.reshape(py, (n, 1)))
-    c, s = cos_t[:, None], sin_t[:, None]
-    bearing_sin, bearing_cos = ly * c - lx * s, lx * c + ly * s
-    proximity = _proximity(dist, profile.max_dist)
-    out[:, 12] = np.where(kickable, 1.0, -1.0)
-    out[:, 13:46:3] = bearing_sin[:, :11]
-    out[:, 14:46:3] = bearing_cos[:, :11]
-    out[:, 15:46:3] = proximity[:, :11]
-    out[:, 46] = _proximity(px, profile.oob_x)
-    out[:, 47] = _proximity(PITCH_HALF_LENGTH - px, profile.oob_x)
-    out[:, 48] = _proximity(PITCH_HALF_WIDTH + py, profile.oob_y)
-    out[:, 49] = _proximity(PITCH_HALF_WIDTH - py, profile.oob_y)
-    out[:, 50] = 1.0
-    out[:, 51] = bearing_sin[:, 11]
-    out[:, 52] = bearing_cos[:, 11]
-    out[:, 53] = proximity[:, 11]
-    out[:, 54] = 1.0
-    vx, vy, ball_speed = _velocity_direction(bvx, bvy)
-    out[:, 55] = _scaled(ball_speed, 0.0, BALL_SPEED_MAX)
-    out[:, 56] = vy  # a ball at rest has heading 0: (sin, cos) = (0, 1)
-    out[:, 57] = vx
-    if profile.n_features > LAST_ACTION_OK:
-        out[:, LAST_ACTION_OK] = np.where(last_action_ok, 1.0, -1.0)
-    return out
+    rows = np.empty((profile.n_features, np.shape(px)[0]))
+    feature_rows(
+        px, py, bx, by, np.stack((pvx, bvx)), np.stack((pvy, bvy)), stamina, np.cos(theta), np.sin(theta),
+        kickable, collided_ball, collided_post, last_action_ok, profile, rows,
+    )  # fmt: skip
+    return rows.T
+
+
+def ball_to_goal_rows(rows: np.ndarray) -> np.ndarray:
+    """2 d(ball, goal) / Dmax recovered from feature rows by the law of cosines, as H&S's code does."""
+    ball_dist = 1.0 - rows[BALL_PROXIMITY]
+    goal_dist = 1.0 - rows[GOAL_PROXIMITY]
+    # cos(alpha_ball - alpha_goal) from the (sin, cos) pairs: the same number as H&S's
+    # cos(atan2(...) - atan2(...)), without three transcendental calls per game.
+    cos_alpha = rows[BALL_COS] * rows[GOAL_COS]
+    cos_alpha += rows[BALL_SIN] * rows[GOAL_SIN]
+    squared = ball_dist * ball_dist
+    squared += goal_dist * goal_dist
+    ball_dist *= 2.0
+    ball_dist *= goal_dist
+    ball_dist *= cos_alpha
+    squared -= ball_dist
+    np.maximum(squared, 0.0, out=squared)
+    return np.sqrt(squared, out=squared)
 
 
 def ball_to_goal(features: np.ndarray) -> np.ndarray:
-    """2 d(ball, goal) / Dmax recovered from the features by the law of cosines, as H&S's code does."""
-    ball_dist = 1.0 - features[:, BALL_PROXIMITY]
-    goal_dist = 1.0 - features[:, GOAL_PROXIMITY]
-    # cos(alpha_ball - alpha_goal) from the (sin, cos) pairs: the same number as H&S's
-    # cos(atan2(...) - atan2(...)), without three transcendental calls per game.
-    cos_alpha = features[:, BALL_COS] * features[:, GOAL_COS] + features[:, BALL_SIN] * features[:, GOAL_SIN]
-    squared = ball_dist**2 + goal_dist**2 - 2.0 * ball_dist * goal_dist * cos_alpha
-    return np.sqrt(np.maximum(squared, 0.0))
+    """:func:`ball_to_goal_rows` of a ``(N, n_features)`` feature matrix."""
+    return ball_to_goal_rows(features.T)
 
 
-def shaped_reward(prev_features, features, holder, kick_bonus_due, goal) -> np.ndarray:
+def shaped_reward(prev_rows, rows, holder, kick_bonus_due, goal, prev_to_goal, to_goal) -> np.ndarray:
     """Hausknecht & Stone's reward between consecutive feature rows (spec 2.9), before the quirk flags.
 
     ``r = Δ ball proximity + 1[first time kickable] + 3 · (−Δ ball-to-goal, if the agent holds the ball)
-    + 5 · 1[goal]``. ``kick_bonus_due`` says the kick bonus has not been paid yet this episode.
+    + 5 · 1[goal]``. ``kick_bonus_due`` says the kick bonus has not been paid yet this episode;
+    ``prev_to_goal, to_goal`` are :func:`ball_to_goal_rows` of the two rows (the env keeps the last).
     Returns the reward and whether the kick bonus was paid now.
     """
-    move_to_ball = features[:, BALL_PROXIMITY] - prev_features[:, BALL_PROXIMITY]
-    kick_bonus = kick_bonus_due & (features[:, KICKABLE] - prev_features[:, KICKABLE] >= 1.0)
-    kick_to_goal = np.where(holder, ball_to_goal(prev_features) - ball_to_goal(features), 0.0)
-    reward = move_to_ball + kick_bonus + 3.0 * kick_to_goal + np.where(goal, 5.0, 0.0)
+    reward = rows[BALL_PROXIMITY] - prev_rows[BALL_PROXIMITY]
+    kick_bonus = kick_bonus_due & (rows[KICKABLE] - prev_rows[KICKABLE] >= 1.0)
+    reward += kick_bonus
+    kick_to_goal = np.where(holder, prev_to_goal - to_goal, 0.0)
+    kick_to_goal *= 3.0
+    reward += kick_to_goal
+    reward += np.where(goal, 5.0, 0.0)
     return reward, kick_bonus
 
 
