@@ -175,9 +175,11 @@ def feature_rows(
     np.multiply(dy, sin_t, out=b)
     np.add(a[:11], b[:11], out=out[14:46:3])
     np.add(a[11], b[11], out=out[52])
-    dist /= profile.max_dist
-    _proximity_into(dist)
-    out[15:46:3], out[53] = dist[:11], dist[11]
+    dist /= profile.max_dist  # then 1 - 2 min(q, 1) as _proximity_into, q >= 0 already
+    np.minimum(dist, 1.0, out=dist)
+    dist *= -2.0
+    np.add(dist[:11], 1.0, out=out[15:46:3])
+    np.add(dist[11], 1.0, out=out[53])
     # Out-of-bounds proximities.
     oob = out[46:50]
     oob[0] = px

@@ -380,9 +380,12 @@ class HalfFieldOffenseVectorEnv(gymnasium.vector.VectorEnv):
         svx, svy, s_body, s_stamina = (self.seen[row, i] for row in (_PVX, _PVY, _BODY, _STAMINA))
         effort = self.effort[i]
         available = s_stamina + phys.EXTRA_STAMINA
-        power = np.where(
-            power >= 0.0, np.minimum(power, available), np.where(-2.0 * power > available, -available / 2.0, power)
-        )
+        if (power >= 0.0).all():  # the action space's dashes; negative power dashes backwards
+            power = np.minimum(power, available)
+        else:
+            power = np.where(
+                power >= 0.0, np.minimum(power, available), np.where(-2.0 * power > available, -available / 2.0, power)
+            )
         accel_rate = rate * effort * phys.DASH_POWER_RATE
         accel = np.abs(power * accel_rate)
         capped = (norm(svx, svy) + accel > phys.PLAYER_SPEED_MAX) & (accel_rate > 0.0)
@@ -398,12 +401,17 @@ class HalfFieldOffenseVectorEnv(gymnasium.vector.VectorEnv):
         power = round_command(power)
         # server side
         backward = power < 0.0
+        any_backward = backward.any()
         stamina = self.stamina[i]
-        need = np.minimum(np.where(backward, -2.0 * power, power), stamina + phys.EXTRA_STAMINA)
+        need = np.minimum(
+            np.where(backward, -2.0 * power, power) if any_backward else power, stamina + phys.EXTRA_STAMINA
+        )
         self.stamina[i] = np.maximum(0.0, stamina - need)
-        power = np.where(backward, -need / 2.0, need)
+        power = np.where(backward, -need / 2.0, need) if any_backward else need
         accel = np.abs(effort * power * rate * phys.DASH_POWER_RATE)
-        phi = np.radians(self.body[i] + direction + np.where(backward, 180.0, 0.0))
+        phi = self.body[i] + direction
+        phi += np.where(backward, 180.0, 0.0) if any_backward else 0.0
+        np.radians(phi, out=phi)
         self.pax[i] = accel * np.cos(phi)
         self.pay[i] = accel * np.sin(phi)
 
@@ -462,21 +470,32 @@ class HalfFieldOffenseVectorEnv(gymnasium.vector.VectorEnv):
     def _move(self, x, y, vx, vy, ax, ay, accel_max, speed_max, rand, decay, radius):
         """Spec 2.5.1 for one kind of object, in place; returns the post-collision flags."""
         i = np.flatnonzero((ax != 0.0) | (ay != 0.0))  # only these accelerate: the rest keep their velocity
-        if i.size:
+        if i.size:  # the limits rarely bind; where they don't, the factor 1 changes nothing
             ax, ay = ax[i], ay[i]
             a = norm(ax, ay)
-            shrink = np.where(a > accel_max, accel_max / np.where(a > 0.0, a, 1.0), 1.0)
-            svx, svy = vx[i] + ax * shrink, vy[i] + ay * shrink
+            over = a > accel_max
+            if over.any():
+                shrink = np.where(over, accel_max / np.where(a > 0.0, a, 1.0), 1.0)
+                ax, ay = ax * shrink, ay * shrink
+            svx, svy = vx[i] + ax, vy[i] + ay
             speed = norm(svx, svy)
-            shrink = np.where(speed > speed_max, speed_max / np.where(speed > 0.0, speed, 1.0), 1.0)
-            vx[i], vy[i] = svx * shrink, svy * shrink
+            over = speed > speed_max
+            if over.any():
+                shrink = np.where(over, speed_max / np.where(speed > 0.0, speed, 1.0), 1.0)
+                svx *= shrink
+                svy *= shrink
+            vx[i], vy[i] = svx, svy
         if rand:  # drawn for every game; only moving objects need the angle's cosine and sine
             length = self.np_random.uniform(0.0, 1.0, self.num_envs) * rand * norm(vx, vy)
             angle = self.np_random.uniform(-np.pi, np.pi, self.num_envs)
             i = np.flatnonzero(length)
-            length, angle = length[i], angle[i]
-            vx[i] += length * np.cos(angle)
-            vy[i] += length * np.sin(angle)
+            if i.size == length.size:
+                vx += length * np.cos(angle)
+                vy += length * np.sin(angle)
+            else:
+                length, angle = length[i], angle[i]
+                vx[i] += length * np.cos(angle)
+                vy[i] += length * np.sin(angle)
         collided = post_collisions(x, y, vx, vy, radius)
         vx *= decay
         vy *= decay
@@ -599,13 +618,15 @@ class HalfFieldOffenseVectorEnv(gymnasium.vector.VectorEnv):
         if a.shape != (n,) or len(boxes) != 3 or any(b.shape != (n, m) for b, m in zip(boxes, PARAM_SIZES)):
             shapes = (a.shape, tuple(b.shape for b in boxes)) if len(boxes) == 3 else a.shape
             raise ValueError(f"actions have shapes {shapes}; expected {expected}")
-        if not (np.issubdtype(a.dtype, np.integer) or np.all(a == np.round(a))) or a.min() < 0 or a.max() > 2:
+        if not (a.dtype.kind in "iu" or np.all(a == np.round(a))) or a.min() < 0 or a.max() > 2:
             raise ValueError(f"discrete actions {a.tolist()} must be integers 0 (DASH), 1 (TURN) or 2 (KICK)")
         a = a.astype(np.int64)
-        dash, turn = a == phys.DASH, a == phys.TURN
-        x0 = np.where(dash, boxes[0][:, 0], np.where(turn, boxes[1][:, 0], boxes[2][:, 0]))
-        x1 = np.where(dash, boxes[0][:, 1], boxes[2][:, 1])
-        bad = ~np.isfinite(x0) | (~turn & ~np.isfinite(x1))
+        dash, turn, kick = boxes
+        x0 = np.choose(a, (dash[:, 0], turn[:, 0], kick[:, 0]))
+        x1 = np.choose(a, (dash[:, 1], kick[:, 1], kick[:, 1]))
+        if np.isfinite(x0).all() and np.isfinite(x1).all():
+            return a, x0, x1
+        bad = ~np.isfinite(x0) | ((a != phys.TURN) & ~np.isfinite(x1))  # a turn has no second parameter
         if bad.any():
             i = int(np.flatnonzero(bad)[0])
             raise ValueError(f"game {i}: action {int(a[i])} has non-finite parameters ({x0[i]}, {x1[i]})")
