@@ -292,20 +292,28 @@ def low_level_features_one(seen, kickable, collided_ball, collided_post, last_ac
         1.0 if kickable else -1.0,
     ]
     max_dist = profile.max_dist
-    for lx, ly in _LANDMARK_LIST + [(bx, by)]:
+    sqrt = math.sqrt
+    for lx, ly in _LANDMARK_LIST:
         dx, dy = lx - px, ly - py
-        d = _norm(dx, dy)
+        d = sqrt(dx * dx + dy * dy)
         if d > 0.0:
             dx, dy = dx / d, dy / d
         else:
             dx, dy = 1.0, 0.0
         q = d / max_dist
         out += (dy * cos_t - dx * sin_t, dx * cos_t + dy * sin_t, 1.0 - 2.0 * q if q < 1.0 else -1.0)
-    ball = out[46:49]  # the ball's bearing and proximity came last; they go after the OOB block
-    del out[46:49]
     nx, ny = profile.oob_x, profile.oob_y
     for d, n in ((px, nx), (PITCH_HALF_LENGTH - px, nx), (PITCH_HALF_WIDTH + py, ny), (PITCH_HALF_WIDTH - py, ny)):
         out.append(1.0 - 2.0 * min(max(d / n, 0.0), 1.0))
+    # The ball, as a landmark, after the out-of-bounds block.
+    dx, dy = bx - px, by - py
+    d = sqrt(dx * dx + dy * dy)
+    if d > 0.0:
+        dx, dy = dx / d, dy / d
+    else:
+        dx, dy = 1.0, 0.0
+    q = d / max_dist
+    ball = (dy * cos_t - dx * sin_t, dx * cos_t + dy * sin_t, 1.0 - 2.0 * q if q < 1.0 else -1.0)
     out.append(1.0)
     out += ball
     out.append(1.0)

@@ -127,6 +127,20 @@ POW10 = [10.0**k for k in range(-POW10_OFFSET, POW10_OFFSET + 1)]
 LOG10_2 = math.log10(2.0)
 
 
+def _fullstate_scales() -> dict[int, tuple[float, float, float]]:
+    """For each binary exponent e (``math.frexp``) of a magnitude in [1e-200, 1e300): the power of ten
+    10**(k + 1) bounding its decimal exponent estimate k = floor((e - 1) log10 2), and the two scales
+    10**(5 - k) and 10**(4 - k) giving 6 significant digits below and at or above that bound."""
+    table = {}
+    for e in range(-664, 998):
+        k = math.floor((e - 1) * LOG10_2)
+        table[e] = (POW10[k + 1 + POW10_OFFSET], POW10[5 - k + POW10_OFFSET], POW10[4 - k + POW10_OFFSET])
+    return table
+
+
+_FULLSTATE_SCALES = _fullstate_scales()
+
+
 def fullstate_value(x: float) -> float:
     """``x`` to the 6 significant digits in which the server prints fullstate information to the agent.
 
@@ -138,10 +152,9 @@ def fullstate_value(x: float) -> float:
     if magnitude < 1e-200:
         return x  # zero, or a decayed velocity too small to matter
     # Decimal exponent from the binary one (cheaper than log10, and identical in the batched env).
-    exponent = math.floor((math.frexp(magnitude)[1] - 1) * LOG10_2)
-    if magnitude >= POW10[exponent + 1 + POW10_OFFSET]:
-        exponent += 1
-    scale = POW10[5 - exponent + POW10_OFFSET]
+    bound, scale, scale_at_bound = _FULLSTATE_SCALES[math.frexp(magnitude)[1]]
+    if magnitude >= bound:
+        scale = scale_at_bound
     return round(x * scale) / scale
 
 
@@ -231,9 +244,8 @@ class HFOGame:
         ``seen = (px, py, pvx, pvy, body, stamina, bx, by, bvx, bvy)``.
         """
         self.seen = tuple(
-            fullstate_value(v)
-            for v in (self.px, self.py, self.pvx, self.pvy, self.body, self.stamina,
-                      self.bx, self.by, self.bvx, self.bvy)
+            map(fullstate_value, (self.px, self.py, self.pvx, self.pvy, self.body, self.stamina,
+                                  self.bx, self.by, self.bvx, self.bvy))
         )  # fmt: skip
 
     # --- agent-side processing and server-side commands (spec 2.3, 2.4) -------------------------
