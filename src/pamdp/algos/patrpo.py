@@ -31,7 +31,7 @@ class PATRPOConfig(AlgoConfig):
     """PATRPO's settings; the defaults are the paper's preset (rllab's for what the paper leaves open)."""
 
     num_envs: int = setting(
-        64, "Copies of the env stepped together; PATRPO's samples are on-policy, so more is just faster."
+        128, "Copies of the env stepped together; PATRPO's samples are on-policy, so more is just faster."
     )
     hidden_sizes: tuple[int, ...] = setting(
         (200, 100, 50), "Hidden layers of pi_d and pi_c (the paper's {200, 100, 50})."
@@ -100,7 +100,14 @@ class PATRPOConfig(AlgoConfig):
     def presets(cls) -> dict[str, PATRPOConfig]:
         return {
             "paper": cls(),
-            "tuned": cls(delta=0.02, gae_lambda=0.97, batch_size=5_000, init_log_std=-0.5, fvp_subsample=0.2),
+            "tuned": cls(
+                delta=0.02,
+                gae_lambda=0.97,
+                batch_size=5_000,
+                init_log_std=-0.5,
+                entropy_coef=0.01,
+                fvp_subsample=0.2,
+            ),
         }
 
 
@@ -171,6 +178,9 @@ class PATRPO(Algorithm):
         else:
             self.linear_baseline = LinearFeatureBaseline(self.obs_dim)
         self.tracker = EpisodeTracker(cfg.num_envs)
+        # (observation, autoreset pending, step within episode) of every env copy between epochs; a loaded
+        # model starts new episodes.
+        self._rollout: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
 
     def _modules(self):
         return {"policy": self.policy, **({"value": self.value} if self.config.baseline == "mlp" else {})}
@@ -219,15 +229,17 @@ class PATRPO(Algorithm):
     def _collect(self) -> dict[str, np.ndarray]:
         """Step the batched env until ``batch_size`` valid samples; returns ``(T, N, ...)`` arrays.
 
-        Gymnasium's vector envs reset a finished copy on the *next* step, ignoring its action: those
-        autoreset steps are marked invalid and carry no sample.
+        Episodes run on across epochs (an epoch's last step bootstraps from the value function), so no
+        partial episode is thrown away. Gymnasium's vector envs reset a finished copy on the *next* step,
+        ignoring its action: those autoreset steps are marked invalid and carry no sample.
         """
         env = self.vec_env
         n = env.num_envs
-        obs, _ = env.reset(seed=int(self.np_rng.integers(2**31 - 1)))
-        self.tracker = EpisodeTracker(n)
-        t_ep = np.zeros(n, dtype=np.int64)
-        prev_done = np.zeros(n, dtype=bool)
+        if self._rollout is None:
+            obs, _ = env.reset(seed=int(self.np_rng.integers(2**31 - 1)))
+            self._rollout = (obs, np.zeros(n, dtype=bool), np.zeros(n, dtype=np.int64))
+            self.tracker = EpisodeTracker(n)
+        obs, prev_done, t_ep = self._rollout
         keys = ("obs", "a", "x", "reward", "terminated", "done", "valid", "next_obs", "t")
         rows: dict[str, list] = {k: [] for k in keys}
         n_valid = 0
@@ -243,6 +255,7 @@ class PATRPO(Algorithm):
             n_valid += int(valid.sum())
             t_ep = np.where(valid, t_ep + 1, 0)
             prev_done, obs = done, next_obs
+        self._rollout = (obs, prev_done, t_ep)
         return {k: np.stack(v) for k, v in rows.items()}
 
     def _run_epoch(self) -> dict[str, float]:

@@ -1,0 +1,80 @@
+"""Shared by the learning benchmarks: run an experiment file and write a markdown record of it."""
+
+from __future__ import annotations
+
+import datetime as dt
+import json
+import os
+import platform
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from pamdp.experiments import load_experiment
+from pamdp.experiments.plots import write_report
+from pamdp.experiments.runner import run_all
+
+HERE = Path(__file__).parent
+
+
+def machine() -> str:
+    cpu = "unknown CPU"
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    import torch
+
+    return (
+        f"{cpu}, {os.cpu_count()} cores; Python {platform.python_version()}, NumPy {np.__version__}, "
+        f"torch {torch.__version__}; load average at the end {os.getloadavg()[0]:.1f}"
+    )
+
+
+def run_and_record(experiment_file: str, out_root: str, record: str, workers: int, scale: float, seeds) -> None:
+    exp = load_experiment(HERE / experiment_file)
+    jobs = [(s, str(exp.run_dir(out_root, s))) for s in exp.specs(seeds, scale)]
+    t0 = time.time()
+    outcomes = run_all(jobs, workers=workers)
+    wall = time.time() - t0
+    report = write_report([Path(out_root) / exp.name], Path(out_root) / exp.name, exp.description)
+    figure = HERE / "results" / f"{Path(record).stem}.png"
+    figure.parent.mkdir(exist_ok=True)
+    shutil.copy(report["png"], figure)
+    per_run = {}
+    for o in outcomes:
+        per_run.setdefault(o.spec.label, []).append(o.seconds)
+    commit = subprocess.run(
+        ["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, cwd=HERE
+    ).stdout.strip()
+    lines = [
+        f"# {exp.description}",
+        "",
+        f"- command: `python {' '.join(sys.argv)}` (commit {commit})",
+        f"- date: {dt.datetime.now().isoformat(timespec='minutes')}",
+        f"- machine: {machine()}",
+        f"- {len(jobs)} runs of {jobs[0][0].total_steps:,} steps, {workers} at a time; total wall time {wall / 60:.1f} min",
+        "- wall time of one run (median per setting, with the other worker running beside it): "
+        + ", ".join(f"{k} {np.median(v) / 60:.1f} min" for k, v in per_run.items()),
+        "",
+        report["table"].read_text().strip(),
+        "",
+        f"![learning curves](results/{figure.name})",
+        "",
+        "Greedy return: the mean over 1000 evaluation episodes of each seed's final model, then mean +- std over",
+        "seeds. Curves: the mean episodic return of each epoch's (stochastic) training episodes.",
+    ]
+    failed = [o for o in outcomes if o.error]
+    if failed:
+        lines += ["", f"{len(failed)} runs failed:"] + [
+            f"- {o.out}: {o.error.strip().splitlines()[-1]}" for o in failed
+        ]
+    (HERE / record).write_text("\n".join(lines) + "\n")
+    print(json.dumps({"record": str(HERE / record), "wall_minutes": wall / 60}))
