@@ -242,6 +242,7 @@ class HalfFieldOffenseVectorEnv(gymnasium.vector.VectorEnv):
             self.body[:] = 0.0  # a new server run, as in the scalar env
         placement = _per_game_options(options, self.num_envs)
         self._place(np.ones(self.num_envs, dtype=bool), placement)
+        self._observe()
         self._needs_reset[:] = False
         self._started = True
         return self._observation(), self._infos()
@@ -254,6 +255,10 @@ class HalfFieldOffenseVectorEnv(gymnasium.vector.VectorEnv):
         self._act(a, x0, x1, ~resetting)
         status = self._advance()
         self.steps += 1
+        # The games that ended last step start anew now, before the features: one pass observes all.
+        any_resetting = resetting.any()
+        if any_resetting:
+            self._place(resetting, {})
         # Two feature buffers in turn: the previous step's rows are the reward's "before".
         prev, self._rows, self._spare_rows = self._rows, self._spare_rows, self._rows
         prev_to_goal = self._to_goal
@@ -263,6 +268,8 @@ class HalfFieldOffenseVectorEnv(gymnasium.vector.VectorEnv):
         reward, paid = shaped_reward(prev, self._rows, self.holder, ~self.bonus_paid, goal, prev_to_goal, self._to_goal)
         # Quirks of H&S's code (see HalfFieldOffenseEnv): only the goal bonus on these transitions.
         plain = (terminal & (not self.terminal_deltas)) | ((self.steps == 1) & (not self.first_step_reward))
+        if any_resetting:
+            plain |= resetting
         if plain.any():
             np.copyto(reward, np.where(goal, 5.0, 0.0), where=plain)
             paid &= ~plain
@@ -270,11 +277,11 @@ class HalfFieldOffenseVectorEnv(gymnasium.vector.VectorEnv):
         timeout = status == phys.OUT_OF_TIME
         terminated = goal | (status == phys.OUT_OF_BOUNDS) | (timeout & self.timeout_terminal)
         truncated = timeout & (not self.timeout_terminal)
-        self.status = status
-        if resetting.any():
-            self._place(resetting, {})
+        if any_resetting:
             reward[resetting] = 0.0
             terminated[resetting] = truncated[resetting] = False
+            status[resetting] = phys.IN_GAME
+        self.status = status
         self._needs_reset = terminated | truncated
         return self._observation(), reward, terminated, truncated, self._infos()
 
@@ -324,8 +331,7 @@ class HalfFieldOffenseVectorEnv(gymnasium.vector.VectorEnv):
         self.steps[idx] = 0
         self.bonus_paid[idx] = False
         self.status[idx] = phys.IN_GAME
-        self._sense()
-        self._observe(idx)
+        self.seen[:, idx] = fullstate_values(self._state[:, idx])
 
     def _allocate(self) -> None:
         n = self.num_envs
@@ -342,7 +348,6 @@ class HalfFieldOffenseVectorEnv(gymnasium.vector.VectorEnv):
         self.steps = np.zeros(n, dtype=np.int64)
         self.status = np.zeros(n, dtype=np.int64)
         self.seen = np.zeros((len(_STATE), n))
-        self._kickable = np.zeros(n, dtype=bool)
         # The body's cosine and sine change only when it turns: kept with the angle they belong to.
         self._trig_body = np.full(n, np.nan)
         self._cos_body, self._sin_body = np.zeros(n), np.zeros(n)
@@ -351,10 +356,10 @@ class HalfFieldOffenseVectorEnv(gymnasium.vector.VectorEnv):
         self._to_goal = np.zeros(n)
 
     # --- agent-side processing and server-side commands (spec 2.3, 2.4) -------------------------
-    def _agent_kickable(self, idx=slice(None)):
-        limit = np.where(self.kicked[idx], phys.KICKABLE_AREA, phys.AGENT_KICKABLE_AREA)
+    def _agent_kickable(self):
+        limit = np.where(self.kicked, phys.KICKABLE_AREA, phys.AGENT_KICKABLE_AREA)
         seen = self.seen
-        return norm(seen[_BX, idx] - seen[_PX, idx], seen[_BY, idx] - seen[_PY, idx]) <= limit
+        return norm(seen[_BX] - seen[_PX], seen[_BY] - seen[_PY]) <= limit
 
     def _act(self, a, x0, x1, active) -> None:
         """Apply the agents' DASH / TURN / KICK to the ``active`` games (``HFOGame.act``)."""
@@ -564,33 +569,24 @@ class HalfFieldOffenseVectorEnv(gymnasium.vector.VectorEnv):
         """``seen``: the agents' world model, the state to 6 significant digits (``HFOGame.sense``)."""
         fullstate_values(self._state, out=self.seen)
 
-    def _observe(self, idx=None) -> None:
-        """Features of the games ``idx`` (all by default) from what their agents see, into ``_rows``;
-        also the agents' kickable test and the ball-to-goal term of the reward."""
-        every = idx is None
-        idx = slice(None) if every else idx
-        seen = self.seen[:, idx]
-        kickable = self._agent_kickable(idx)
-        self._kickable[idx] = kickable
+    def _observe(self) -> None:
+        """Features of every game from what its agent sees, into ``_rows``; also the agents' kickable
+        test and the ball-to-goal term of the reward."""
+        seen = self.seen
+        self._kickable = kickable = self._agent_kickable()
         # cos and sin of the body angle, recomputed only where the seen angle changed (turns, resets)
-        turned = np.flatnonzero(self._trig_body[idx] != seen[_BODY])
+        turned = np.flatnonzero(self._trig_body != seen[_BODY])
         if turned.size:
-            games = turned if every else idx[turned]
             theta = seen[_BODY, turned]
-            self._trig_body[games] = theta
+            self._trig_body[turned] = theta
             theta = np.radians(theta)
-            self._cos_body[games], self._sin_body[games] = np.cos(theta), np.sin(theta)
-        rows = self._rows if every else np.empty((self.profile.n_features, len(idx)))
+            self._cos_body[turned], self._sin_body[turned] = np.cos(theta), np.sin(theta)
         feature_rows(
             seen[_PX], seen[_PY], seen[_BX], seen[_BY], seen[_PVX:_BVX + 1], seen[_PVY:_BVY + 1], seen[_STAMINA],
-            self._cos_body[idx], self._sin_body[idx], kickable, self.collided_ball[idx], self.collided_post[idx],
-            self.last_action_ok[idx], self.profile, rows,
+            self._cos_body, self._sin_body, kickable, self.collided_ball, self.collided_post, self.last_action_ok,
+            self.profile, self._rows,
         )  # fmt: skip
-        to_goal = ball_to_goal_rows(rows)
-        if every:
-            self._to_goal = to_goal
-        else:
-            self._rows[:, idx], self._to_goal[idx] = rows, to_goal
+        self._to_goal = ball_to_goal_rows(self._rows)
 
     def _observation(self) -> np.ndarray:
         """The ``(N, n_features)`` float32 observation: one strided copy per feature row (the fastest
