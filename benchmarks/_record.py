@@ -60,7 +60,8 @@ def run_and_record(experiment_file: str, out_root: str, record: str, workers: in
         f"- command: `python {' '.join(sys.argv)}` (commit {commit})",
         f"- date: {dt.datetime.now().isoformat(timespec='minutes')}",
         f"- machine: {machine()}",
-        f"- {len(jobs)} runs of {jobs[0][0].total_steps:,} steps, {workers} at a time; total wall time {wall / 60:.1f} min",
+        f"- {len(jobs)} runs of {jobs[0][0].total_steps:,} steps, {workers} at a time; "
+        f"total wall time {wall / 60:.1f} min",
         "- wall time of one run (median per setting, with the other worker running beside it): "
         + ", ".join(f"{k} {np.median(v) / 60:.1f} min" for k, v in per_run.items()),
         "",
