@@ -9,7 +9,7 @@ measured ``--repeats`` times:
 
 Medians over the repeats are written as a markdown record with the command, date and machine.
 
-    python benchmarks/bench_offpolicy_speed.py --out benchmarks/results/offpolicy_speed.md
+    python benchmarks/bench_offpolicy_speed.py --out benchmarks/offpolicy_speed.md
 """
 
 from __future__ import annotations
@@ -45,7 +45,7 @@ def cpu_name() -> str:
 
 
 def measure(cls, config, n_updates: int, n_samples: int, repeats: int) -> dict:
-    config = dataclasses.replace(config, learning_starts=1_000, epoch_steps=n_samples, buffer_size=200_000)
+    config = dataclasses.replace(config, learning_starts=n_samples, epoch_steps=n_samples, buffer_size=200_000)
     model = cls("pamdp/Platform-v0", config)
     torch.set_num_threads(config.torch_threads)
     model.learn(n_samples, progress_bar=False)  # fills the buffer past learning_starts and warms up
@@ -67,7 +67,7 @@ def main(argv=None) -> int:
     parser.add_argument("--updates", type=int, default=300, help="updates per repeat")
     parser.add_argument("--samples", type=int, default=1_000, help="env samples per repeat (one epoch)")
     parser.add_argument("--repeats", type=int, default=3)
-    parser.add_argument("--out", default="benchmarks/results/offpolicy_speed.md")
+    parser.add_argument("--out", default="benchmarks/offpolicy_speed.md")
     args = parser.parse_args(argv)
 
     lines = [
