@@ -145,14 +145,16 @@ def worker_speed(kind: str, num_envs: int, seconds: float) -> dict:
     n_calls, elapsed = 16, 0.0
     while elapsed < seconds / 4:  # calibrate to roughly `seconds`
         n_calls *= 2
-        t0 = time.perf_counter()
+        t0 = time.process_time()
         run(n_calls)
-        elapsed = time.perf_counter() - t0
+        elapsed = time.process_time() - t0
     n_calls = max(1, int(n_calls * seconds / elapsed))
-    t0 = time.perf_counter()
+    c0, t0 = time.process_time(), time.perf_counter()
     run(n_calls)
-    elapsed = time.perf_counter() - t0
-    return {"steps_per_second": n_calls * per_step / elapsed}
+    cpu, wall = time.process_time() - c0, time.perf_counter() - t0
+    # CPU time is the primary figure: on a shared machine, wall time also counts the time the process
+    # waited for its core.
+    return {"steps_per_second": n_calls * per_step / cpu, "wall_steps_per_second": n_calls * per_step / wall}
 
 
 def worker_versions() -> dict:
@@ -223,18 +225,26 @@ def main(argv=None) -> None:
         (f"pamdp PlatformVectorEnv, N={n}", ours, "vector", n) for n in (1, 64, 1024)
     ]
     results: dict[str, list[float]] = {name: [] for name, *_ in configs}
+    wall: dict[str, list[float]] = {name: [] for name, *_ in configs}
     for rep in range(args.repeats):
         for name, python, kind, n in configs:
-            sps = _call(python, ["speed", kind, str(n), str(args.seconds)], pin)["steps_per_second"]
-            results[name].append(sps)
-            print(f"  repeat {rep + 1}/{args.repeats}  {name:32s} {sps:12,.0f} steps/s", flush=True)
+            out = _call(python, ["speed", kind, str(n), str(args.seconds)], pin)
+            results[name].append(out["steps_per_second"])
+            wall[name].append(out["wall_steps_per_second"])
+            print(
+                f"  repeat {rep + 1}/{args.repeats}  {name:32s} {out['steps_per_second']:12,.0f} steps/CPU-s "
+                f"{out['wall_steps_per_second']:12,.0f} steps/wall-s",
+                flush=True,
+            )
 
     peer_median = float(np.median(results[configs[0][0]]))
     rows = []
     for name, *_ in configs:
         v = np.array(results[name])
+        w = np.median(wall[name]) / np.median(wall[configs[0][0]])
         rows.append(
-            f"| {name} | {np.median(v):,.0f} | {v.min():,.0f} – {v.max():,.0f} | {np.median(v) / peer_median:.1f}x |"
+            f"| {name} | {np.median(v):,.0f} | {v.min():,.0f} – {v.max():,.0f} | {np.median(v) / peer_median:.1f}x "
+            f"| {np.median(wall[name]):,.0f} ({w:.1f}x) |"
         )
     vo, vp = _call(ours, ["versions"], False), _call(peer, ["versions"], False)
     scalar_ratio = np.median(results["pamdp PlatformEnv"]) / peer_median
@@ -245,8 +255,8 @@ def main(argv=None) -> None:
 
 Written by `benchmarks/bench_platform.py` on {datetime.datetime.now().strftime("%Y-%m-%d %H:%M")}.
 
-| environment | median steps/s | range over {args.repeats} repeats | vs peer |
-|---|---:|---:|---:|
+| environment | steps per CPU-s (median) | range ({args.repeats} repeats) | vs peer | steps per wall-s (vs peer) |
+|---|---:|---:|---:|---:|
 {chr(10).join(rows)}
 
 Targets (per core): scalar at least 5x the peer (measured **{scalar_ratio:.1f}x**), batched at N = 1024 at
@@ -256,8 +266,9 @@ least 100x the peer (measured **{vec_ratio:.1f}x**).
 - Machine: {_cpu_model()}, {os.cpu_count()} logical CPUs; every measurement in a fresh process pinned to
   core 0 (`taskset -c 0`: {"yes" if pin and shutil.which("taskset") else "no"}), one thread.
   Load average at the end of the run: {", ".join(f"{x:.2f}" for x in load) if load else "n/a"}.
-  The machine is shared (other engineers' jobs may run on the other core, and compete for memory
-  bandwidth and caches), hence {args.repeats} interleaved repeats of {args.seconds:g} s and medians.
+  The machine is shared (other engineers' jobs ran during the measurement and compete for the cores,
+  memory bandwidth and caches), hence {args.repeats} interleaved repeats of {args.seconds:g} s, medians, and
+  CPU time (`time.process_time`) as the primary clock; wall-clock figures are given for comparison.
 - pamdp: Python {vo["python"]}, NumPy {vo["numpy"]}, Gymnasium {vo["gymnasium"]}; pure NumPy, no numba.
 - Peer: `hybrid-platform` 0.1.0 in a separate venv, Python {vp["python"]}, NumPy {vp["numpy"]},
   Gymnasium {vp["gymnasium"]}, numba {vp.get("numba", "n/a")}.

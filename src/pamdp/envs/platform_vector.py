@@ -59,7 +59,6 @@ INITIAL_STATE = np.array([0.0, PLATFORM_HEIGHT, 0.0, 0.0, 230.0, 730.0, -ENEMY_S
 GRAVITY_DV = -GRAVITY * DT
 """The airborne ACCEL(0, -g) changes vy by exactly this (ay = -g is inside its clip range)."""
 PARAM_HIGH = np.array(PARAM_MAX)
-NOISE_SCALE = np.array([[PLAYER_NOISE], [ENEMY_NOISE]])
 (E1_LO, E1_HI), (E2_LO, E2_HI) = ENEMY_BOUNDS
 PLATFORM_X = np.array([px for px, _ in PLATFORMS])
 PLATFORM_RIGHT = np.array([px + w for px, w in PLATFORMS])
@@ -223,10 +222,11 @@ class PlatformVectorEnv(VectorEnv):
         w[DY0] = dy0
         w[TARGET_VX] = p / (2.0 * dy0 / GRAVITY + 1.0)
         n = idx.size
-        ar = np.arange(n)
+        e1x_at = E1X * n + np.arange(n)  # flat index of enemy 1's x in the working set
         on = _on_platform(w[X], w[Y])
-        count = 0
-        while n:
+        live = np.ones(n, dtype=bool)  # working-set copies still moving (stopped ones are dropped lazily)
+        n_live, count = n, 0
+        while n_live:
             count += 1
             x, y, vx, vy = w[X], w[Y], w[VX], w[VY]
 
@@ -234,8 +234,10 @@ class PlatformVectorEnv(VectorEnv):
             # Multiplying by the boolean `on` adds exactly 0.0 to the copies it does not concern.
             dvx = w[RUN_DV] * on
             dvy = GRAVITY_DV * ~on
-            jumping = np.flatnonzero(on & ~is_run)
-            if jumping.size:
+            # A jump copy stands on a platform only in its first sub-step: afterwards it is in the air until
+            # it lands, which stops it. (Copies that stopped but are still in the working set do not matter.)
+            jumping = np.flatnonzero(on & ~is_run) if count == 1 else ()
+            if len(jumping):
                 jump_dy0 = w[DY0, jumping]
                 dx = np.clip(w[TARGET_VX, jumping] - vx[jumping], -AX_MAX, VY_MAX - jump_dy0)
                 n0, n1 = -np.abs(normal(0.0, JUMP_DEV, size=(2, jumping.size)))
@@ -243,8 +245,7 @@ class PlatformVectorEnv(VectorEnv):
                 dvy[jumping] = np.clip((jump_dy0 + n1) / DT, -AY_MAX, AY_MAX) * DT
             vx += dvx
             vy += dvy
-            noise = normal(0.0, 1.0, size=(2, n)) * NOISE_SCALE  # player, active enemy
-            vx -= np.abs(noise[0])
+            vx -= np.abs(normal(0.0, PLAYER_NOISE, size=n))
             _clip(vx, 0.0, VX_MAX)  # = clip to +-VX_MAX, then vx >= 0
             _clip(vy, -VY_MAX, VY_MAX)
             np.minimum(vx, VX_MAX - (VX_MAX - VX_GROUND) * on, out=vx)  # cap 70 on the ground, else 100
@@ -258,12 +259,12 @@ class PlatformVectorEnv(VectorEnv):
 
             # §7.6 on the active enemy, gathered from row E1X or E2X (E1DX or E2DX) of the flat working set.
             flat = w.reshape(-1)
-            at_x = (E1X * n + ar) + enemy2 * n
+            at_x = e1x_at + enemy2 * n
             at_dx = at_x + (E1DX - E1X) * n
             ex, edx = flat[at_x], flat[at_dx]
             lo, hi = E1_LO + (E2_LO - E1_LO) * enemy2, E1_HI + (E2_HI - E1_HI) * enemy2
             edx *= 1.0 - 2.0 * ((ex <= lo) | (ex >= hi))  # turn round unless strictly inside (lo, hi)
-            edx += noise[1]
+            edx += normal(0.0, ENEMY_NOISE, size=n)
             _clip(edx, -ENEMY_SPEED, ENEMY_SPEED)
             ex += edx * DT
             np.minimum(np.maximum(ex, lo, out=ex), hi, out=ex)
@@ -283,6 +284,7 @@ class PlatformVectorEnv(VectorEnv):
             stop = done | (on & ~is_run)
             if count == RUN_SUBSTEPS:
                 stop |= is_run
+            stop &= live
             if stop.any():
                 out = idx[stop]
                 # At the goal x == 1035 exactly, so this is also the goal reward (1035 - x0) / 1035.
@@ -290,10 +292,14 @@ class PlatformVectorEnv(VectorEnv):
                 terminated[out] = done[stop]
                 substeps[out] = count
                 self._state[:, out] = w[:STATE_ROWS, stop]
-                keep = ~stop
-                w, idx, is_run, on = w.compress(keep, axis=1), idx[keep], is_run[keep], on[keep]
-                n = idx.size
-                ar = ar[:n]
+                live &= ~stop
+                n_live -= out.size
+                # Stopped copies keep being simulated (harmlessly, their results are already out) until
+                # a quarter of the working set has stopped: dropping them copies the whole working set.
+                if n_live <= 0.75 * n:
+                    w, idx, is_run, on = w.compress(live, axis=1), idx[live], is_run[live], on[live]
+                    n, live = n_live, np.ones(n_live, dtype=bool)
+                    e1x_at = E1X * n + np.arange(n)
 
     def _observations(self) -> np.ndarray:
         s = self._state
