@@ -3,63 +3,104 @@
 Run ``.venv/bin/python benchmarks/bench_hfo.py`` (about a minute); it rewrites ``benchmarks/hfo_speed.md``.
 Actions are sampled before timing, so the figures are the env's own cost. Each figure is the median
 over repeats; another process may be using the machine's other core, so the load average is recorded.
+
+``--baseline COMMIT`` also times the HFO modules of that git commit (exported to a temporary
+directory), interleaved repeat by repeat with the working tree's, so that both see the same load.
+``--cpu 0`` pins the process to one core (as ``taskset -c 0``).
 """
 
 from __future__ import annotations
 
 import argparse
 import datetime
+import importlib
 import os
 import pathlib
 import platform
 import statistics
+import subprocess
 import sys
+import tempfile
 import time
 
 import gymnasium
 import numpy as np
 
 import pamdp  # noqa: F401  (registers the envs)
-from pamdp.envs.hfo import HalfFieldOffenseEnv, HalfFieldOffenseVectorEnv
+from pamdp.envs import hfo
 from pamdp.envs.hfo_baseline import scripted_scorer_batch
 
-
-def scalar_steps_per_second(env, steps: int, repeats: int, seed: int = 0) -> float:
-    """Median steps/s of one env under uniformly random actions (resets included)."""
-    env.action_space.seed(seed)
-    actions = [env.action_space.sample() for _ in range(2000)]
-    env.reset(seed=seed)
-    rates = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        for k in range(steps):
-            _, _, terminated, truncated, _ = env.step(actions[k % len(actions)])
-            if terminated or truncated:
-                env.reset()
-        rates.append(steps / (time.perf_counter() - start))
-    return statistics.median(rates)
+HFO_MODULES = ("hfo", "hfo_physics", "hfo_features", "hfo_vector", "hfo_interface")
+#: Batched steps before timing: the games, all placed at once, first time out together near step 100.
+BATCHED_WARMUP = 200
 
 
-def batched_steps_per_second(num_envs: int, steps: int, repeats: int, seed: int = 0) -> float:
-    """Median env-steps/s of the batched env under uniformly random actions (autoresets included)."""
-    env = gymnasium.make_vec("pamdp/HalfFieldOffense-v0", num_envs=num_envs, vectorization_mode="vector_entry_point")
-    env.action_space.seed(seed)
-    actions = [env.action_space.sample() for _ in range(16)]
-    env.reset(seed=seed)
-    for k in range(10):
+def import_baseline(commit: str):
+    """The ``hfo`` module of ``commit``, imported from a temporary copy as package ``hfo_at_baseline``."""
+    repo = pathlib.Path(__file__).resolve().parents[1]
+    package = pathlib.Path(tempfile.mkdtemp()) / "hfo_at_baseline"
+    package.mkdir()
+    (package / "__init__.py").write_text("")
+    for name in HFO_MODULES:
+        source = subprocess.run(
+            ["git", "show", f"{commit}:src/pamdp/envs/{name}.py"], cwd=repo, check=True, capture_output=True, text=True
+        ).stdout
+        source = source.replace("from pamdp.envs import hfo_physics", "from hfo_at_baseline import hfo_physics")
+        (package / f"{name}.py").write_text(source.replace("from pamdp.envs.hfo", "from hfo_at_baseline.hfo"))
+    sys.path.insert(0, str(package.parent))
+    return importlib.import_module("hfo_at_baseline.hfo")
+
+
+def scalar_rate(env, actions, steps: int) -> float:
+    """Steps/s of one env over ``steps`` steps of ``actions`` (resets included)."""
+    start = time.perf_counter()
+    for k in range(steps):
+        _, _, terminated, truncated, _ = env.step(actions[k % len(actions)])
+        if terminated or truncated:
+            env.reset()
+    return steps / (time.perf_counter() - start)
+
+
+def batched_rate(env, actions, steps: int) -> float:
+    """Env-steps/s of a batched env over ``steps`` batched steps (autoresets included)."""
+    start = time.perf_counter()
+    for k in range(steps):
         env.step(actions[k % len(actions)])
-    rates = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        for k in range(steps):
-            env.step(actions[k % len(actions)])
-        rates.append(steps * num_envs / (time.perf_counter() - start))
-    return statistics.median(rates)
+    return steps * env.num_envs / (time.perf_counter() - start)
+
+
+def speeds(modules: dict, args) -> dict:
+    """Median steps/s of each module's scalar env, scalar env via ``gymnasium.make`` (current only) and
+    batched env, repeats interleaved across modules."""
+    space = hfo.HalfFieldOffenseEnv().action_space
+    space.seed(0)
+    scalar_actions = [space.sample() for _ in range(2000)]
+    batched_space = hfo.HalfFieldOffenseVectorEnv(num_envs=args.num_envs).action_space
+    batched_space.seed(0)
+    batched_actions = [batched_space.sample() for _ in range(16)]
+    envs = {}
+    for name, module in modules.items():
+        scalar, batched = module.HalfFieldOffenseEnv(), module.HalfFieldOffenseVectorEnv(num_envs=args.num_envs)
+        scalar.reset(seed=0)
+        batched.reset(seed=0)
+        batched_rate(batched, batched_actions, BATCHED_WARMUP)
+        envs[name] = {"scalar": scalar, "batched": batched}
+    envs["current"]["made"] = gymnasium.make("pamdp/HalfFieldOffense-v0")
+    envs["current"]["made"].reset(seed=0)
+    rates = {name: {kind: [] for kind in kinds} for name, kinds in envs.items()}
+    for _ in range(args.repeats):
+        for name, kinds in envs.items():
+            for kind, env in kinds.items():
+                if kind == "batched":
+                    rates[name][kind].append(batched_rate(env, batched_actions, args.batched_steps))
+                else:
+                    rates[name][kind].append(scalar_rate(env, scalar_actions, args.scalar_steps))
+    return {name: {kind: statistics.median(r) for kind, r in kinds.items()} for name, kinds in rates.items()}
 
 
 def scorer_results(episodes: int, num_envs: int = 250, seed: int = 0) -> tuple[float, float, dict]:
     """Goal rate and mean steps to goal of the scripted scorer (actuator noise on), first ``episodes``."""
-    env = HalfFieldOffenseVectorEnv(num_envs=num_envs)
+    env = hfo.HalfFieldOffenseVectorEnv(num_envs=num_envs)
     obs, _ = env.reset(seed=seed)
     outcomes, goal_steps = {}, []
     while sum(outcomes.values()) < episodes:
@@ -85,33 +126,48 @@ def cpu_model() -> str:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__)
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--repeats", type=int, default=5, help="timed repeats; the median is reported")
     parser.add_argument("--scalar-steps", type=int, default=20_000, help="steps per scalar repeat")
     parser.add_argument("--batched-steps", type=int, default=100, help="batched steps per repeat")
     parser.add_argument("--num-envs", type=int, default=1024, help="games in the batched env")
     parser.add_argument("--episodes", type=int, default=1000, help="scripted-scorer episodes")
+    parser.add_argument("--baseline", metavar="COMMIT", help="also time this commit's HFO envs, interleaved")
+    parser.add_argument("--cpu", type=int, help="pin the process to this core")
     parser.add_argument("--out", default=str(pathlib.Path(__file__).with_name("hfo_speed.md")))
     args = parser.parse_args()
+    if args.cpu is not None:
+        os.sched_setaffinity(0, {args.cpu})
 
+    modules = {"current": hfo}
+    if args.baseline:
+        modules["baseline"] = import_baseline(args.baseline)
     load_before = os.getloadavg()[0]
-    raw = scalar_steps_per_second(HalfFieldOffenseEnv(), args.scalar_steps, args.repeats)
-    made = scalar_steps_per_second(gymnasium.make("pamdp/HalfFieldOffense-v0"), args.scalar_steps, args.repeats)
-    batched = batched_steps_per_second(args.num_envs, args.batched_steps, args.repeats)
+    rates = speeds(modules, args)
     goal_rate, goal_steps, outcomes = scorer_results(args.episodes)
     load_after = os.getloadavg()[0]
 
+    def result(kind: str) -> str:
+        text = f"{rates['current'][kind]:,.0f} steps/s"
+        if args.baseline:
+            before = rates["baseline"][kind]
+            text += f" (baseline {before:,.0f}, x{rates['current'][kind] / before:.2f})"
+        return text
+
     command = "python benchmarks/bench_hfo.py " + " ".join(sys.argv[1:])
     rows = [
-        ("scalar `HalfFieldOffenseEnv`, random actions", f"{raw:,.0f} steps/s", ">= 20 000"),
-        ("scalar via `gymnasium.make` (wrappers)", f"{made:,.0f} steps/s", ""),
-        (f"batched `HalfFieldOffenseVectorEnv`, N = {args.num_envs}", f"{batched:,.0f} steps/s", ">= 1 000 000"),
+        ("scalar `HalfFieldOffenseEnv`, random actions", result("scalar"), ">= 20 000"),
+        ("scalar via `gymnasium.make` (wrappers)", f"{rates['current']['made']:,.0f} steps/s", ""),
+        (f"batched `HalfFieldOffenseVectorEnv`, N = {args.num_envs}", result("batched"), ">= 1 000 000"),
         (
             f"scripted scorer, {args.episodes} episodes (noise on)",
             f"goal rate {goal_rate:.3f}, {goal_steps:.1f} steps to goal",
             "real HFO: almost always, ~70 steps",
         ),
     ]
+    baseline = ""
+    if args.baseline:
+        baseline = f"Baseline: commit `{args.baseline}`, timed in the same process, repeats interleaved.  "
     text = [
         "# Half Field Offense: speed and scripted-scorer results",
         "",
@@ -121,7 +177,8 @@ def main() -> None:
         f"NumPy {np.__version__}, Gymnasium {gymnasium.__version__}  ",
         f"Load average (1 min) before / after: {load_before:.2f} / {load_after:.2f} (other engineers' jobs "
         "may share the cores; figures are medians of "
-        f"{args.repeats} repeats)",
+        f"{args.repeats} repeats; batched after {BATCHED_WARMUP} warm-up steps, so autoresets are included)  ",
+        *([baseline] if baseline else []),
         "",
         "| measurement | result | target |",
         "|---|---|---|",
