@@ -1,8 +1,10 @@
 """N games of HFO 1v0 stepped at once with NumPy: the batched twin of ``hfo_physics.HFOGame``.
 
-Every line of the scalar simulation has its masked, array-wide counterpart here, in the same order, so
-that with the actuator noise off the two agree step for step (``tests/test_hfo_vector.py``). Rare
-branches (goal posts, the speed caps of the dash) run on the subset of games that need them.
+Every line of the scalar simulation has its array-wide counterpart here, in the same order and with
+the same floating-point operations, so that with the actuator noise off the two agree step for step
+(``tests/test_hfo_vector.py``). For speed, each action runs on the games that take it, rare branches
+(goal posts, the speed caps, backward dashes) only when some game needs them, the state is updated in
+place, and the features are computed once per step as contiguous rows (``hfo_features.feature_rows``).
 """
 
 from __future__ import annotations
