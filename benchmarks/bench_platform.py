@@ -275,6 +275,10 @@ least 100x the peer (measured **{vec_ratio:.1f}x**).
 - Scalar envs are made with `gymnasium.make` (so both carry the same TimeLimit/checker wrappers) and reset on
   episode end; the batched env with `gymnasium.make_vec(..., vectorization_mode="vector_entry_point")`, which
   auto-resets. One agent step of a random policy runs ~72 physics sub-steps.
+- The batched env pays NumPy's per-call overhead on every sub-step (the loop runs until the longest copy
+  stops, ~145 sub-steps when any copy hops), so for a single copy the scalar env is the fast choice; batching
+  pays off from N of a few dozen. Repeats on this shared machine scatter by tens of percent, so read ratios
+  near a target as "at the target", not as a margin.
 - Same dynamics: driven by the same `numpy.random.RandomState` and actions, pamdp's `PlatformEnv` and the peer
   agreed exactly (observations as float32, rewards, sub-step counts, termination) on {steps - bad} of {steps}
   steps over {episodes} episodes ({bad} mismatching).

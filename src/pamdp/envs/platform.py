@@ -166,8 +166,12 @@ class PlatformEnv(gymnasium.Env):
     Internal state (read it for tests and plots, not to control the env): ``player`` =
     ``[x, y, vx, vy]`` and ``enemies`` = ``[[x1, dx1], [x2, dx2]]`` via :attr:`state`.
 
+    Noise: every Gaussian draw is ``self.np_random.normal(...)``. After ``reset()``, assign
+    ``numpy.random.RandomState(S)`` to replay the reference implementation driven by the same generator,
+    or :class:`ZeroNoise` for the noise-free dynamics; ``reset(seed=...)`` installs a fresh generator.
+
     Args:
-        render_mode: ``None`` or ``"rgb_array"`` (a top-down picture of the course, see :func:`draw_platform`).
+        render_mode: ``None`` or ``"rgb_array"`` (a side view of the course, see :func:`draw_platform`).
     """
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 10}
