@@ -88,6 +88,8 @@ def train_run(spec: RunSpec, out: str | os.PathLike, progress_bar: bool = True, 
     model = None
     if (out / CHECKPOINT).exists() or (out / FINAL_MODEL).exists():
         recorded = json.loads(run_file.read_text()) if run_file.exists() else {}
+        if "config" in recorded:  # settings added since the run started count as their defaults
+            recorded["config"] = cls.config_class.from_dict(recorded["config"]).to_dict()
         differ = sorted(k for k in ("algo", "env", "config") if recorded.get(k) != run_info[k])
         if differ:
             raise ValueError(
