@@ -101,3 +101,13 @@ def test_render_writes_a_gif(tmp_path):
     gif = tmp_path / "ep.gif"
     assert main(["render", "pamdp/Platform-v0", "--out", str(gif)]) == 0
     assert gif.read_bytes()[:6] in (b"GIF87a", b"GIF89a")
+
+
+def test_soccer_evaluation_reports_goal_rate(tmp_path, capsys):
+    out = tmp_path / "hfo"
+    argv = ["train", "patrpo", "--env", "pamdp/HalfFieldOffense-v0", "--total-steps", "500", "--out", str(out)]
+    assert main([*argv, "--eval-episodes", "0", *TINY]) == 0
+    assert main(["evaluate", str(out), "--episodes", "8", "--json"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert result["episodes"] == 8 and 0.0 <= result["goal_rate"] <= 1.0
+    assert result["mean_steps_to_goal"] is None or result["mean_steps_to_goal"] > 0

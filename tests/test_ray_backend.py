@@ -24,7 +24,8 @@ DRIVER = textwrap.dedent(
 
     out = sys.argv[1]
     tiny = (("batch_size", 200), ("hidden_sizes", [16]), ("num_envs", 4), ("vf_hidden_sizes", [16]))
-    jobs = [(RunSpec("patrpo", "pamdp/Platform-v0", 400, s, "paper", tiny, 5, "tiny"), f"{out}/seed{s}") for s in (0, 1)]
+    spec = lambda s: RunSpec("patrpo", "pamdp/Platform-v0", 400, s, "paper", tiny, 5, "tiny")
+    jobs = [(spec(s), f"{out}/seed{s}") for s in (0, 1)]
     outcomes = run_all_ray(jobs, address="127.0.0.1:6379", log=print)
     json.dump([o.error for o in outcomes], open(f"{out}/errors.json", "w"))
     """

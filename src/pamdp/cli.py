@@ -205,7 +205,8 @@ def _format_evaluation(result: dict) -> str:
     )
     text += f" (mean length {result['mean_length']:.1f} steps)"
     if "goal_rate" in result:
-        text += f"; goal rate {result['goal_rate']:.3f}, {result['mean_steps_to_goal']:.1f} steps to goal"
+        steps = result["mean_steps_to_goal"]
+        text += f"; goal rate {result['goal_rate']:.3f}" + (f", {steps:.1f} steps to goal" if steps is not None else "")
     return text
 
 

@@ -23,7 +23,7 @@ def evaluate(
     Each of the ``num_envs`` copies plays a fixed share of the episodes, so that short episodes are not
     over-represented. Returns ``mean_return``, ``std_return``, ``mean_length`` and ``episodes``; when the
     env reports ``info["status"]`` (Half Field Offense), also ``goal_rate`` and ``mean_steps_to_goal``
-    (NaN when no goal was scored).
+    (``None`` when no goal was scored).
     """
     if episodes < 1:
         raise ValueError(f"episodes = {episodes!r}; expected an integer >= 1")
@@ -68,5 +68,5 @@ def evaluate(
     if statuses:
         goals = np.array([s == "GOAL" for s in statuses])
         result["goal_rate"] = float(goals.mean())
-        result["mean_steps_to_goal"] = float(np.mean(np.array(lengths)[goals])) if goals.any() else float("nan")
+        result["mean_steps_to_goal"] = float(np.mean(np.array(lengths)[goals])) if goals.any() else None
     return result

@@ -104,9 +104,9 @@ def results_table(groups: dict[str, list[Path]]) -> str:
             ret = np.array([e["mean_return"] for e in evals])
             greedy = f"{ret.mean():.3f} +- {ret.std():.3f} ({len(evals)} evaluated)"
             goals = [e["goal_rate"] for e in evals if "goal_rate" in e]
-            steps = [e["mean_steps_to_goal"] for e in evals if "mean_steps_to_goal" in e]
+            steps = [e["mean_steps_to_goal"] for e in evals if e.get("mean_steps_to_goal") is not None]
             goal = f"{np.mean(goals):.3f}" if goals else "-"
-            to_goal = f"{np.nanmean(steps):.1f}" if steps and not np.all(np.isnan(steps)) else "-"
+            to_goal = f"{np.mean(steps):.1f}" if steps else "-"
         else:
             greedy, goal, to_goal = "not evaluated", "-", "-"
         lines.append(f"| {label} | {len(runs)} | {greedy} | {goal} | {to_goal} | {last} |")
