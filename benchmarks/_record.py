@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import csv
 import datetime as dt
 import json
 import os
@@ -48,9 +49,11 @@ def run_and_record(experiment_file: str, out_root: str, record: str, workers: in
     figure = HERE / "results" / f"{Path(record).stem}.png"
     figure.parent.mkdir(exist_ok=True)
     shutil.copy(report["png"], figure)
-    per_run = {}
+    per_run = {}  # training time of each run from its own log, so that resumed and skipped runs count too
     for o in outcomes:
-        per_run.setdefault(o.spec.label, []).append(o.seconds)
+        with open(Path(o.out) / "progress.csv", newline="") as f:
+            seconds = sum(float(r["time/epoch_seconds"]) for r in csv.DictReader(f))
+        per_run.setdefault(o.spec.label, []).append(seconds)
     commit = subprocess.run(
         ["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, cwd=HERE
     ).stdout.strip()
@@ -60,9 +63,9 @@ def run_and_record(experiment_file: str, out_root: str, record: str, workers: in
         f"- command: `python {' '.join(sys.argv)}` (commit {commit})",
         f"- date: {dt.datetime.now().isoformat(timespec='minutes')}",
         f"- machine: {machine()}",
-        f"- {len(jobs)} runs of {jobs[0][0].total_steps:,} steps, {workers} at a time; "
-        f"total wall time {wall / 60:.1f} min",
-        "- wall time of one run (median per setting, with the other worker running beside it): "
+        f"- {len(jobs)} runs of {jobs[0][0].total_steps:,} steps, {workers} at a time; this invocation took "
+        f"{wall / 60:.1f} min (runs finished by an earlier, interrupted invocation are skipped, partial ones resumed)",
+        "- training time of one run (median per setting, from its progress.csv; another run beside it): "
         + ", ".join(f"{k} {np.median(v) / 60:.1f} min" for k, v in per_run.items()),
         "",
         report["table"].read_text().strip(),
