@@ -150,3 +150,25 @@ def test_short_run_beats_the_random_policy():
 
 def test_top_level_import():
     assert pamdp.PATRPO is PATRPO
+
+
+def test_linear_baseline_option_trains_and_round_trips(tmp_path):
+    cfg = PATRPOConfig.from_dict({"baseline": "linear"}, base=SMALL)
+    model = PATRPO("pamdp/Platform-v0", cfg)
+    model.learn(1000, progress_bar=False)
+    assert np.any(model.linear_baseline.coef != 0)
+    model.save(tmp_path / "lin.pt")
+    loaded = PATRPO.load(tmp_path / "lin.pt")
+    np.testing.assert_array_equal(loaded.linear_baseline.coef, model.linear_baseline.coef)
+
+
+@pytest.mark.parametrize("estimator", ["joint_sample", "chain_sample"])
+def test_every_kl_estimator_runs_an_update_within_its_bound(estimator):
+    cfg = PATRPOConfig.from_dict({"kl_estimator": estimator}, base=SMALL)
+    model = PATRPO("pamdp/Platform-v0", cfg)
+    stats = []
+    model.learn(2000, progress_bar=False, callback=lambda algo, s: stats.append(s))
+    assert any(s["train/line_search_success"] == 1.0 for s in stats)
+    for s in stats:
+        if s["train/line_search_success"]:
+            assert s["train/kl_estimate"] <= cfg.delta + 1e-9
