@@ -1,0 +1,101 @@
+"""Regenerate the settings tables of ``docs/algorithms.md`` from the config dataclasses.
+
+Each table sits between two marker comments, ``<!-- settings:NAME start -->`` and
+``<!-- settings:NAME end -->``, where ``NAME`` is a config class below; everything between the markers is
+replaced. A row per ``dataclasses.fields(Config)``: the name, the type, the default, the value in each
+preset that differs from the default (blank where it does not), and the field's ``metadata["help"]``.
+
+    python docs/gen_settings.py            # rewrite docs/algorithms.md in place
+    python docs/gen_settings.py --check    # exit 1 if the tables are out of date (for CI)
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import re
+import sys
+import typing
+from pathlib import Path
+
+from pamdp.algos.paddpg import PADDPGConfig
+from pamdp.algos.pasvg import PASVG0Config
+from pamdp.algos.patrpo import PATRPOConfig
+
+CONFIGS = {c.__name__: c for c in (PATRPOConfig, PASVG0Config, PADDPGConfig)}
+DOC = Path(__file__).with_name("algorithms.md")
+BLOCK = re.compile(r"(<!-- settings:(\w+) start -->\n)(.*?)(<!-- settings:\2 end -->)", re.DOTALL)
+
+
+def _value(v) -> str:
+    if isinstance(v, tuple):
+        return "(" + ", ".join(_value(x) for x in v) + ("," if len(v) == 1 else "") + ")"
+    if isinstance(v, int) and not isinstance(v, bool) and abs(v) >= 10_000:
+        return f"{v:_}"
+    return repr(v)
+
+
+def _type(hint) -> str:
+    if typing.get_origin(hint) is tuple:
+        return "tuple[int, ...]"
+    return getattr(hint, "__name__", str(hint))
+
+
+def table(config_class) -> str:
+    """The markdown table of one config class, with a line naming presets identical to the defaults."""
+    default = config_class()
+    presets = config_class.presets()
+    differing = {n: p for n, p in presets.items() if p != default}
+    same = [n for n in presets if n not in differing]
+    hints = typing.get_type_hints(config_class)
+    head = ["setting", "type", "default", *(f"`{n}`" for n in differing), "meaning"]
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for f in dataclasses.fields(config_class):
+        base = getattr(default, f.name)
+        cells = [f"`{f.name}`", f"`{_type(hints[f.name])}`", f"`{_value(base)}`"]
+        for p in differing.values():
+            v = getattr(p, f.name)
+            cells.append(f"`{_value(v)}`" if v != base else "")
+        cells.append(f.metadata.get("help", "").replace("|", "\\|"))
+        lines.append("| " + " | ".join(cells) + " |")
+    if same:
+        names = ", ".join(f"`{n}`" for n in same)
+        verb = "is" if len(same) == 1 else "are"
+        lines += ["", f"Preset {names} {verb} the defaults."]
+    return "\n".join(lines) + "\n"
+
+
+def render(text: str) -> str:
+    def replace(m: re.Match) -> str:
+        name = m.group(2)
+        if name not in CONFIGS:
+            raise SystemExit(f"unknown config {name!r} in a settings marker; expected one of {', '.join(CONFIGS)}")
+        return m.group(1) + table(CONFIGS[name]) + m.group(4)
+
+    return BLOCK.sub(replace, text)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--check", action="store_true", help="report out-of-date tables instead of writing")
+    args = parser.parse_args(argv)
+    text = DOC.read_text()
+    found = {m.group(2) for m in BLOCK.finditer(text)}
+    missing = sorted(set(CONFIGS) - found)
+    if missing:
+        print(f"{DOC}: no settings markers for {', '.join(missing)}", file=sys.stderr)
+        return 1
+    new = render(text)
+    if args.check:
+        if new != text:
+            print(f"{DOC}: settings tables are out of date; run python docs/gen_settings.py", file=sys.stderr)
+            return 1
+        return 0
+    if new != text:
+        DOC.write_text(new)
+        print(f"rewrote the settings tables in {DOC}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
