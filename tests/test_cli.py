@@ -111,3 +111,24 @@ def test_soccer_evaluation_reports_goal_rate(tmp_path, capsys):
     result = json.loads(capsys.readouterr().out)
     assert result["episodes"] == 8 and 0.0 <= result["goal_rate"] <= 1.0
     assert result["mean_steps_to_goal"] is None or result["mean_steps_to_goal"] > 0
+
+
+def test_config_file_preset_and_seed_with_flags(tmp_path):
+    cfg = tmp_path / "c.json"
+    cfg.write_text(json.dumps({"preset": "tuned", "seed": 7, "delta": 0.03}))
+    out = tmp_path / "run"
+    argv = ["train", "patrpo", "--config", str(cfg), "--preset", "paper", "--total-steps", "500", "--out", str(out)]
+    assert main([*argv, "--eval-episodes", "0", *TINY]) == 0
+    run = json.loads((out / "run.json").read_text())
+    assert run["preset"] == "paper" and run["config"]["seed"] == 7 and run["config"]["delta"] == 0.03
+
+
+def test_env_kwargs_reach_the_env(tmp_path):
+    out = tmp_path / "hfo2016"
+    argv = ["train", "patrpo", "--env", "pamdp/HalfFieldOffense-v0", "--env-kwargs", '{"profile": "hfo2016"}']
+    assert main([*argv, "--total-steps", "300", "--out", str(out), "--eval-episodes", "0", *TINY]) == 0
+    from pamdp.algos.base import load_model
+
+    model = load_model(out)
+    assert model.obs_dim == 58 and model.env_kwargs == {"profile": "hfo2016"}
+    assert json.loads((out / "run.json").read_text())["env_kwargs"] == {"profile": "hfo2016"}

@@ -18,7 +18,14 @@ import sys
 import typing
 from pathlib import Path
 
-from pamdp.experiments.runner import ALGORITHMS, DEFAULT_PRESET, RunSpec, algorithm_class, train_run
+from pamdp.experiments.runner import ALGORITHMS, RunSpec, algorithm_class, default_preset, train_run
+
+DEFAULT_TOTAL_STEPS = {"patrpo": 500_000, "pasvg0": 1_000_000, "paddpg": 1_000_000}
+ALGO_HELP = {
+    "patrpo": "PATRPO: TRPO of the hierarchical policy with the chain-rule KL",
+    "pasvg0": "PASVG(0): Gumbel-Softmax stochastic value gradients with replay",
+    "paddpg": "PADDPG: Hausknecht & Stone's parameterized-action DDPG (the baseline)",
+}
 
 
 def _parse_value(text: str, hint):
@@ -81,10 +88,16 @@ def build_parser() -> argparse.ArgumentParser:
         cls = algorithm_class(name)
         if cls is None:
             continue
-        p = algos.add_parser(name, help=(cls.__doc__ or "").strip().splitlines()[0])
+        p = algos.add_parser(name, help=ALGO_HELP.get(name, name))
         p.add_argument("--env", default="pamdp/Platform-v0", help="registered env id (default: %(default)s)")
-        p.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
-        p.add_argument("--total-steps", type=int, default=None, help="environment steps (default: the preset's)")
+        p.add_argument("--env-kwargs", type=json.loads, default=None, help="JSON object of env constructor arguments")
+        p.add_argument("--seed", type=int, default=None, help="random seed (default: the config file's, else 0)")
+        p.add_argument(
+            "--total-steps",
+            type=int,
+            default=None,
+            help=f"environment steps (default: {DEFAULT_TOTAL_STEPS[name]:,})",
+        )
         p.add_argument(
             "--out", default=None, help="run directory (default: runs/ALGO-ENV-seedN-TIME); reuse it to resume"
         )
@@ -92,7 +105,7 @@ def build_parser() -> argparse.ArgumentParser:
             "--preset",
             default=None,
             choices=list(cls.config_class.presets()),
-            help=f"settings preset (default: {DEFAULT_PRESET})",
+            help=f"settings preset (default: {default_preset(cls.config_class)})",
         )
         p.add_argument("--config", default=None, help="TOML or JSON file of settings")
         p.add_argument(
@@ -103,8 +116,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     ev = sub.add_parser("evaluate", help="evaluate a trained model (a run directory or a model file)")
     ev.add_argument("model", help="run directory written by `pamdp train`, or a saved model file")
-    ev.add_argument("--episodes", type=int, default=1000)
-    ev.add_argument("--seed", type=int, default=0)
+    ev.add_argument("--episodes", type=int, default=1000, help="episodes to play (default: %(default)s)")
+    ev.add_argument("--seed", type=int, default=None, help="env seed (default: 10000 + the training seed, as train's)")
     ev.add_argument("--stochastic", action="store_true", help="sample actions instead of the greedy ones")
     ev.add_argument("--json", action="store_true", help="print one JSON object")
 
@@ -124,24 +137,31 @@ def build_parser() -> argparse.ArgumentParser:
 
     rd = sub.add_parser("render", help="write one episode to a GIF (a trained model, or random actions in an env)")
     rd.add_argument("source", help="run directory, model file, or a registered env id (random actions)")
-    rd.add_argument("--out", default="episode.gif")
-    rd.add_argument("--seed", type=int, default=0)
+    rd.add_argument("--out", default="episode.gif", help="GIF path (default: %(default)s)")
+    rd.add_argument("--seed", type=int, default=0, help="env seed (default: %(default)s)")
     return parser
 
 
 # -- train -------------------------------------------------------------------------------------------
-DEFAULT_TOTAL_STEPS = {"patrpo": 500_000, "pasvg0": 1_000_000, "paddpg": 1_000_000}
 
 
 def _train_spec(args, cls) -> RunSpec:
     file_values = _read_config_file(args.config) if args.config else {}
-    preset = args.preset or file_values.pop("preset", None)
+    file_preset = file_values.pop("preset", None)
+    preset = args.preset or file_preset
+    seed = args.seed if args.seed is not None else int(file_values.pop("seed", 0))
+    file_values.pop("seed", None)
     flags = {k[4:]: v for k, v in vars(args).items() if k.startswith("cfg_") and v is not None}
     total = args.total_steps if args.total_steps is not None else DEFAULT_TOTAL_STEPS[args.algo]
     if total < 0:
         raise ValueError(f"--total-steps {total}; expected a non-negative number of steps")
     settings = {**file_values, **flags}
-    return RunSpec(args.algo, args.env, total, args.seed, preset, tuple(sorted(settings.items())), args.eval_episodes)
+    if args.env_kwargs is not None and not isinstance(args.env_kwargs, dict):
+        raise ValueError(f"--env-kwargs {args.env_kwargs!r}; expected a JSON object")
+    env_kwargs = tuple(sorted((args.env_kwargs or {}).items()))
+    return RunSpec(
+        args.algo, args.env, total, seed, preset, tuple(sorted(settings.items())), args.eval_episodes, "", env_kwargs
+    )
 
 
 def cmd_train(args) -> int:
@@ -149,7 +169,7 @@ def cmd_train(args) -> int:
     spec = _train_spec(args, cls)
     spec.config()  # validate the settings before creating any directory
     stamp = dt.datetime.now().strftime("%Y%m%d-%H%M%S")
-    out = Path(args.out or f"runs/{args.algo}-{args.env.split('/')[-1]}-seed{args.seed}-{stamp}")
+    out = Path(args.out or f"runs/{args.algo}-{args.env.split('/')[-1]}-seed{spec.seed}-{stamp}")
     try:
         result = train_run(spec, out, progress_bar=not args.no_progress, log=lambda m: print(m, file=sys.stderr))
     except KeyboardInterrupt:
@@ -215,7 +235,8 @@ def cmd_evaluate(args) -> int:
     from pamdp.evaluation import evaluate
 
     model = load_model(args.model)
-    result = evaluate(model, episodes=args.episodes, seed=args.seed, deterministic=not args.stochastic)
+    seed = args.seed if args.seed is not None else 10_000 + model.config.seed
+    result = evaluate(model, episodes=args.episodes, seed=seed, deterministic=not args.stochastic)
     print(json.dumps(result) if args.json else _format_evaluation(result))
     return 0
 

@@ -155,11 +155,11 @@ def make_vector_env(
     return gymnasium.make_vec(env_id, num_envs=num_envs, vectorization_mode=vectorization_mode, **(env_kwargs or {}))
 
 
-def _describe_env(env) -> tuple[str | None, dict, spaces.Space, spaces.Space]:
+def _describe_env(env, env_kwargs: dict | None = None) -> tuple[str | None, dict, spaces.Space, spaces.Space]:
     """``(env_id, env_kwargs, single observation space, single action space)`` of what a user passed."""
     if isinstance(env, str):
         spec = gymnasium.spec(env)
-        probe = gymnasium.make(env)
+        probe = gymnasium.make(env, **(env_kwargs or {}))
         obs_space, act_space = probe.observation_space, probe.action_space
         probe.close()
         return spec.id, {}, obs_space, act_space
@@ -331,7 +331,7 @@ class Algorithm:
         if not isinstance(config, self.config_class):
             raise ValueError(f"{type(self).__name__} needs a {self.config_class.__name__}, got {type(config).__name__}")
         self.config = config
-        env_id, spec_kwargs, obs_space, act_space = _describe_env(env)
+        env_id, spec_kwargs, obs_space, act_space = _describe_env(env, env_kwargs)
         self.env_id = env_id
         self.env_kwargs = {**spec_kwargs, **(env_kwargs or {})}
         self._env_arg = None if isinstance(env, str) else env
@@ -506,8 +506,9 @@ class Algorithm:
             if payload["env_id"] is None:
                 raise ValueError("this model was trained on an unregistered env; pass env= to load it")
             algo = cls(payload["env_id"], config, env_kwargs=payload["env_kwargs"])
-        else:
-            algo = cls(env, config)
+        else:  # the recorded env arguments still apply when the same env id is named again
+            same_id = isinstance(env, str) and env == payload["env_id"]
+            algo = cls(env, config, env_kwargs=payload["env_kwargs"] if same_id else None)
         for name, module in algo._modules().items():
             module.load_state_dict(payload["modules"][name])
         for name, opt in algo._optimizers().items():

@@ -28,7 +28,10 @@ __all__ = ["PATRPO", "PATRPOConfig", "LinearFeatureBaseline", "gae"]
 
 @dataclasses.dataclass(frozen=True)
 class PATRPOConfig(AlgoConfig):
-    """PATRPO's settings; the defaults are the paper's preset (rllab's for what the paper leaves open)."""
+    """PATRPO's settings; the defaults are the paper's preset, rllab's TRPO settings where the paper is silent,
+    and two modern choices that do not change the algorithm: an MLP value baseline (rllab's linear one is
+    ``baseline="linear"``) and 128 env copies stepped together (samples per epoch are ``batch_size`` either way).
+    """
 
     num_envs: int = setting(
         128, "Copies of the env stepped together; PATRPO's samples are on-policy, so more is just faster."

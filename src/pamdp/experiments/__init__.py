@@ -1,7 +1,8 @@
 """The paper's experiments as files, and what runs and plots them (``pamdp reproduce``, ``pamdp plot``).
 
 Each experiment is a TOML file in ``configs/`` (one per figure of the paper): the env, the budget, the
-seeds and a list of runs (a label, an algorithm, a preset and setting overrides).
+seeds, optional ``env_kwargs`` for the env's constructor, and a list of runs (a label, an algorithm, a preset,
+setting overrides, and optionally their own ``env`` and ``env_kwargs``).
 """
 
 from __future__ import annotations
@@ -31,6 +32,7 @@ class Experiment:
     seeds: tuple[int, ...]
     eval_episodes: int
     runs: tuple[dict, ...]
+    env_kwargs: dict = dataclasses.field(default_factory=dict)
 
     def specs(self, seeds=None, scale: float = 1.0) -> list[RunSpec]:
         """One :class:`RunSpec` per (run, seed); ``scale`` multiplies the step budget."""
@@ -41,6 +43,7 @@ class Experiment:
         for run in self.runs:
             for seed in self.seeds if seeds is None else seeds:
                 settings = tuple(sorted(run.get("settings", {}).items()))
+                env_kwargs = tuple(sorted({**self.env_kwargs, **run.get("env_kwargs", {})}.items()))
                 out.append(
                     RunSpec(
                         run["algo"],
@@ -51,6 +54,7 @@ class Experiment:
                         settings,
                         self.eval_episodes,
                         run["label"],
+                        env_kwargs,
                     )
                 )
         return out
@@ -88,4 +92,5 @@ def load_experiment(name_or_path: str | os.PathLike) -> Experiment:
         tuple(data["seeds"]),
         int(data.get("eval_episodes", 1000)),
         tuple(data["runs"]),
+        dict(data.get("env_kwargs", {})),
     )

@@ -22,7 +22,7 @@ import traceback
 from pathlib import Path
 from typing import Any
 
-__all__ = ["RunSpec", "train_run", "run_all", "algorithm_class", "ALGORITHMS", "DEFAULT_PRESET"]
+__all__ = ["RunSpec", "default_preset", "train_run", "run_all", "algorithm_class", "ALGORITHMS", "DEFAULT_PRESET"]
 
 ALGORITHMS = {
     "patrpo": "pamdp.algos.patrpo:PATRPO",
@@ -47,6 +47,12 @@ def algorithm_class(name: str):
         raise
 
 
+def default_preset(config_class) -> str:
+    """The preset a run gets when none is named: ``tuned`` where the algorithm has one, else its first."""
+    presets = config_class.presets()
+    return DEFAULT_PRESET if DEFAULT_PRESET in presets else next(iter(presets))
+
+
 @dataclasses.dataclass(frozen=True)
 class RunSpec:
     """One training run: an algorithm with settings, on an env, for a seed."""
@@ -59,13 +65,13 @@ class RunSpec:
     settings: tuple[tuple[str, Any], ...] = ()
     eval_episodes: int = 1000
     label: str = ""
+    env_kwargs: tuple[tuple[str, Any], ...] = ()
 
     def config(self):
         cls = algorithm_class(self.algo)
         if cls is None:
             raise ValueError(f"algorithm {self.algo!r} is not available in this install")
-        presets = cls.config_class.presets()
-        preset = self.preset or (DEFAULT_PRESET if DEFAULT_PRESET in presets else next(iter(presets)))
+        preset = self.preset or default_preset(cls.config_class)
         base = cls.config_class.preset(preset)
         return cls, preset, cls.config_class.from_dict({**dict(self.settings), "seed": self.seed}, base=base)
 
@@ -80,6 +86,7 @@ def train_run(spec: RunSpec, out: str | os.PathLike, progress_bar: bool = True, 
     run_info = {
         "algo": spec.algo,
         "env": spec.env,
+        "env_kwargs": dict(spec.env_kwargs),
         "preset": preset,
         "total_steps": spec.total_steps,
         "config": config.to_dict(),
@@ -90,7 +97,8 @@ def train_run(spec: RunSpec, out: str | os.PathLike, progress_bar: bool = True, 
         recorded = json.loads(run_file.read_text()) if run_file.exists() else {}
         if "config" in recorded:  # settings added since the run started count as their defaults
             recorded["config"] = cls.config_class.from_dict(recorded["config"]).to_dict()
-        differ = sorted(k for k in ("algo", "env", "config") if recorded.get(k) != run_info[k])
+        recorded.setdefault("env_kwargs", {})
+        differ = sorted(k for k in ("algo", "env", "env_kwargs", "config") if recorded.get(k) != run_info[k])
         if differ:
             raise ValueError(
                 f"{out} holds a run with other {', '.join(differ)}; "
@@ -104,7 +112,7 @@ def train_run(spec: RunSpec, out: str | os.PathLike, progress_bar: bool = True, 
         log(f"resuming {out} at step {model.num_timesteps:,} of {spec.total_steps:,}")
     else:
         out.mkdir(parents=True, exist_ok=True)
-        model = cls(spec.env, config)
+        model = cls(spec.env, config, env_kwargs=dict(spec.env_kwargs))
     run_file.write_text(json.dumps({**run_info, "command": sys.argv}, indent=2))
     start = time.time()
     model.learn(max(spec.total_steps - model.num_timesteps, 0), progress_bar=progress_bar, run_dir=out)
