@@ -69,11 +69,13 @@ def plot_curves(
     fig, ax = plt.subplots(figsize=(5.0, 3.4), dpi=110)
     for label, runs in groups.items():
         agg = aggregate(runs, metric)
-        line = ax.plot(agg["epoch"], agg["mean"], label=f"{label} ({len(runs)} seeds)", linewidth=1.4)[0]
+        x = agg["steps"] / 1e6
+        line = ax.plot(x, agg["mean"], label=f"{label} ({len(runs)} seeds)", linewidth=1.4)[0]
         ax.fill_between(
-            agg["epoch"], agg["mean"] - agg["std"], agg["mean"] + agg["std"], color=line.get_color(), alpha=0.2
+            x, agg["mean"] - agg["std"], agg["mean"] + agg["std"], color=line.get_color(), alpha=0.2
         )
-    ax.set_xlabel("epoch")
+    # Samples rather than epochs on the x axis: settings may differ in samples per epoch.
+    ax.set_xlabel("environment samples (millions)")
     ax.set_ylabel("average return" if metric == METRIC else metric)
     if title:
         ax.set_title(title)
