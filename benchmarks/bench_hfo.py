@@ -2,7 +2,9 @@
 
 Run ``.venv/bin/python benchmarks/bench_hfo.py`` (about a minute); it rewrites ``benchmarks/hfo_speed.md``.
 Actions are sampled before timing, so the figures are the env's own cost. Each figure is the median
-over repeats; another process may be using the machine's other core, so the load average is recorded.
+over repeats of steps per CPU-second of this process (``time.process_time``): another process may be
+using the machine's cores, and CPU time does not count the time spent waiting for one. The load
+average is recorded too.
 
 ``--baseline COMMIT`` also times the HFO modules of that git commit (exported to a temporary
 directory), interleaved repeat by repeat with the working tree's, so that both see the same load.
@@ -33,6 +35,8 @@ from pamdp.envs.hfo_baseline import scripted_scorer_batch
 HFO_MODULES = ("hfo", "hfo_physics", "hfo_features", "hfo_vector", "hfo_interface")
 #: Batched steps before timing: the games, all placed at once, first time out together near step 100.
 BATCHED_WARMUP = 200
+#: Fewest env steps (batched steps times games) per timed repeat of a batched env.
+BATCHED_ENV_STEPS = 20_000
 
 
 def import_baseline(commit: str):
@@ -52,47 +56,53 @@ def import_baseline(commit: str):
 
 
 def scalar_rate(env, actions, steps: int) -> float:
-    """Steps/s of one env over ``steps`` steps of ``actions`` (resets included)."""
-    start = time.perf_counter()
+    """Steps per CPU-second of one env over ``steps`` steps of ``actions`` (resets included)."""
+    start = time.process_time()
     for k in range(steps):
         _, _, terminated, truncated, _ = env.step(actions[k % len(actions)])
         if terminated or truncated:
             env.reset()
-    return steps / (time.perf_counter() - start)
+    return steps / (time.process_time() - start)
 
 
 def batched_rate(env, actions, steps: int) -> float:
-    """Env-steps/s of a batched env over ``steps`` batched steps (autoresets included)."""
-    start = time.perf_counter()
+    """Env-steps per CPU-second of a batched env over ``steps`` batched steps (autoresets included)."""
+    start = time.process_time()
     for k in range(steps):
         env.step(actions[k % len(actions)])
-    return steps * env.num_envs / (time.perf_counter() - start)
+    return steps * env.num_envs / (time.process_time() - start)
 
 
 def speeds(modules: dict, args) -> dict:
     """Median steps/s of each module's scalar env, scalar env via ``gymnasium.make`` (current only) and
-    batched env, repeats interleaved across modules."""
+    batched env at each of ``args.num_envs`` sizes, repeats interleaved across modules."""
     space = hfo.HalfFieldOffenseEnv().action_space
     space.seed(0)
     scalar_actions = [space.sample() for _ in range(2000)]
-    batched_space = hfo.HalfFieldOffenseVectorEnv(num_envs=args.num_envs).action_space
-    batched_space.seed(0)
-    batched_actions = [batched_space.sample() for _ in range(16)]
+    batched_actions = {}
+    for n in args.num_envs:
+        batched_space = hfo.HalfFieldOffenseVectorEnv(num_envs=n).action_space
+        batched_space.seed(0)
+        batched_actions[n] = [batched_space.sample() for _ in range(16)]
     envs = {}
     for name, module in modules.items():
-        scalar, batched = module.HalfFieldOffenseEnv(), module.HalfFieldOffenseVectorEnv(num_envs=args.num_envs)
-        scalar.reset(seed=0)
-        batched.reset(seed=0)
-        batched_rate(batched, batched_actions, BATCHED_WARMUP)
-        envs[name] = {"scalar": scalar, "batched": batched}
+        envs[name] = {"scalar": module.HalfFieldOffenseEnv()}
+        envs[name]["scalar"].reset(seed=0)
+        for n in args.num_envs:
+            batched = module.HalfFieldOffenseVectorEnv(num_envs=n)
+            batched.reset(seed=0)
+            batched_rate(batched, batched_actions[n], BATCHED_WARMUP)
+            envs[name][n] = batched
     envs["current"]["made"] = gymnasium.make("pamdp/HalfFieldOffense-v0")
     envs["current"]["made"].reset(seed=0)
     rates = {name: {kind: [] for kind in kinds} for name, kinds in envs.items()}
     for _ in range(args.repeats):
         for name, kinds in envs.items():
             for kind, env in kinds.items():
-                if kind == "batched":
-                    rates[name][kind].append(batched_rate(env, batched_actions, args.batched_steps))
+                if isinstance(kind, int):
+                    # small batches take more steps, so that each repeat times enough env steps
+                    steps = max(args.batched_steps, BATCHED_ENV_STEPS // kind)
+                    rates[name][kind].append(batched_rate(env, batched_actions[kind], steps))
                 else:
                     rates[name][kind].append(scalar_rate(env, scalar_actions, args.scalar_steps))
     return {name: {kind: statistics.median(r) for kind, r in kinds.items()} for name, kinds in rates.items()}
@@ -129,8 +139,10 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--repeats", type=int, default=5, help="timed repeats; the median is reported")
     parser.add_argument("--scalar-steps", type=int, default=20_000, help="steps per scalar repeat")
-    parser.add_argument("--batched-steps", type=int, default=100, help="batched steps per repeat")
-    parser.add_argument("--num-envs", type=int, default=1024, help="games in the batched env")
+    parser.add_argument("--batched-steps", type=int, default=100, help="batched steps per repeat (more for small N)")
+    parser.add_argument(
+        "--num-envs", type=int, nargs="+", default=[1024], help="games in the batched env (several: one row each)"
+    )
     parser.add_argument("--episodes", type=int, default=1000, help="scripted-scorer episodes")
     parser.add_argument("--baseline", metavar="COMMIT", help="also time this commit's HFO envs, interleaved")
     parser.add_argument("--cpu", type=int, help="pin the process to this core")
@@ -147,7 +159,7 @@ def main() -> None:
     goal_rate, goal_steps, outcomes = scorer_results(args.episodes)
     load_after = os.getloadavg()[0]
 
-    def result(kind: str) -> str:
+    def result(kind) -> str:
         text = f"{rates['current'][kind]:,.0f} steps/s"
         if args.baseline:
             before = rates["baseline"][kind]
@@ -158,7 +170,10 @@ def main() -> None:
     rows = [
         ("scalar `HalfFieldOffenseEnv`, random actions", result("scalar"), ">= 20 000"),
         ("scalar via `gymnasium.make` (wrappers)", f"{rates['current']['made']:,.0f} steps/s", ""),
-        (f"batched `HalfFieldOffenseVectorEnv`, N = {args.num_envs}", result("batched"), ">= 1 000 000"),
+        *(
+            (f"batched `HalfFieldOffenseVectorEnv`, N = {n}", result(n), ">= 1 000 000" if n == 1024 else "")
+            for n in args.num_envs
+        ),
         (
             f"scripted scorer, {args.episodes} episodes (noise on)",
             f"goal rate {goal_rate:.3f}, {goal_steps:.1f} steps to goal",
