@@ -34,9 +34,8 @@ UpdateFn = Callable[[], dict[str, float]]
 
 def soft_update(target: nn.Module, source: nn.Module, tau: float) -> None:
     """Polyak averaging of target networks, as DDPG: ``theta' <- tau * theta + (1 - tau) * theta'``."""
-    with torch.no_grad():
-        for t, s in zip(target.parameters(), source.parameters()):
-            t.lerp_(s, tau)
+    with torch.no_grad():  # one foreach call, not a Python loop of a kernel per tensor
+        torch._foreach_lerp_(list(target.parameters()), list(source.parameters()), tau)
 
 
 def hard_update(target: nn.Module, source: nn.Module) -> None:

@@ -170,10 +170,17 @@ class GumbelHybridPolicy(nn.Module):
         self, obs: torch.Tensor, eta_a: torch.Tensor, eta_x: torch.Tensor, temperature: float, hard: bool
     ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
         """``(index, a, x)`` for the noise ``(eta_a, eta_x)``; ``a`` is the critic's action input."""
-        index, a = gumbel_softmax_sample(self.pi_d(obs), eta_a, temperature, hard)
+        return self.sample(obs, eta_a, eta_x, temperature, hard)[1:]
+
+    def sample(
+        self, obs: torch.Tensor, eta_a: torch.Tensor, eta_x: torch.Tensor, temperature: float, hard: bool
+    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
+        """``(logits, index, a, x)``: :meth:`forward` plus ``pi_d``'s logits, so an update runs ``pi_d`` once."""
+        logits = self.pi_d(obs)
+        index, a = gumbel_softmax_sample(logits, eta_a, temperature, hard)
         std = self.log_std.clamp(LOG_STD_MIN, LOG_STD_MAX).exp()[index]
         x = torch.tanh(self.pi_c(torch.cat([obs, a], dim=-1)) + std * eta_x) * self.mask[index]
-        return index, a, x
+        return logits, index, a, x
 
     def mode(self, obs: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
         """The greedy action: the most probable discrete action and its mean parameters."""
@@ -206,10 +213,10 @@ class PASVG0(Algorithm):
         self.critic = Critic(self.obs_dim, h.n_actions, h.max_param_size, cfg.hidden_sizes, cfg.activation)
         self.policy_target = copy.deepcopy(self.policy).requires_grad_(False)
         self.critic_target = copy.deepcopy(self.critic).requires_grad_(False)
-        self.policy_optimizer = torch.optim.Adam(
-            [p for p in self.policy.parameters() if p.requires_grad], lr=cfg.policy_lr, foreach=True
-        )
-        self.critic_optimizer = torch.optim.Adam(self.critic.parameters(), lr=cfg.critic_lr, foreach=True)
+        # fused: one kernel per step instead of a dozen foreach passes, about 3x faster on a CPU.
+        self.policy_params = [p for p in self.policy.parameters() if p.requires_grad]
+        self.policy_optimizer = torch.optim.Adam(self.policy_params, lr=cfg.policy_lr, fused=True)
+        self.critic_optimizer = torch.optim.Adam(self.critic.parameters(), lr=cfg.critic_lr, fused=True)
         K, m, d = h.n_actions, h.max_param_size, self.obs_dim
         fields = {
             "obs": ((d,), np.float32),
@@ -271,9 +278,7 @@ class PASVG0(Algorithm):
             self.np_rng,
         )
 
-    def _step(self, optimizer: torch.optim.Optimizer, loss: torch.Tensor, params) -> None:
-        optimizer.zero_grad(set_to_none=True)
-        loss.backward()
+    def _step(self, optimizer: torch.optim.Optimizer, params) -> None:
         if self.config.grad_clip > 0:
             nn.utils.clip_grad_norm_(params, self.config.grad_clip)
         optimizer.step()
@@ -291,17 +296,21 @@ class PASVG0(Algorithm):
             y = b["reward"] + cfg.gamma * (~b["terminated"]).float() * q_next
         q = self.critic(obs, b["a_in"], b["x"])
         critic_loss = F.mse_loss(q, y)
-        self._step(self.critic_optimizer, critic_loss, self.critic.parameters())
+        self.critic_optimizer.zero_grad(set_to_none=True)
+        critic_loss.backward()
+        self._step(self.critic_optimizer, self.critic.parameters())
 
         # The recorded noise, pushed through the current policy: a = f(s, eta_a), x = g(s, a, eta_x).
-        _, a, x = self.policy(obs, b["eta_a"], b["eta_x"], cfg.temperature, cfg.straight_through)
-        self.critic.requires_grad_(False)  # the policy loss differentiates Q in (a, x) only
+        logits, _, a, x = self.policy.sample(obs, b["eta_a"], b["eta_x"], cfg.temperature, cfg.straight_through)
         q_pi = self.critic(obs, a, x)
-        self.critic.requires_grad_(True)
-        logits = self.policy.pi_d(obs)
         entropy = -(logits.softmax(-1) * logits.log_softmax(-1)).sum(-1).mean()
         actor_loss = -q_pi.mean() - cfg.entropy_coef * entropy
-        self._step(self.policy_optimizer, actor_loss, self.policy.parameters())
+        # The policy loss differentiates Q in (a, x) only: asking for the policy's gradients alone skips the
+        # critic's weight gradients, which backward() would compute and the critic must not receive.
+        grads = torch.autograd.grad(actor_loss, self.policy_params)
+        for p, g in zip(self.policy_params, grads):
+            p.grad = g
+        self._step(self.policy_optimizer, self.policy_params)
 
         soft_update(self.critic_target, self.critic, cfg.tau)
         soft_update(self.policy_target, self.policy, cfg.tau)
