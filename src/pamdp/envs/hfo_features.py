@@ -121,11 +121,20 @@ def _proximity_into(q, out=None):
 _LANDMARK_X, _LANDMARK_Y = LANDMARKS[:, :1].copy(), LANDMARKS[:, 1:].copy()
 _FLAG_ROWS = (9, 11, 12, LAST_ACTION_OK)
 _CONSTANT_ROWS = ((0, 1.0), (1, 1.0), (8, -1.0), (10, -1.0), (50, 1.0), (54, 1.0))
+_SPEED_NORMALISERS = np.array([[SELF_SPEED_MAX], [BALL_SPEED_MAX]])
+
+
+def constant_rows(out: np.ndarray) -> np.ndarray:
+    """Write the features that are the same in every state (no teammates, no opponents) into the rows
+    of ``out``, shape ``(n_features, N)``."""
+    for row, value in _CONSTANT_ROWS:
+        out[row] = value
+    return out
 
 
 def feature_rows(
     px, py, bx, by, vx, vy, stamina, cos_t, sin_t, kickable, collided_ball, collided_post, last_action_ok,
-    profile: FeatureProfile, out: np.ndarray,
+    profile: FeatureProfile, out: np.ndarray, scratch: np.ndarray | None = None, constants: bool = True,
 ) -> np.ndarray:  # fmt: skip
     """The features of N states as the rows of ``out``, shape ``(profile.n_features, N)``, float64.
 
@@ -133,9 +142,11 @@ def feature_rows(
     at once. ``vx, vy`` hold the player's (row 0) and the ball's (row 1) velocity, shape ``(2, N)``;
     ``cos_t, sin_t`` are the cosine and sine of the body angle (the caller keeps them from one turn to
     the next); the rest as :func:`low_level_features`. Every number equals the scalar twin's.
+    ``scratch``, shape ``(5, 12, N)``, saves allocating the landmark temporaries on each call;
+    ``constants=False`` leaves the constant rows as they are (a caller reusing ``out`` wrote them).
     """
-    for row, value in _CONSTANT_ROWS:
-        out[row] = value
+    if constants:
+        constant_rows(out)
     for row, flag in zip(_FLAG_ROWS, (collided_ball, collided_post, kickable, last_action_ok)):
         if row < profile.n_features:
             np.multiply(flag, 2.0, out=out[row])
@@ -148,19 +159,25 @@ def feature_rows(
     out[2] -= cos_t * uy[0]
     np.multiply(cos_t, ux[0], out=out[3])
     out[3] += sin_t * uy[0]
-    _scaled_into(speed[0], SELF_SPEED_MAX, out[4])
     _scaled_into(stamina, STAMINA_MAX, out[7])
-    _scaled_into(speed[1], BALL_SPEED_MAX, out[55])
+    # The speeds are lengths, never negative: the lower clip of _scaled_into is skipped.
+    np.minimum(speed[0], SELF_SPEED_MAX, out=out[4])
+    np.minimum(speed[1], BALL_SPEED_MAX, out=out[55])
+    speed_rows = out[4:56:51]
+    speed_rows *= 2.0
+    speed_rows /= _SPEED_NORMALISERS
+    speed_rows -= 1.0
     out[56], out[57] = uy[1], ux[1]  # a ball at rest has heading 0: (sin, cos) = (0, 1)
     # Landmarks (rows 0-10) and the ball (row 11): bearing heading(L - p) - body as (sin, cos), proximity.
     n = px.shape[0]
-    dx, dy = np.empty((12, n)), np.empty((12, n))
+    dx, dy, dist, a, b = np.empty((5, 12, n)) if scratch is None else scratch
     np.subtract(_LANDMARK_X, px, out=dx[:11])
     np.subtract(bx, px, out=dx[11])
     np.subtract(_LANDMARK_Y, py, out=dy[:11])
     np.subtract(by, py, out=dy[11])
-    dist = dx * dx
-    dist += dy * dy
+    np.multiply(dx, dx, out=dist)
+    np.multiply(dy, dy, out=b)
+    dist += b
     np.sqrt(dist, out=dist)
     zero = None if dist.min() > 0.0 else dist == 0.0
     safe = dist if zero is None else dist + zero
@@ -168,7 +185,8 @@ def feature_rows(
     dy /= safe
     if zero is not None:  # the player exactly on a landmark or the ball: heading 0
         dx[zero], dy[zero] = 1.0, 0.0
-    a, b = dy * cos_t, dx * sin_t
+    np.multiply(dy, cos_t, out=a)
+    np.multiply(dx, sin_t, out=b)
     np.subtract(a[:11], b[:11], out=out[13:46:3])
     np.subtract(a[11], b[11], out=out[51])
     np.multiply(dx, cos_t, out=a)

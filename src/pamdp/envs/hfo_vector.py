@@ -16,7 +16,7 @@ from gymnasium.vector import AutoresetMode
 from gymnasium.vector.utils import batch_space
 
 from pamdp.envs import hfo_physics as phys
-from pamdp.envs.hfo_features import PROFILES, ball_to_goal_rows, feature_rows, shaped_reward
+from pamdp.envs.hfo_features import PROFILES, ball_to_goal_rows, constant_rows, feature_rows, shaped_reward
 from pamdp.envs.hfo_interface import (
     ACTION_FORM,
     PARAM_SIZES,
@@ -28,10 +28,15 @@ from pamdp.envs.hfo_interface import (
 
 _STATUS_NAMES = np.array(phys.STATUS_NAMES)
 
-#: Rows of the state matrix (and of ``seen``): velocities side by side, so that the player's and the
-#: ball's are handled in one pass by the features.
-_STATE = ("px", "py", "bx", "by", "pvx", "bvx", "pvy", "bvy", "body", "stamina")
-_PX, _PY, _BX, _BY, _PVX, _BVX, _PVY, _BVY, _BODY, _STAMINA = range(len(_STATE))
+#: Rows of the state matrix (and of ``seen``): the player's and the ball's coordinates side by side,
+#: so that the movement and the features handle both objects in one pass over a ``(2, N)`` block.
+_STATE = ("px", "bx", "py", "by", "pvx", "bvx", "pvy", "bvy", "body", "stamina")
+_PX, _BX, _PY, _BY, _PVX, _BVX, _PVY, _BVY, _BODY, _STAMINA = range(len(_STATE))
+#: Per-object constants of the movement, as columns for the ``(2, N)`` blocks: row 0 the player, row 1 the ball.
+_ACCEL_MAX = np.array([[phys.PLAYER_ACCEL_MAX], [phys.BALL_ACCEL_MAX]])
+_SPEED_MAX = np.array([[phys.PLAYER_SPEED_MAX], [phys.BALL_SPEED_MAX]])
+_DECAY = np.array([[phys.PLAYER_DECAY], [phys.BALL_DECAY]])
+_POST_REACH = phys.GOAL_POST_RADIUS + np.array([[phys.PLAYER_SIZE], [phys.BALL_SIZE]])
 
 
 def normalize_angle(deg):
@@ -59,7 +64,8 @@ def _fullstate_tables():
 
 
 _THRESHOLD_BITS, _SCALES = _fullstate_tables()
-_TINY_BITS = np.float64(1e-200).view(np.int64)
+#: Bit pattern of 1e-200 less one, unsigned: see the end of :func:`fullstate_values`.
+_TINY_BITS_LESS_ONE = np.float64(1e-200).view(np.uint64) - np.uint64(1)
 _MAGNITUDE_BITS = np.int64(0x7FFFFFFFFFFFFFFF)
 
 
@@ -79,7 +85,11 @@ def fullstate_values(x, out=None):
     out = np.multiply(x, scale, out=out)
     np.rint(out, out=out)
     out /= scale
-    tiny = magnitude < _TINY_BITS  # zero, or a decayed velocity too small to matter
+    # Magnitudes below 1e-200 are kept as they are. Zeros (common: objects at rest) come through the
+    # scaling unchanged, sign included, so only the nonzero ones are looked for: magnitude - 1 wraps
+    # around for zero when read as unsigned.
+    magnitude -= 1
+    tiny = magnitude.view(np.uint64) < _TINY_BITS_LESS_ONE
     if tiny.any():
         np.copyto(out, x, where=tiny)
     return out
@@ -128,24 +138,29 @@ def _segment_circle_entry(x, y, path_x, path_y, cx, cy, reach):
     return np.where(ok & (t >= 0.0) & (t <= 1.0), t, np.inf)
 
 
-def post_collisions(x, y, vx, vy, radius):
+def post_collisions(x, y, vx, vy, reach):
     """:func:`hfo_physics.post_collisions` over arrays, in place: moves ``x, y`` by ``vx, vy`` (bounced off
-    the posts) and returns the collision flags. The sweep runs only on games near a post."""
-    reach = phys.GOAL_POST_RADIUS + radius
+    the posts) and returns the collision flags. ``reach`` is the post radius plus the object's, a number
+    or an array that broadcasts against ``x`` (one per row of objects). The sweep runs only on objects
+    near a post."""
     near = np.abs(x)
     near -= phys.POST_X
     np.abs(near, out=near)
-    near_x = near <= np.abs(vx) + reach
-    np.abs(y, out=near)
-    near -= phys.POST_Y
-    np.abs(near, out=near)
-    near_x &= near <= np.abs(vy) + reach
+    limit = np.abs(vx)
+    limit += reach
+    near_x = near <= limit
     collided = np.zeros(x.shape, dtype=bool)
-    if not near_x.any():
+    i = np.flatnonzero(near_x) if near_x.any() else None
+    if i is not None:  # near a post in x: then in y? (few objects, so on their flat indices)
+        reach = np.broadcast_to(reach, x.shape).ravel()[i]
+        x, y, vx, vy, collided_flat = (v.reshape(-1) for v in (x, y, vx, vy, collided))
+        near_y = np.abs(np.abs(y[i]) - phys.POST_Y) <= np.abs(vy[i]) + reach
+        i, reach = i[near_y], reach[near_y]
+    if i is None or not i.size:
         x += vx
         y += vy
         return collided
-    i = np.flatnonzero(near_x)
+    # The sweep below works on the flat indices ``i`` of the objects near a post, each with its reach.
     sx, sy, svx, svy = x[i], y[i], vx[i], vy[i]
     cx, cy = np.copysign(phys.POST_X, sx), np.copysign(phys.POST_Y, sy)
     dx, dy = sx - cx, sy - cy
@@ -185,7 +200,7 @@ def post_collisions(x, y, vx, vy, radius):
         hit_any |= hit
     x += vx
     y += vy
-    x[i], y[i], vx[i], vy[i], collided[i] = sx + path_x, sy + path_y, svx, svy, hit_any
+    x[i], y[i], vx[i], vy[i], collided_flat[i] = sx + path_x, sy + path_y, svx, svy, hit_any
     return collided
 
 
@@ -252,9 +267,9 @@ class HalfFieldOffenseVectorEnv(gymnasium.vector.VectorEnv):
     def step(self, actions):
         if not self._started:
             raise gymnasium.error.ResetNeeded("call reset() before step()")
-        a, x0, x1 = self._parse_actions(actions)
+        a, params = self._parse_actions(actions)
         resetting = self._needs_reset
-        self._act(a, x0, x1, ~resetting)
+        self._act(a, params, ~resetting)
         status = self._advance()
         self.steps += 1
         # The games that ended last step start anew now, before the features: one pass observes all.
@@ -341,7 +356,15 @@ class HalfFieldOffenseVectorEnv(gymnasium.vector.VectorEnv):
         self._state = np.zeros((len(_STATE), n))
         for name, row in zip(_STATE, self._state):
             setattr(self, name, row)
-        for name in ("prev_bx", "prev_by", "effort", "recovery", "capacity", "pax", "pay", "bax", "bay"):
+        # (2, N) blocks of the movement: positions x and y, velocities x and y (views of the state).
+        self._xy = self._state[_PX : _BY + 1].reshape(2, 2, n)
+        self._v = self._state[_PVX : _BVY + 1].reshape(2, 2, n)
+        # Accelerations accumulated this cycle, x and y, player (row 0) and ball (row 1).
+        self._accel = np.zeros((2, 2, n))
+        (self.pax, self.bax), (self.pay, self.bay) = self._accel
+        self._rand = np.array([[self.player_rand], [self.ball_rand]])
+        self._noise_draws = np.zeros((4, n))
+        for name in ("prev_bx", "prev_by", "effort", "recovery", "capacity"):
             setattr(self, name, np.zeros(n))
         for name in ("holder", "kicked", "last_action_ok", "collided_ball", "collided_post", "bonus_paid"):
             setattr(self, name, np.zeros(n, dtype=bool))
@@ -353,8 +376,11 @@ class HalfFieldOffenseVectorEnv(gymnasium.vector.VectorEnv):
         # The body's cosine and sine change only when it turns: kept with the angle they belong to.
         self._trig_body = np.full(n, np.nan)
         self._cos_body, self._sin_body = np.zeros(n), np.zeros(n)
-        self._rows = np.zeros((self.profile.n_features, n))
-        self._spare_rows = np.zeros((self.profile.n_features, n))
+        # Two feature buffers in turn, their constant rows written once; the observation is copied
+        # from them feature by feature.
+        self._rows, self._spare_rows = (constant_rows(np.zeros((self.profile.n_features, n))) for _ in range(2))
+        self._row_lists = {id(rows): list(rows) for rows in (self._rows, self._spare_rows)}
+        self._feature_scratch = np.zeros((5, 12, n))
         self._to_goal = np.zeros(n)
 
     # --- agent-side processing and server-side commands (spec 2.3, 2.4) -------------------------
@@ -363,18 +389,18 @@ class HalfFieldOffenseVectorEnv(gymnasium.vector.VectorEnv):
         seen = self.seen
         return norm(seen[_BX] - seen[_PX], seen[_BY] - seen[_PY]) <= limit
 
-    def _act(self, a, x0, x1, active) -> None:
+    def _act(self, a, params, active) -> None:
         """Apply the agents' DASH / TURN / KICK to the ``active`` games (``HFOGame.act``)."""
         dash, turn = active & (a == phys.DASH), active & (a == phys.TURN)
         kick = active & (a == phys.KICK) & self._kickable  # the test of the features just observed
-        for accel in (self.pax, self.pay, self.bax, self.bay):
-            accel.fill(0.0)
+        self._accel.fill(0.0)
+        dash_params, turn_params, kick_params = params
         if dash.any():
-            self._dash(x0, x1, np.flatnonzero(dash))
+            self._dash(dash_params[:, 0], dash_params[:, 1], np.flatnonzero(dash))
         if turn.any():
-            self._turn(x0, np.flatnonzero(turn))
+            self._turn(turn_params[:, 0], np.flatnonzero(turn))
         if kick.any():
-            self._kick(x0, x1, np.flatnonzero(kick))
+            self._kick(kick_params[:, 0], kick_params[:, 1], np.flatnonzero(kick))
         self.kicked = kick
         self.last_action_ok = dash | turn | kick
 
@@ -384,7 +410,8 @@ class HalfFieldOffenseVectorEnv(gymnasium.vector.VectorEnv):
         steps = np.rint(_clip(direction[i], -180.0, 180.0) / phys.DASH_ANGLE_STEP)
         direction = phys.DASH_ANGLE_STEP * steps
         rate = _DASH_RATES[steps.astype(np.int64) + 4]
-        svx, svy, s_body, s_stamina = (self.seen[row, i] for row in (_PVX, _PVY, _BODY, _STAMINA))
+        seen = self.seen.take(i, axis=1)  # one gather of every row is cheaper than four
+        svx, svy, s_body, s_stamina = seen[_PVX], seen[_PVY], seen[_BODY], seen[_STAMINA]
         effort = self.effort[i]
         available = s_stamina + phys.EXTRA_STAMINA
         if (power >= 0.0).all():  # the action space's dashes; negative power dashes backwards
@@ -456,14 +483,7 @@ class HalfFieldOffenseVectorEnv(gymnasium.vector.VectorEnv):
 
     # --- one simulation cycle (spec 2.5) ----------------------------------------------------------
     def _advance(self):
-        self.collided_post = self._move(
-            self.px, self.py, self.pvx, self.pvy, self.pax, self.pay,
-            phys.PLAYER_ACCEL_MAX, phys.PLAYER_SPEED_MAX, self.player_rand, phys.PLAYER_DECAY, phys.PLAYER_SIZE,
-        )  # fmt: skip
-        self._move(
-            self.bx, self.by, self.bvx, self.bvy, self.bax, self.bay,
-            phys.BALL_ACCEL_MAX, phys.BALL_SPEED_MAX, self.ball_rand, phys.BALL_DECAY, phys.BALL_SIZE,
-        )  # fmt: skip
+        self.collided_post = self._move()[0]
         dist = norm(self.bx - self.px, self.by - self.py)
         self.collided_ball = dist < phys.TOUCH_DISTANCE
         if self.collided_ball.any():
@@ -474,38 +494,48 @@ class HalfFieldOffenseVectorEnv(gymnasium.vector.VectorEnv):
         self._sense()
         return status
 
-    def _move(self, x, y, vx, vy, ax, ay, accel_max, speed_max, rand, decay, radius):
-        """Spec 2.5.1 for one kind of object, in place; returns the post-collision flags."""
-        i = np.flatnonzero((ax != 0.0) | (ay != 0.0))  # only these accelerate: the rest keep their velocity
+    def _move(self):
+        """Spec 2.5.1 for the player and the ball at once, in place, on ``(2, N)`` blocks (row 0 the
+        player, row 1 the ball); returns the post-collision flags, same shape."""
+        x, y, vx, vy = self._xy[0], self._xy[1], self._v[0], self._v[1]
+        ax, ay = self._accel
+        # Flat indices into the (2, N) blocks: only these accelerate, the rest keep their velocity.
+        i = np.flatnonzero((ax != 0.0) | (ay != 0.0))
         if i.size:  # the limits rarely bind; where they don't, the factor 1 changes nothing
-            ax, ay = ax[i], ay[i]
+            flat_vx, flat_vy = vx.reshape(-1), vy.reshape(-1)
+            ax, ay = ax.reshape(-1)[i], ay.reshape(-1)[i]
             a = norm(ax, ay)
-            over = a > accel_max
+            over = a > _ACCEL_MAX.ravel()[i // self.num_envs]
             if over.any():
+                accel_max = _ACCEL_MAX.ravel()[i // self.num_envs]
                 shrink = np.where(over, accel_max / np.where(a > 0.0, a, 1.0), 1.0)
                 ax, ay = ax * shrink, ay * shrink
-            svx, svy = vx[i] + ax, vy[i] + ay
+            svx, svy = flat_vx[i] + ax, flat_vy[i] + ay
             speed = norm(svx, svy)
+            speed_max = _SPEED_MAX.ravel()[i // self.num_envs]
             over = speed > speed_max
             if over.any():
                 shrink = np.where(over, speed_max / np.where(speed > 0.0, speed, 1.0), 1.0)
                 svx *= shrink
                 svy *= shrink
-            vx[i], vy[i] = svx, svy
-        if rand:  # drawn for every game; only moving objects need the angle's cosine and sine
-            length = self.np_random.uniform(0.0, 1.0, self.num_envs) * rand * norm(vx, vy)
-            angle = self.np_random.uniform(-np.pi, np.pi, self.num_envs)
+            flat_vx[i], flat_vy[i] = svx, svy
+        if self.player_rand:  # drawn for every game, in the scalar order: player's length and angle, then the ball's
+            draws = self._noise_draws
+            for row in draws:
+                self.np_random.random(out=row)
+            length = draws[0::2] * self._rand
+            length *= norm(vx, vy)
             i = np.flatnonzero(length)
-            if i.size == length.size:
-                vx += length * np.cos(angle)
-                vy += length * np.sin(angle)
-            else:
-                length, angle = length[i], angle[i]
-                vx[i] += length * np.cos(angle)
-                vy[i] += length * np.sin(angle)
-        collided = post_collisions(x, y, vx, vy, radius)
-        vx *= decay
-        vy *= decay
+            if i.size:  # only moving objects need the angle's cosine and sine
+                # U(-pi, pi) as NumPy's generator draws it: low + (high - low) * u
+                angle = draws[1::2].reshape(-1)[i] * (2.0 * np.pi)
+                angle += -np.pi
+                length = length.reshape(-1)[i]
+                vx.reshape(-1)[i] += length * np.cos(angle)
+                vy.reshape(-1)[i] += length * np.sin(angle)
+        collided = post_collisions(x, y, vx, vy, _POST_REACH)
+        vx *= _DECAY
+        vy *= _DECAY
         return collided
 
     def _resolve_overlap(self, mask) -> None:
@@ -586,7 +616,7 @@ class HalfFieldOffenseVectorEnv(gymnasium.vector.VectorEnv):
         feature_rows(
             seen[_PX], seen[_PY], seen[_BX], seen[_BY], seen[_PVX:_BVX + 1], seen[_PVY:_BVY + 1], seen[_STAMINA],
             self._cos_body, self._sin_body, kickable, self.collided_ball, self.collided_post, self.last_action_ok,
-            self.profile, self._rows,
+            self.profile, self._rows, self._feature_scratch, constants=False,
         )  # fmt: skip
         self._to_goal = ball_to_goal_rows(self._rows)
 
@@ -595,7 +625,7 @@ class HalfFieldOffenseVectorEnv(gymnasium.vector.VectorEnv):
         transposition here, twice as fast as ``rows.T.astype``)."""
         obs = np.empty((self.num_envs, self.profile.n_features), dtype=np.float32)
         columns = obs.T
-        for k, row in enumerate(self._rows):
+        for k, row in enumerate(self._row_lists[id(self._rows)]):
             columns[k] = row
         return obs
 
@@ -604,7 +634,8 @@ class HalfFieldOffenseVectorEnv(gymnasium.vector.VectorEnv):
         return {"status": _STATUS_NAMES[self.status], "step": self.steps.copy(), "_status": every, "_step": every}
 
     def _parse_actions(self, actions):
-        """``(a, first parameters, second parameters)`` as arrays of shape (N,); ``ValueError`` if malformed."""
+        """``(a, (dash, turn, kick))`` as float64 arrays of shapes (N,), (N, 2), (N, 1), (N, 2);
+        ``ValueError`` if malformed, or if a game's chosen action has non-finite parameters."""
         n = self.num_envs
         expected = f"{ACTION_FORM}, batched: (a[{n}], (dash[{n}, 2], turn[{n}, 1], kick[{n}, 2]))"
         try:
@@ -618,17 +649,18 @@ class HalfFieldOffenseVectorEnv(gymnasium.vector.VectorEnv):
             raise ValueError(f"actions have shapes {shapes}; expected {expected}")
         if not (a.dtype.kind in "iu" or np.all(a == np.round(a))) or a.min() < 0 or a.max() > 2:
             raise ValueError(f"discrete actions {a.tolist()} must be integers 0 (DASH), 1 (TURN) or 2 (KICK)")
-        a = a.astype(np.int64)
+        a = a.astype(np.int64, copy=False)
         dash, turn, kick = boxes
+        # A finite sum means every parameter is finite (an overflow only sends us to the exact check).
+        if np.isfinite(dash.sum() + turn.sum() + kick.sum()):
+            return a, boxes
         x0 = np.choose(a, (dash[:, 0], turn[:, 0], kick[:, 0]))
         x1 = np.choose(a, (dash[:, 1], kick[:, 1], kick[:, 1]))
-        if np.isfinite(x0).all() and np.isfinite(x1).all():
-            return a, x0, x1
         bad = ~np.isfinite(x0) | ((a != phys.TURN) & ~np.isfinite(x1))  # a turn has no second parameter
         if bad.any():
             i = int(np.flatnonzero(bad)[0])
             raise ValueError(f"game {i}: action {int(a[i])} has non-finite parameters ({x0[i]}, {x1[i]})")
-        return a, x0, x1
+        return a, boxes
 
 
 def _per_game_options(options, n: int) -> dict:
