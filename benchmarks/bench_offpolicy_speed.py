@@ -7,9 +7,12 @@ measured ``--repeats`` times:
 - samples/s: environment samples per second during training, i.e. whole epochs of collecting and
   learning at the preset's update-to-data ratio (``learn()``'s own loop).
 
-Medians over the repeats are written as a markdown record with the command, date and machine.
+With ``--baseline REF`` the same cases also run on the package as it was at git commit ``REF`` (exported
+to a temporary directory), with the settings of the current presets. Each case runs in one worker process
+per version, and the repeats alternate between them, so both versions see the same load on a shared
+machine. Medians over the repeats are written as a markdown record with the command, date and machine.
 
-    python benchmarks/bench_offpolicy_speed.py --out benchmarks/offpolicy_speed.md
+    python benchmarks/bench_offpolicy_speed.py --baseline 3eb7877 --out benchmarks/offpolicy_speed.md
 """
 
 from __future__ import annotations
@@ -17,23 +20,24 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import datetime as dt
+import json
 import os
 import platform
 import statistics
+import subprocess
 import sys
+import tarfile
+import tempfile
 import time
-
-import torch
-
-from pamdp.algos.paddpg import PADDPG, PADDPGConfig
-from pamdp.algos.pasvg import PASVG0, PASVG0Config
+from pathlib import Path
 
 CASES = [
-    ("PASVG0", PASVG0, PASVG0Config, "paper"),
-    ("PASVG0", PASVG0, PASVG0Config, "tuned"),
-    ("PADDPG", PADDPG, PADDPGConfig, "paper"),
-    ("PADDPG", PADDPG, PADDPGConfig, "hausknecht_stone"),
+    ("PASVG0", "paper"),
+    ("PASVG0", "tuned"),
+    ("PADDPG", "paper"),
+    ("PADDPG", "hausknecht_stone"),
 ]
+REPO = Path(__file__).resolve().parents[1]
 
 
 def cpu_name() -> str:
@@ -44,55 +48,144 @@ def cpu_name() -> str:
         return platform.processor() or platform.machine()
 
 
-def measure(cls, config, n_updates: int, n_samples: int, repeats: int) -> dict:
+def config_classes():
+    from pamdp.algos.paddpg import PADDPG, PADDPGConfig
+    from pamdp.algos.pasvg import PASVG0, PASVG0Config
+
+    return {"PASVG0": (PASVG0, PASVG0Config), "PADDPG": (PADDPG, PADDPGConfig)}
+
+
+def worker(algo: str, config_json: str, n_updates: int, n_samples: int) -> int:
+    """Build and warm up one model, then measure one repeat per ``go`` line on stdin (JSON on stdout)."""
+    import torch
+
+    cls, config_class = config_classes()[algo]
+    values = json.loads(config_json)
+    known = {f.name for f in dataclasses.fields(config_class)}
+    if set(values) - known:  # a setting newer than the baseline's code: measure without it
+        print(f"{algo}: ignoring settings unknown to this version: {sorted(set(values) - known)}", file=sys.stderr)
+    config = config_class.from_dict({k: v for k, v in values.items() if k in known})
     config = dataclasses.replace(config, learning_starts=n_samples, epoch_steps=n_samples, buffer_size=200_000)
     model = cls("pamdp/Platform-v0", config)
     torch.set_num_threads(config.torch_threads)
     model.learn(n_samples, progress_bar=False)  # fills the buffer past learning_starts and warms up
-    updates, samples = [], []
-    for _ in range(repeats):
+    print(json.dumps({"ready": True}), flush=True)
+    for _ in sys.stdin:
         t = time.perf_counter()
         for _ in range(n_updates):
             model._update()
-        updates.append(n_updates / (time.perf_counter() - t))
+        updates = n_updates / (time.perf_counter() - t)
         start = model.num_timesteps
         t = time.perf_counter()
         model.learn(n_samples, progress_bar=False)
-        samples.append((model.num_timesteps - start) / (time.perf_counter() - t))
-    return {"updates_per_s": statistics.median(updates), "samples_per_s": statistics.median(samples)}
+        samples = (model.num_timesteps - start) / (time.perf_counter() - t)
+        print(json.dumps({"updates_per_s": updates, "samples_per_s": samples}), flush=True)
+    return 0
+
+
+def export_source(ref: str, dest: str) -> str:
+    """The package's ``src`` tree at git commit ``ref``, unpacked under ``dest``; returns the ``src`` path."""
+    archive = subprocess.run(["git", "-C", str(REPO), "archive", ref, "src"], check=True, capture_output=True).stdout
+    path = Path(dest) / "archive.tar"
+    path.write_bytes(archive)
+    with tarfile.open(path) as tar:
+        tar.extractall(dest, filter="data")
+    return str(Path(dest) / "src")
+
+
+def start_worker(algo: str, config: dict, args, src: str | None) -> subprocess.Popen:
+    env = dict(os.environ)
+    if src is not None:
+        env["PYTHONPATH"] = src + os.pathsep + env.get("PYTHONPATH", "")
+    cmd = [sys.executable, __file__, "--worker", algo, json.dumps(config)]
+    cmd += ["--updates", str(args.updates), "--samples", str(args.samples)]
+    proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True, env=env)
+    if json.loads(proc.stdout.readline()) != {"ready": True}:
+        raise RuntimeError(f"worker for {algo} did not start")
+    return proc
+
+
+def measure(algo: str, config: dict, args, sources: list[str | None]) -> list[dict]:
+    """Medians per source (current package: ``None``), the repeats alternating between sources."""
+    procs = [start_worker(algo, config, args, src) for src in sources]
+    runs: list[list[dict]] = [[] for _ in sources]
+    try:
+        for r in range(args.repeats):
+            order = range(len(procs)) if r % 2 == 0 else reversed(range(len(procs)))
+            for i in order:
+                procs[i].stdin.write("go\n")
+                procs[i].stdin.flush()
+                runs[i].append(json.loads(procs[i].stdout.readline()))
+    finally:
+        for proc in procs:
+            proc.stdin.close()
+            proc.wait()
+    return [{k: statistics.median(run[k] for run in rs) for k in rs[0]} for rs in runs]
 
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--updates", type=int, default=300, help="updates per repeat")
     parser.add_argument("--samples", type=int, default=1_000, help="env samples per repeat (one epoch)")
-    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--baseline", metavar="REF", help="git commit to compare with (same settings)")
     parser.add_argument("--out", default="benchmarks/offpolicy_speed.md")
+    parser.add_argument("--worker", nargs=2, metavar=("ALGO", "CONFIG"), help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
+    if args.worker:
+        return worker(*args.worker, args.updates, args.samples)
 
+    import torch
+
+    classes = config_classes()
+    head = "# Off-policy training speed (PASVG(0), PADDPG) on Platform"
+    cols = "| algorithm | preset | hidden layers | batch | num_envs | updates/sample | updates/s | samples/s |"
+    rule = "|---|---|---|---|---|---|---|---|"
+    if args.baseline:
+        ref = subprocess.run(
+            ["git", "-C", str(REPO), "rev-parse", "--short", args.baseline], check=True, capture_output=True, text=True
+        ).stdout.strip()
+        head_ref = subprocess.run(
+            ["git", "-C", str(REPO), "rev-parse", "--short", "HEAD"], check=True, capture_output=True, text=True
+        ).stdout.strip()
+        cols = (
+            "| algorithm | preset | hidden layers | batch | num_envs | updates/sample "
+            f"| updates/s at {ref} | updates/s now | speed-up | samples/s at {ref} | samples/s now |"
+        )
+        rule = "|---|---|---|---|---|---|---|---|---|---|---|"
     lines = [
-        "# Off-policy training speed (PASVG(0), PADDPG) on Platform",
+        head,
         "",
         f"- command: `python {' '.join(sys.argv)}`",
-        f"- date: {dt.datetime.now().isoformat(timespec='seconds')}",
+        f"- date: {dt.datetime.now().isoformat(timespec='seconds')}"
+        + (f"; code: HEAD {head_ref} (with any uncommitted changes) against {ref}" if args.baseline else ""),
         f"- machine: {cpu_name()}, {os.cpu_count()} CPUs (shared with other jobs), "
         f"load average at start {os.getloadavg()[0]:.1f}; Python {platform.python_version()}, "
         f"torch {torch.__version__}",
         f"- medians of {args.repeats} repeats; {args.updates} updates and {args.samples} samples per repeat; "
-        "torch threads 1; samples/s is whole training epochs (collect + learn at the preset's update-to-data ratio)",
+        "torch threads 1; samples/s is whole training epochs (collect + learn at the preset's update-to-data ratio)"
+        + ("; the two versions alternate repeat by repeat, each in its own process" if args.baseline else ""),
         "",
-        "| algorithm | preset | hidden layers | batch | num_envs | updates/sample | updates/s "
-        "| samples/s during training |",
-        "|---|---|---|---|---|---|---|---|",
+        cols,
+        rule,
     ]
-    for name, cls, config_class, preset in CASES:
-        cfg = config_class.preset(preset)
-        r = measure(cls, cfg, args.updates, args.samples, args.repeats)
-        lines.append(
-            f"| {name} | {preset} | {'-'.join(map(str, cfg.hidden_sizes))} | {cfg.batch_size} | {cfg.num_envs} | "
-            f"{cfg.updates_per_step:g} | {r['updates_per_s']:.0f} | {r['samples_per_s']:.0f} |"
-        )
-        print(lines[-1], flush=True)
+    with tempfile.TemporaryDirectory() as tmp:
+        sources = [None] + ([export_source(args.baseline, tmp)] if args.baseline else [])
+        for name, preset in CASES:
+            cfg = classes[name][1].preset(preset)
+            results = measure(name, cfg.to_dict(), args, sources)
+            cells = [name, preset, "-".join(map(str, cfg.hidden_sizes)), cfg.batch_size, cfg.num_envs]
+            cells.append(f"{cfg.updates_per_step:g}")
+            now = results[0]
+            if args.baseline:
+                base = results[1]
+                cells += [f"{base['updates_per_s']:.0f}", f"{now['updates_per_s']:.0f}"]
+                cells += [f"{now['updates_per_s'] / base['updates_per_s']:.2f}x"]
+                cells += [f"{base['samples_per_s']:.0f}", f"{now['samples_per_s']:.0f}"]
+            else:
+                cells += [f"{now['updates_per_s']:.0f}", f"{now['samples_per_s']:.0f}"]
+            lines.append("| " + " | ".join(map(str, cells)) + " |")
+            print(lines[-1], flush=True)
     os.makedirs(os.path.dirname(args.out) or ".", exist_ok=True)
     with open(args.out, "w") as f:
         f.write("\n".join(lines) + "\n")
