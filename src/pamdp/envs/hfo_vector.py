@@ -502,24 +502,26 @@ class HalfFieldOffenseVectorEnv(gymnasium.vector.VectorEnv):
         # Flat indices into the (2, N) blocks: only these accelerate, the rest keep their velocity.
         i = np.flatnonzero((ax != 0.0) | (ay != 0.0))
         if i.size:  # the limits rarely bind; where they don't, the factor 1 changes nothing
+            obj = i // self.num_envs  # 0 for the player, 1 for the ball
             flat_vx, flat_vy = vx.reshape(-1), vy.reshape(-1)
             ax, ay = ax.reshape(-1)[i], ay.reshape(-1)[i]
             a = norm(ax, ay)
-            over = a > _ACCEL_MAX.ravel()[i // self.num_envs]
+            accel_max = _ACCEL_MAX.ravel()[obj]
+            over = a > accel_max
             if over.any():
-                accel_max = _ACCEL_MAX.ravel()[i // self.num_envs]
                 shrink = np.where(over, accel_max / np.where(a > 0.0, a, 1.0), 1.0)
                 ax, ay = ax * shrink, ay * shrink
             svx, svy = flat_vx[i] + ax, flat_vy[i] + ay
             speed = norm(svx, svy)
-            speed_max = _SPEED_MAX.ravel()[i // self.num_envs]
+            speed_max = _SPEED_MAX.ravel()[obj]
             over = speed > speed_max
             if over.any():
                 shrink = np.where(over, speed_max / np.where(speed > 0.0, speed, 1.0), 1.0)
                 svx *= shrink
                 svy *= shrink
             flat_vx[i], flat_vy[i] = svx, svy
-        if self.player_rand:  # drawn for every game, in the scalar order: player's length and angle, then the ball's
+        if self.player_rand:  # the ball's noise is on or off with the player's
+            # Drawn for every game, in the scalar env's order: the player's length and angle, then the ball's.
             draws = self._noise_draws
             for row in draws:
                 self.np_random.random(out=row)
