@@ -191,7 +191,7 @@ def main() -> None:
         f"Machine: {cpu_model()}, {os.cpu_count()} cores; Python {platform.python_version()}, "
         f"NumPy {np.__version__}, Gymnasium {gymnasium.__version__}  ",
         f"Load average (1 min) before / after: {load_before:.2f} / {load_after:.2f} (other engineers' jobs "
-        "may share the cores; figures are medians of "
+        "may share the cores; figures are env steps per CPU-second of the process, medians of "
         f"{args.repeats} repeats; batched after {BATCHED_WARMUP} warm-up steps, so autoresets are included)  ",
         *([baseline] if baseline else []),
         "",
