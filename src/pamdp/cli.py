@@ -18,6 +18,7 @@ import sys
 import typing
 from pathlib import Path
 
+from pamdp._memory import keep_freed_memory
 from pamdp.experiments.runner import ALGORITHMS, RunSpec, algorithm_class, default_preset, train_run
 
 DEFAULT_TOTAL_STEPS = {"patrpo": 500_000, "pasvg0": 1_000_000, "paddpg": 1_000_000}
@@ -261,6 +262,8 @@ def cmd_render(args) -> int:
 
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
+    if args.command in ("train", "reproduce", "evaluate"):
+        keep_freed_memory()
     handlers = {
         "train": cmd_train,
         "evaluate": cmd_evaluate,

@@ -128,6 +128,9 @@ def train_run(spec: RunSpec, out: str | os.PathLike, progress_bar: bool = True, 
 def _worker(spec: RunSpec, out: str) -> dict:
     import torch
 
+    from pamdp._memory import keep_freed_memory
+
+    keep_freed_memory()  # a spawned process: the parent's allocator settings are not inherited
     torch.set_num_threads(1)
     log_file = Path(out) / "stdout.log"
     Path(out).mkdir(parents=True, exist_ok=True)
