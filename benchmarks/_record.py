@@ -82,3 +82,18 @@ def run_and_record(experiment_file: str, out_root: str, record: str, workers: in
         ]
     (HERE / record).write_text("\n".join(lines) + "\n")
     print(json.dumps({"record": str(HERE / record), "wall_minutes": wall / 60}))
+
+
+def main(experiment_file: str, doc: str, workers: int = 2) -> None:
+    """The command line every learning benchmark shares: ``[--workers N] [--scale F] [--seeds 0,1] [--out DIR]``."""
+    import argparse
+
+    p = argparse.ArgumentParser(description=doc, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--workers", type=int, default=workers)
+    p.add_argument("--scale", type=float, default=1.0)
+    p.add_argument("--seeds", default=None)
+    p.add_argument("--out", default="results/bench")
+    a = p.parse_args()
+    seeds = [int(s) for s in a.seeds.split(",")] if a.seeds else None
+    record = Path(experiment_file).with_suffix(".md").name
+    run_and_record(experiment_file, a.out, record, a.workers, a.scale, seeds)
