@@ -37,6 +37,8 @@ _ACCEL_MAX = np.array([[phys.PLAYER_ACCEL_MAX], [phys.BALL_ACCEL_MAX]])
 _SPEED_MAX = np.array([[phys.PLAYER_SPEED_MAX], [phys.BALL_SPEED_MAX]])
 _DECAY = np.array([[phys.PLAYER_DECAY], [phys.BALL_DECAY]])
 _POST_REACH = phys.GOAL_POST_RADIUS + np.array([[phys.PLAYER_SIZE], [phys.BALL_SIZE]])
+#: Games per block of the observation's transposition (:meth:`HalfFieldOffenseVectorEnv._observation`).
+_OBS_BLOCK = 128
 
 
 def normalize_angle(deg):
@@ -376,10 +378,10 @@ class HalfFieldOffenseVectorEnv(gymnasium.vector.VectorEnv):
         # The body's cosine and sine change only when it turns: kept with the angle they belong to.
         self._trig_body = np.full(n, np.nan)
         self._cos_body, self._sin_body = np.zeros(n), np.zeros(n)
-        # Two feature buffers in turn, their constant rows written once; the observation is copied
-        # from them feature by feature.
+        # Two feature buffers in turn, their constant rows written once; the observation is transposed
+        # from them through ``_blocks`` (see _observation).
         self._rows, self._spare_rows = (constant_rows(np.zeros((self.profile.n_features, n))) for _ in range(2))
-        self._row_lists = {id(rows): list(rows) for rows in (self._rows, self._spare_rows)}
+        self._blocks = np.zeros((n // _OBS_BLOCK, self.profile.n_features, _OBS_BLOCK), dtype=np.float32)
         self._feature_scratch = np.zeros((5, 12, n))
         self._to_goal = np.zeros(n)
 
@@ -523,22 +525,34 @@ class HalfFieldOffenseVectorEnv(gymnasium.vector.VectorEnv):
         if self.player_rand:  # the ball's noise is on or off with the player's
             # Drawn for every game, in the scalar env's order: the player's length and angle, then the ball's.
             draws = self._noise_draws
-            for row in draws:
-                self.np_random.random(out=row)
+            self.np_random.random(out=draws)  # the same stream as one call per row
             length = draws[0::2] * self._rand
             length *= norm(vx, vy)
-            i = np.flatnonzero(length)
-            if i.size:  # only moving objects need the angle's cosine and sine
-                # U(-pi, pi) as NumPy's generator draws it: low + (high - low) * u
-                angle = draws[1::2].reshape(-1)[i] * (2.0 * np.pi)
-                angle += -np.pi
-                length = length.reshape(-1)[i]
-                vx.reshape(-1)[i] += length * np.cos(angle)
-                vy.reshape(-1)[i] += length * np.sin(angle)
+            for obj in range(2):  # only moving objects need the angle's cosine and sine
+                self._add_noise(vx[obj], vy[obj], length[obj], draws[2 * obj + 1])
         collided = post_collisions(x, y, vx, vy, _POST_REACH)
         vx *= _DECAY
         vy *= _DECAY
         return collided
+
+    def _add_noise(self, vx, vy, length, u) -> None:
+        """Adds the vectors of ``length`` at angle U(-pi, pi) (from the uniform draws ``u``) to the
+        velocities ``vx, vy`` of one kind of object, in place, where ``length`` is not 0."""
+        moving = np.count_nonzero(length)
+        if 2 * moving > length.size:  # most of them (players always, after the first dash): whole rows
+            # U(-pi, pi) as NumPy's generator draws it: low + (high - low) * u
+            angle = u * (2.0 * np.pi)
+            angle += -np.pi
+            where = True if moving == length.size else length != 0.0  # a masked add leaves -0.0 as it is
+            np.add(vx, length * np.cos(angle), out=vx, where=where)
+            np.add(vy, length * np.sin(angle), out=vy, where=where)
+        elif moving:  # a few of them (balls, mostly at rest): on their indices
+            i = np.flatnonzero(length)
+            angle = u[i] * (2.0 * np.pi)
+            angle += -np.pi
+            length = length[i]
+            vx[i] += length * np.cos(angle)
+            vy[i] += length * np.sin(angle)
 
     def _resolve_overlap(self, mask) -> None:
         dx, dy = self.bx - self.px, self.by - self.py
@@ -623,32 +637,45 @@ class HalfFieldOffenseVectorEnv(gymnasium.vector.VectorEnv):
         self._to_goal = ball_to_goal_rows(self._rows)
 
     def _observation(self) -> np.ndarray:
-        """The ``(N, n_features)`` float32 observation: one strided copy per feature row (the fastest
-        transposition here, twice as fast as ``rows.T.astype``)."""
-        obs = np.empty((self.num_envs, self.profile.n_features), dtype=np.float32)
-        columns = obs.T
-        for k, row in enumerate(self._row_lists[id(self._rows)]):
-            columns[k] = row
+        """The ``(N, n_features)`` float32 observation, transposed from the feature rows in two passes
+        that each read and write memory in order: first every block of ``_OBS_BLOCK`` games, all rows,
+        to ``_blocks`` (contiguous runs of the rows, cast to float32), then each block, small enough
+        for the L1 cache, to its games' rows of the observation. A third faster than one strided copy.
+        The games past the last whole block (all of them when N < _OBS_BLOCK) take one strided copy."""
+        n, n_features = self.num_envs, self.profile.n_features
+        rows, blocks = self._rows, self._blocks
+        obs = np.empty((n, n_features), dtype=np.float32)
+        whole = blocks.shape[0] * _OBS_BLOCK
+        if whole:
+            runs = rows[:, :whole].reshape(n_features, -1, _OBS_BLOCK).transpose(1, 0, 2)
+            np.copyto(blocks, runs, casting="same_kind")
+            np.copyto(obs[:whole].reshape(-1, _OBS_BLOCK, n_features), blocks.transpose(0, 2, 1))
+        if whole < n:
+            np.copyto(obs[whole:], rows[:, whole:].T, casting="same_kind")
         return obs
 
     def _infos(self) -> dict:
         every = np.ones(self.num_envs, dtype=bool)
         return {"status": _STATUS_NAMES[self.status], "step": self.steps.copy(), "_status": every, "_step": every}
 
+    def _expected_actions(self) -> str:
+        """The form of a batch of actions, for error messages (formatted only when one is raised)."""
+        n = self.num_envs
+        return f"{ACTION_FORM}, batched: (a[{n}], (dash[{n}, 2], turn[{n}, 1], kick[{n}, 2]))"
+
     def _parse_actions(self, actions):
         """``(a, (dash, turn, kick))`` as float64 arrays of shapes (N,), (N, 2), (N, 1), (N, 2);
         ``ValueError`` if malformed, or if a game's chosen action has non-finite parameters."""
         n = self.num_envs
-        expected = f"{ACTION_FORM}, batched: (a[{n}], (dash[{n}, 2], turn[{n}, 1], kick[{n}, 2]))"
         try:
             a_raw, params = actions
             a = np.asarray(a_raw)
             boxes = [np.asarray(p, dtype=np.float64) for p in params]
         except (TypeError, ValueError):
-            raise ValueError(f"actions are malformed; expected {expected}") from None
+            raise ValueError(f"actions are malformed; expected {self._expected_actions()}") from None
         if a.shape != (n,) or len(boxes) != 3 or any(b.shape != (n, m) for b, m in zip(boxes, PARAM_SIZES)):
             shapes = (a.shape, tuple(b.shape for b in boxes)) if len(boxes) == 3 else a.shape
-            raise ValueError(f"actions have shapes {shapes}; expected {expected}")
+            raise ValueError(f"actions have shapes {shapes}; expected {self._expected_actions()}")
         if not (a.dtype.kind in "iu" or np.all(a == np.round(a))) or a.min() < 0 or a.max() > 2:
             raise ValueError(f"discrete actions {a.tolist()} must be integers 0 (DASH), 1 (TURN) or 2 (KICK)")
         a = a.astype(np.int64, copy=False)
