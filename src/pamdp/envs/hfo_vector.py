@@ -261,6 +261,7 @@ class HalfFieldOffenseVectorEnv(gymnasium.vector.VectorEnv):
             self.body[:] = 0.0  # a new server run, as in the scalar env
         placement = _per_game_options(options, self.num_envs)
         self._place(np.ones(self.num_envs, dtype=bool), placement)
+        self._sense()
         self._observe()
         self._needs_reset[:] = False
         self._started = True
@@ -274,10 +275,12 @@ class HalfFieldOffenseVectorEnv(gymnasium.vector.VectorEnv):
         self._act(a, params, ~resetting)
         status = self._advance()
         self.steps += 1
-        # The games that ended last step start anew now, before the features: one pass observes all.
+        # The games that ended last step start anew now, before the agents' view and the features:
+        # one pass of each covers all.
         any_resetting = resetting.any()
         if any_resetting:
             self._place(resetting, {})
+        self._sense()
         # Two feature buffers in turn: the previous step's rows are the reward's "before".
         prev, self._rows, self._spare_rows = self._rows, self._spare_rows, self._rows
         prev_to_goal = self._to_goal
@@ -349,8 +352,7 @@ class HalfFieldOffenseVectorEnv(gymnasium.vector.VectorEnv):
         self.last_action_ok[idx] = self.kicked[idx] = False
         self.steps[idx] = 0
         self.bonus_paid[idx] = False
-        self.status[idx] = phys.IN_GAME
-        self.seen[:, idx] = fullstate_values(self._state[:, idx])
+        self.status[idx] = phys.IN_GAME  # the agents' view (_sense) is left to the caller
 
     def _allocate(self) -> None:
         n = self.num_envs
@@ -493,8 +495,7 @@ class HalfFieldOffenseVectorEnv(gymnasium.vector.VectorEnv):
             dist = norm(self.bx - self.px, self.by - self.py)
         status = self._referee(dist)
         self._update_stamina()
-        self._sense()
-        return status
+        return status  # the agents' view (_sense) is taken by the caller, after placing new episodes
 
     def _move(self):
         """Spec 2.5.1 for the player and the ball at once, in place, on ``(2, N)`` blocks (row 0 the
