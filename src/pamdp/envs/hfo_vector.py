@@ -700,7 +700,7 @@ class HalfFieldOffenseVectorEnv(gymnasium.vector.VectorEnv):
         if a.shape != (n,) or len(boxes) != 3 or any(b.shape != (n, m) for b, m in zip(boxes, PARAM_SIZES)):
             shapes = (a.shape, tuple(b.shape for b in boxes)) if len(boxes) == 3 else a.shape
             raise ValueError(f"actions have shapes {shapes}; expected {self._expected_actions()}")
-        if not (a.dtype.kind in "iu" or np.all(a == np.round(a))) or a.min() < 0 or a.max() > 2:
+        if not (a.dtype.kind in "iu" or np.all(a == np.round(a))) or _any((a < 0) | (a > 2)):  # not 2 reductions
             raise ValueError(f"discrete actions {a.tolist()} must be integers 0 (DASH), 1 (TURN) or 2 (KICK)")
         a = a.astype(np.int64, copy=False)
         dash, turn, kick = boxes
