@@ -432,10 +432,8 @@ class HalfFieldOffenseVectorEnv(gymnasium.vector.VectorEnv):
         steps = np.rint(_clip(direction[i], -180.0, 180.0) / phys.DASH_ANGLE_STEP)
         direction = phys.DASH_ANGLE_STEP * steps
         rate = _DASH_RATES[steps.astype(np.int64) + 4]
-        seen = self.seen.take(i, axis=1)  # one gather of every row is cheaper than four
-        svx, svy, s_body, s_stamina = seen[_PVX], seen[_PVY], seen[_BODY], seen[_STAMINA]
         effort = self.effort[i]
-        available = s_stamina + phys.EXTRA_STAMINA
+        available = self.seen[_STAMINA, i] + phys.EXTRA_STAMINA
         if not _any(power < 0.0):  # the action space's dashes; negative power dashes backwards
             power = np.minimum(power, available)
         else:
@@ -446,6 +444,8 @@ class HalfFieldOffenseVectorEnv(gymnasium.vector.VectorEnv):
         accel = np.abs(power * accel_rate)
         capped = (seen_speed + accel > phys.PLAYER_SPEED_MAX) & (accel_rate > 0.0)
         if _any(capped):  # librcsc's speed-cap conservation; never binding with player_decay 0.4
+            seen = self.seen.take(i, axis=1)  # one gather of every row is cheaper than three
+            svx, svy, s_body = seen[_PVX], seen[_PVY], seen[_BODY]
             phi = np.radians(s_body + direction + np.where(power < 0.0, 180.0, 0.0))
             ux, uy = np.cos(phi), np.sin(phi)
             capped &= norm(svx + accel * ux, svy + accel * uy) > phys.PLAYER_SPEED_MAX
