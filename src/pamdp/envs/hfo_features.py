@@ -8,6 +8,7 @@ check the two against each other.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -72,56 +73,58 @@ SELF_SPEED_MAX = 0.46
 BALL_SPEED_MAX = 5.0
 
 
-def _directions(x, y):
+def _directions(x, y, work=None):
     """Unit vectors of the velocities (x, y) and their lengths; the zero vector's direction is (1, 0).
 
     Exact for velocities decayed to 1e-160 and below, whose squares underflow: the components are first
     divided by the larger one. (A held player's velocity decays by 0.4 per cycle for hundreds of
-    cycles; HFO takes its direction with atan2, which has no such trouble.)
+    cycles; HFO takes its direction with atan2, which has no such trouble.) ``work``, shape
+    ``(5,) + x.shape``, holds the temporaries and the three results.
     """
-    m = np.maximum(np.abs(x), np.abs(y))
+    work = np.empty((5,) + x.shape) if work is None else work
+    unit, length, m, t = work[:2], work[2], work[3], work[4]
+    np.abs(x, out=unit[0])
+    np.abs(y, out=unit[1])
+    np.maximum(unit[0], unit[1], out=m)
     any_zero = not m.min() > 0.0
     zero = m == 0.0 if any_zero else None
-    safe = m + zero if any_zero else m  # m + 0.0 is m: only the zero vectors divide by 1
-    ux, uy = x / safe, y / safe
-    length = ux * ux
-    length += uy * uy
+    safe = np.add(m, zero, out=t) if any_zero else m  # m + 0.0 is m: only the zero vectors divide by 1
+    ux, uy = unit
+    np.divide(x, safe, out=ux)
+    np.divide(y, safe, out=uy)
+    np.multiply(ux, ux, out=length)
+    np.multiply(uy, uy, out=t)
+    length += t
     np.sqrt(length, out=length)  # >= 1 where m > 0: the larger component is now +-1
     if any_zero:
-        np.add(length, zero, out=safe)
-        ux /= safe
-        uy /= safe
-        ux[zero], uy[zero] = 1.0, 0.0
+        np.add(length, zero, out=t)
+        unit /= t
+        # putmask: a third of the cost of boolean-index assignment
+        np.putmask(ux, zero, 1.0)
+        np.putmask(uy, zero, 0.0)
     else:
-        ux /= length
-        uy /= length
+        unit /= length
     length *= m
     return ux, uy, length
 
 
-def _scaled_into(x, hi, out):
-    """Spec 2.8's normalised scalar for lo = 0: [0, hi] onto [-1, 1], clipping, written to ``out``."""
-    np.maximum(x, 0.0, out=out)
-    np.minimum(out, hi, out=out)
-    out *= 2.0
-    out /= hi
-    out -= 1.0
-
-
-def _proximity_into(q, out=None):
-    """1 when touching, -1 at distance ``n`` or farther, from ``q = d / n`` (overwritten unless ``out``)."""
-    out = q if out is None else out
-    np.maximum(q, 0.0, out=out)
-    np.minimum(out, 1.0, out=out)
-    out *= -2.0  # 1 - 2q and 1 + (-2q) are the same number: negation and doubling are exact
-    out += 1.0
-    return out
-
-
 _LANDMARK_X, _LANDMARK_Y = LANDMARKS[:, :1].copy(), LANDMARKS[:, 1:].copy()
-_FLAG_ROWS = (9, 11, 12, LAST_ACTION_OK)
 _CONSTANT_ROWS = ((0, 1.0), (1, 1.0), (8, -1.0), (10, -1.0), (50, 1.0), (54, 1.0))
-_SPEED_NORMALISERS = np.array([[SELF_SPEED_MAX], [BALL_SPEED_MAX]])
+_SPEED_MAX = np.array([[SELF_SPEED_MAX], [BALL_SPEED_MAX]])
+
+
+@functools.lru_cache(maxsize=8)
+def _bounds(n: int) -> np.ndarray:
+    """Read-only rows the clips of :func:`feature_rows` compare with, for N games: -2 (12 rows), 0, the
+    stamina cap, the two speed caps. ``np.minimum`` and ``np.maximum`` run two to four times slower
+    against a scalar than against an array of the same shape."""
+    rows = np.empty((16, n))
+    rows[:12] = -2.0
+    rows[12] = 0.0
+    rows[13] = STAMINA_MAX
+    rows[14:] = _SPEED_MAX
+    rows.flags.writeable = False
+    return rows
 
 
 def constant_rows(out: np.ndarray) -> np.ndarray:
@@ -142,70 +145,94 @@ def feature_rows(
     at once. ``vx, vy`` hold the player's (row 0) and the ball's (row 1) velocity, shape ``(2, N)``;
     ``cos_t, sin_t`` are the cosine and sine of the body angle (the caller keeps them from one turn to
     the next); the rest as :func:`low_level_features`. Every number equals the scalar twin's.
-    ``scratch``, shape ``(5, 12, N)``, saves allocating the landmark temporaries on each call;
+    ``scratch``, shape ``(5, 12, N)``, saves allocating the temporaries on each call;
     ``constants=False`` leaves the constant rows as they are (a caller reusing ``out`` wrote them).
+
+    The normalisations ``2 v / hi - 1`` and ``1 - 2 min(q, 1)`` divide by ``hi / 2`` and ``-n / 2``
+    instead of doubling: halving the divisor is exact, so ``v / (hi / 2)`` is the same rounding of
+    the same quotient as ``(2 v) / hi``, and ``d / (-n / 2)`` is ``-2 (d / n)`` except below 1e-300,
+    where adding 1 gives 1 either way.
     """
+    n = px.shape[0]
+    if scratch is None:
+        scratch = np.empty((5, 12, n))
+    bounds = _bounds(n)
     if constants:
         constant_rows(out)
-    for row, flag in zip(_FLAG_ROWS, (collided_ball, collided_post, kickable, last_action_ok)):
-        if row < profile.n_features:
-            np.multiply(flag, 2.0, out=out[row])
-            out[row] -= 1.0
+    # The flags as 2 f - 1. Rows 9 to 12 in one pass: row 10 (constant -1) is set to 0 for it.
+    flags = out[9:13]
+    np.copyto(flags[0], collided_ball)
+    flags[1] = 0.0
+    np.copyto(flags[2], collided_post)
+    np.copyto(flags[3], kickable)
+    flags *= 2.0
+    flags -= 1.0
+    if LAST_ACTION_OK < profile.n_features:
+        np.multiply(last_action_ok, 2.0, out=out[LAST_ACTION_OK])
+        out[LAST_ACTION_OK] -= 1.0
     out[5], out[6] = sin_t, cos_t
-    # Own and ball velocity in one pass: direction and speed.
-    ux, uy, speed = _directions(vx, vy)
+    # Own and ball velocity in one pass: direction and speed (its temporaries in the scratch's first
+    # two rows, free until the landmarks).
+    ux, uy, speed = _directions(vx, vy, scratch[:, :2])
     # Own velocity direction relative to the body, as body minus velocity heading (sign order of HFO).
+    t = scratch[3, 0]
     np.multiply(sin_t, ux[0], out=out[2])
-    out[2] -= cos_t * uy[0]
+    np.multiply(cos_t, uy[0], out=t)
+    out[2] -= t
     np.multiply(cos_t, ux[0], out=out[3])
-    out[3] += sin_t * uy[0]
-    _scaled_into(stamina, STAMINA_MAX, out[7])
-    # The speeds are lengths, never negative: the lower clip of _scaled_into is skipped.
-    np.minimum(speed[0], SELF_SPEED_MAX, out=out[4])
-    np.minimum(speed[1], BALL_SPEED_MAX, out=out[55])
+    np.multiply(sin_t, uy[0], out=t)
+    out[3] += t
+    stamina_row = out[7]
+    np.maximum(stamina, bounds[12], out=stamina_row)
+    np.minimum(stamina_row, bounds[13], out=stamina_row)
+    stamina_row /= STAMINA_MAX / 2.0
+    stamina_row -= 1.0
+    # The speeds are lengths, never negative: no lower clip.
     speed_rows = out[4:56:51]
-    speed_rows *= 2.0
-    speed_rows /= _SPEED_NORMALISERS
+    np.minimum(speed, bounds[14:], out=speed_rows)
+    speed_rows[0] /= SELF_SPEED_MAX / 2.0
+    speed_rows[1] /= BALL_SPEED_MAX / 2.0
     speed_rows -= 1.0
     out[56], out[57] = uy[1], ux[1]  # a ball at rest has heading 0: (sin, cos) = (0, 1)
     # Landmarks (rows 0-10) and the ball (row 11): bearing heading(L - p) - body as (sin, cos), proximity.
-    n = px.shape[0]
-    dx, dy, dist, a, b = np.empty((5, 12, n)) if scratch is None else scratch
+    # dx and dy side by side, so that each step below is one call for both.
+    d, products, dist = scratch[:2], scratch[2:4], scratch[4]
+    dx, dy = d
     np.subtract(_LANDMARK_X, px, out=dx[:11])
     np.subtract(bx, px, out=dx[11])
     np.subtract(_LANDMARK_Y, py, out=dy[:11])
     np.subtract(by, py, out=dy[11])
-    np.multiply(dx, dx, out=dist)
-    np.multiply(dy, dy, out=b)
-    dist += b
+    np.multiply(d, d, out=products)
+    np.add(products[0], products[1], out=dist)
     np.sqrt(dist, out=dist)
-    zero = None if dist.min() > 0.0 else dist == 0.0
-    safe = dist if zero is None else dist + zero
-    dx /= safe
-    dy /= safe
-    if zero is not None:  # the player exactly on a landmark or the ball: heading 0
-        dx[zero], dy[zero] = 1.0, 0.0
-    np.multiply(dy, cos_t, out=a)
-    np.multiply(dx, sin_t, out=b)
-    np.subtract(a[:11], b[:11], out=out[13:46:3])
-    np.subtract(a[11], b[11], out=out[51])
-    np.multiply(dx, cos_t, out=a)
-    np.multiply(dy, sin_t, out=b)
-    np.add(a[:11], b[:11], out=out[14:46:3])
-    np.add(a[11], b[11], out=out[52])
-    dist /= profile.max_dist  # then 1 - 2 min(q, 1) as _proximity_into, q >= 0 already
-    np.minimum(dist, 1.0, out=dist)
-    dist *= -2.0
+    if dist.min() > 0.0:
+        d /= dist
+    else:  # the player exactly on a landmark or the ball: heading 0
+        zero = dist == 0.0
+        d /= np.add(dist, zero, out=products[0])
+        np.putmask(dx, zero, 1.0)
+        np.putmask(dy, zero, 0.0)
+    dx_cos, dy_cos = np.multiply(d, cos_t, out=products)
+    dx_sin, dy_sin = np.multiply(d, sin_t, out=d)
+    np.subtract(dy_cos[:11], dx_sin[:11], out=out[13:46:3])
+    np.subtract(dy_cos[11], dx_sin[11], out=out[51])
+    np.add(dx_cos[:11], dy_sin[:11], out=out[14:46:3])
+    np.add(dx_cos[11], dy_sin[11], out=out[52])
+    dist /= -profile.max_dist / 2.0  # -2 q, then 1 + max(-2 q, -2); q >= 0 already
+    np.maximum(dist, bounds[:12], out=dist)
     np.add(dist[:11], 1.0, out=out[15:46:3])
     np.add(dist[11], 1.0, out=out[53])
-    # Out-of-bounds proximities.
+    # Out-of-bounds proximities, 1 - 2 clip(q, 0, 1) as 1 + clip(-2 q, -2, 0).
     oob = out[46:50]
     oob[0] = px
     np.subtract(PITCH_HALF_LENGTH, px, out=oob[1])
     np.add(PITCH_HALF_WIDTH, py, out=oob[2])
     np.subtract(PITCH_HALF_WIDTH, py, out=oob[3])
-    oob /= np.array([[profile.oob_x], [profile.oob_x], [profile.oob_y], [profile.oob_y]])
-    _proximity_into(oob)
+    oob[:2] /= -profile.oob_x / 2.0
+    oob[2:] /= -profile.oob_y / 2.0
+    np.minimum(oob, bounds[12], out=oob)
+    np.maximum(oob, bounds[:4], out=oob)
+    oob += 1.0
     return out
 
 
