@@ -73,7 +73,7 @@ SELF_SPEED_MAX = 0.46
 BALL_SPEED_MAX = 5.0
 
 
-def _directions(x, y, work=None):
+def _directions(x, y, work):
     """Unit vectors of the velocities (x, y) and their lengths; the zero vector's direction is (1, 0).
 
     Exact for velocities decayed to 1e-160 and below, whose squares underflow: the components are first
@@ -81,25 +81,27 @@ def _directions(x, y, work=None):
     cycles; HFO takes its direction with atan2, which has no such trouble.) ``work``, shape
     ``(5,) + x.shape``, holds the temporaries and the three results.
     """
-    work = np.empty((5,) + x.shape) if work is None else work
     unit, length, m, t = work[:2], work[2], work[3], work[4]
-    np.abs(x, out=unit[0])
-    np.abs(y, out=unit[1])
-    np.maximum(unit[0], unit[1], out=m)
-    any_zero = not m.min() > 0.0
-    zero = m == 0.0 if any_zero else None
-    safe = np.add(m, zero, out=t) if any_zero else m  # m + 0.0 is m: only the zero vectors divide by 1
     ux, uy = unit
-    np.divide(x, safe, out=ux)
-    np.divide(y, safe, out=uy)
+    np.abs(x, out=ux)
+    np.abs(y, out=uy)
+    np.maximum(ux, uy, out=m)
+    any_zero = not m.min() > 0.0
+    if any_zero:  # max(m, tiny) is m but for the zero vectors, whose 0 / tiny is 0 as 0 / 1 is
+        _, _, _, _, one, tiny = _bounds(x.shape[-1])
+        np.divide(x, np.maximum(m, tiny, out=t), out=ux)
+        np.divide(y, t, out=uy)
+    else:
+        np.divide(x, m, out=ux)
+        np.divide(y, m, out=uy)
     np.multiply(ux, ux, out=length)
     np.multiply(uy, uy, out=t)
     length += t
     np.sqrt(length, out=length)  # >= 1 where m > 0: the larger component is now +-1
     if any_zero:
-        np.add(length, zero, out=t)
-        unit /= t
+        unit /= np.maximum(length, one, out=t)  # the zero vectors' length 0 divides by 1
         # putmask: a third of the cost of boolean-index assignment
+        zero = m == 0.0
         np.putmask(ux, zero, 1.0)
         np.putmask(uy, zero, 0.0)
     else:
@@ -114,17 +116,20 @@ _SPEED_MAX = np.array([[SELF_SPEED_MAX], [BALL_SPEED_MAX]])
 
 
 @functools.lru_cache(maxsize=8)
-def _bounds(n: int) -> np.ndarray:
-    """Read-only rows the clips of :func:`feature_rows` compare with, for N games: -2 (12 rows), 0, the
-    stamina cap, the two speed caps. ``np.minimum`` and ``np.maximum`` run two to four times slower
-    against a scalar than against an array of the same shape."""
-    rows = np.empty((16, n))
+def _bounds(n: int) -> tuple[np.ndarray, ...]:
+    """Read-only arrays, for N games, that :func:`feature_rows` clips against: -2 (12 rows), 0, the
+    stamina cap, the two speed caps, 1 (2 rows), the smallest positive float (2 rows). ``np.minimum``
+    and ``np.maximum`` run two to four times slower against a scalar than against an array of the
+    same shape."""
+    rows = np.empty((20, n))
     rows[:12] = -2.0
     rows[12] = 0.0
     rows[13] = STAMINA_MAX
-    rows[14:] = _SPEED_MAX
+    rows[14:16] = _SPEED_MAX
+    rows[16:18] = 1.0
+    rows[18:] = np.nextafter(0.0, 1.0)
     rows.flags.writeable = False
-    return rows
+    return rows[:12], rows[12], rows[13], rows[14:16], rows[16:18], rows[18:]
 
 
 def constant_rows(out: np.ndarray) -> np.ndarray:
@@ -156,7 +161,7 @@ def feature_rows(
     n = px.shape[0]
     if scratch is None:
         scratch = np.empty((5, 12, n))
-    bounds = _bounds(n)
+    neg_two, zeros, stamina_max, speed_max, _, _ = _bounds(n)
     if constants:
         constant_rows(out)
     # The flags as 2 f - 1. Rows 9 to 12 in one pass: row 10 (constant -1) is set to 0 for it.
@@ -183,13 +188,13 @@ def feature_rows(
     np.multiply(sin_t, uy[0], out=t)
     out[3] += t
     stamina_row = out[7]
-    np.maximum(stamina, bounds[12], out=stamina_row)
-    np.minimum(stamina_row, bounds[13], out=stamina_row)
+    np.maximum(stamina, zeros, out=stamina_row)
+    np.minimum(stamina_row, stamina_max, out=stamina_row)
     stamina_row /= STAMINA_MAX / 2.0
     stamina_row -= 1.0
     # The speeds are lengths, never negative: no lower clip.
     speed_rows = out[4:56:51]
-    np.minimum(speed, bounds[14:], out=speed_rows)
+    np.minimum(speed, speed_max, out=speed_rows)
     speed_rows[0] /= SELF_SPEED_MAX / 2.0
     speed_rows[1] /= BALL_SPEED_MAX / 2.0
     speed_rows -= 1.0
@@ -219,7 +224,7 @@ def feature_rows(
     np.add(dx_cos[:11], dy_sin[:11], out=out[14:46:3])
     np.add(dx_cos[11], dy_sin[11], out=out[52])
     dist /= -profile.max_dist / 2.0  # -2 q, then 1 + max(-2 q, -2); q >= 0 already
-    np.maximum(dist, bounds[:12], out=dist)
+    np.maximum(dist, neg_two, out=dist)
     np.add(dist[:11], 1.0, out=out[15:46:3])
     np.add(dist[11], 1.0, out=out[53])
     # Out-of-bounds proximities, 1 - 2 clip(q, 0, 1) as 1 + clip(-2 q, -2, 0).
@@ -230,8 +235,8 @@ def feature_rows(
     np.subtract(PITCH_HALF_WIDTH, py, out=oob[3])
     oob[:2] /= -profile.oob_x / 2.0
     oob[2:] /= -profile.oob_y / 2.0
-    np.minimum(oob, bounds[12], out=oob)
-    np.maximum(oob, bounds[:4], out=oob)
+    np.minimum(oob, zeros, out=oob)
+    np.maximum(oob, neg_two[:4], out=oob)
     oob += 1.0
     return out
 
