@@ -73,22 +73,22 @@ SELF_SPEED_MAX = 0.46
 BALL_SPEED_MAX = 5.0
 
 
-def _directions(x, y, work):
+def _directions(x, y, work, one, tiny):
     """Unit vectors of the velocities (x, y) and their lengths; the zero vector's direction is (1, 0).
 
     Exact for velocities decayed to 1e-160 and below, whose squares underflow: the components are first
     divided by the larger one. (A held player's velocity decays by 0.4 per cycle for hundreds of
     cycles; HFO takes its direction with atan2, which has no such trouble.) ``work``, shape
-    ``(5,) + x.shape``, holds the temporaries and the three results.
+    ``(5,) + x.shape``, holds the temporaries and the three results; ``one`` and ``tiny`` are arrays
+    of 1 and of the smallest positive float, of the shape of ``x``.
     """
     unit, length, m, t = work[:2], work[2], work[3], work[4]
-    ux, uy = unit
+    ux, uy = work[0], work[1]
     np.abs(x, out=ux)
     np.abs(y, out=uy)
     np.maximum(ux, uy, out=m)
     any_zero = not m.min() > 0.0
     if any_zero:  # max(m, tiny) is m but for the zero vectors, whose 0 / tiny is 0 as 0 / 1 is
-        _, _, _, _, one, tiny = _bounds(x.shape[-1])
         np.divide(x, np.maximum(m, tiny, out=t), out=ux)
         np.divide(y, t, out=uy)
     else:
@@ -116,20 +116,23 @@ _SPEED_MAX = np.array([[SELF_SPEED_MAX], [BALL_SPEED_MAX]])
 
 
 @functools.lru_cache(maxsize=8)
-def _bounds(n: int) -> tuple[np.ndarray, ...]:
-    """Read-only arrays, for N games, that :func:`feature_rows` clips against: -2 (12 rows), 0, the
-    stamina cap, the two speed caps, 1 (2 rows), the smallest positive float (2 rows). ``np.minimum``
-    and ``np.maximum`` run two to four times slower against a scalar than against an array of the
-    same shape."""
-    rows = np.empty((20, n))
+def _operands(n: int, profile: FeatureProfile) -> tuple[np.ndarray, ...]:
+    """Read-only arrays for N games that :func:`feature_rows` clips against or divides by: -2 (12 rows),
+    0 (4 rows), the stamina cap, the two speed caps, 1 (2 rows), the smallest positive float (2 rows),
+    half the speed caps, minus half the out-of-bounds normalisers. ``np.minimum`` and ``np.maximum``
+    run two to four times slower against a scalar than against an array of the same shape, and a
+    division by a column broadcast along the rows twice slower."""
+    rows = np.empty((29, n))
     rows[:12] = -2.0
-    rows[12] = 0.0
-    rows[13] = STAMINA_MAX
-    rows[14:16] = _SPEED_MAX
-    rows[16:18] = 1.0
-    rows[18:] = np.nextafter(0.0, 1.0)
+    rows[12:16] = 0.0
+    rows[16] = STAMINA_MAX
+    rows[17:19] = _SPEED_MAX
+    rows[19:21] = 1.0
+    rows[21:23] = np.nextafter(0.0, 1.0)
+    rows[23:25] = _SPEED_MAX / 2.0
+    rows[25:29] = -0.5 * np.array([[profile.oob_x], [profile.oob_x], [profile.oob_y], [profile.oob_y]])
     rows.flags.writeable = False
-    return rows[:12], rows[12], rows[13], rows[14:16], rows[16:18], rows[18:]
+    return rows[:12], rows[12:16], rows[16], rows[17:19], rows[19:21], rows[21:23], rows[23:25], rows[25:29]
 
 
 def constant_rows(out: np.ndarray) -> np.ndarray:
@@ -161,7 +164,7 @@ def feature_rows(
     n = px.shape[0]
     if scratch is None:
         scratch = np.empty((5, 12, n))
-    neg_two, zeros, stamina_max, speed_max, _, _ = _bounds(n)
+    neg_two, zeros, stamina_max, speed_max, one, tiny, speed_halves, oob_divisors = _operands(n, profile)
     if constants:
         constant_rows(out)
     # The flags as 2 f - 1. Rows 9 to 12 in one pass: row 10 (constant -1) is set to 0 for it.
@@ -178,7 +181,7 @@ def feature_rows(
     out[5], out[6] = sin_t, cos_t
     # Own and ball velocity in one pass: direction and speed (its temporaries in the scratch's first
     # two rows, free until the landmarks).
-    ux, uy, speed = _directions(vx, vy, scratch[:, :2])
+    ux, uy, speed = _directions(vx, vy, scratch[:, :2], one, tiny)
     # Own velocity direction relative to the body, as body minus velocity heading (sign order of HFO).
     t = scratch[3, 0]
     np.multiply(sin_t, ux[0], out=out[2])
@@ -188,21 +191,20 @@ def feature_rows(
     np.multiply(sin_t, uy[0], out=t)
     out[3] += t
     stamina_row = out[7]
-    np.maximum(stamina, zeros, out=stamina_row)
+    np.maximum(stamina, zeros[0], out=stamina_row)
     np.minimum(stamina_row, stamina_max, out=stamina_row)
     stamina_row /= STAMINA_MAX / 2.0
     stamina_row -= 1.0
     # The speeds are lengths, never negative: no lower clip.
     speed_rows = out[4:56:51]
     np.minimum(speed, speed_max, out=speed_rows)
-    speed_rows[0] /= SELF_SPEED_MAX / 2.0
-    speed_rows[1] /= BALL_SPEED_MAX / 2.0
+    speed_rows /= speed_halves
     speed_rows -= 1.0
     out[56], out[57] = uy[1], ux[1]  # a ball at rest has heading 0: (sin, cos) = (0, 1)
     # Landmarks (rows 0-10) and the ball (row 11): bearing heading(L - p) - body as (sin, cos), proximity.
     # dx and dy side by side, so that each step below is one call for both.
     d, products, dist = scratch[:2], scratch[2:4], scratch[4]
-    dx, dy = d
+    dx, dy = d[0], d[1]
     np.subtract(_LANDMARK_X, px, out=dx[:11])
     np.subtract(bx, px, out=dx[11])
     np.subtract(_LANDMARK_Y, py, out=dy[:11])
@@ -217,8 +219,10 @@ def feature_rows(
         d /= np.add(dist, zero, out=products[0])
         np.putmask(dx, zero, 1.0)
         np.putmask(dy, zero, 0.0)
-    dx_cos, dy_cos = np.multiply(d, cos_t, out=products)
-    dx_sin, dy_sin = np.multiply(d, sin_t, out=d)
+    np.multiply(d, cos_t, out=products)
+    dx_cos, dy_cos = products[0], products[1]
+    np.multiply(d, sin_t, out=d)
+    dx_sin, dy_sin = d[0], d[1]
     np.subtract(dy_cos[:11], dx_sin[:11], out=out[13:46:3])
     np.subtract(dy_cos[11], dx_sin[11], out=out[51])
     np.add(dx_cos[:11], dy_sin[:11], out=out[14:46:3])
@@ -233,8 +237,7 @@ def feature_rows(
     np.subtract(PITCH_HALF_LENGTH, px, out=oob[1])
     np.add(PITCH_HALF_WIDTH, py, out=oob[2])
     np.subtract(PITCH_HALF_WIDTH, py, out=oob[3])
-    oob[:2] /= -profile.oob_x / 2.0
-    oob[2:] /= -profile.oob_y / 2.0
+    oob /= oob_divisors
     np.minimum(oob, zeros, out=oob)
     np.maximum(oob, neg_two[:4], out=oob)
     oob += 1.0
