@@ -121,7 +121,7 @@ def _operands(n: int, profile: FeatureProfile) -> tuple[np.ndarray, ...]:
     0 (4 rows), the stamina cap, the two speed caps, 1 (2 rows), the smallest positive float (2 rows),
     half the speed caps, minus half the out-of-bounds normalisers. ``np.minimum`` and ``np.maximum``
     run two to four times slower against a scalar than against an array of the same shape, and a
-    division by a column broadcast along the rows twice slower."""
+    division by a column broadcast along the rows half as fast."""
     rows = np.empty((29, n))
     rows[:12] = -2.0
     rows[12:16] = 0.0
