@@ -11,6 +11,7 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -115,14 +116,27 @@ _CONSTANT_ROWS = ((0, 1.0), (1, 1.0), (8, -1.0), (10, -1.0), (50, 1.0), (54, 1.0
 _SPEED_MAX = np.array([[SELF_SPEED_MAX], [BALL_SPEED_MAX]])
 
 
+class _Operands(NamedTuple):
+    """Read-only arrays for N games that :func:`feature_rows` clips against, divides by or subtracts
+    from. ``np.minimum`` and ``np.maximum`` run two to four times slower against a scalar than against
+    an array of the same shape, and an operation with a column broadcast along the rows a third to
+    half as fast."""
+
+    neg_two: np.ndarray  # 12 rows
+    zeros: np.ndarray  # 4 rows
+    stamina_max: np.ndarray
+    speed_max: np.ndarray  # own, ball
+    one: np.ndarray  # 2 rows
+    tiny: np.ndarray  # 2 rows of the smallest positive float
+    speed_halves: np.ndarray  # half the speed caps
+    oob_divisors: np.ndarray  # minus half the out-of-bounds normalisers
+    landmark_x: np.ndarray  # 11 rows
+    landmark_y: np.ndarray
+
+
 @functools.lru_cache(maxsize=8)
-def _operands(n: int, profile: FeatureProfile) -> tuple[np.ndarray, ...]:
-    """Read-only arrays for N games that :func:`feature_rows` clips against or divides by: -2 (12 rows),
-    0 (4 rows), the stamina cap, the two speed caps, 1 (2 rows), the smallest positive float (2 rows),
-    half the speed caps, minus half the out-of-bounds normalisers. ``np.minimum`` and ``np.maximum``
-    run two to four times slower against a scalar than against an array of the same shape, and a
-    division by a column broadcast along the rows half as fast."""
-    rows = np.empty((29, n))
+def _operands(n: int, profile: FeatureProfile) -> _Operands:
+    rows = np.empty((51, n))
     rows[:12] = -2.0
     rows[12:16] = 0.0
     rows[16] = STAMINA_MAX
@@ -131,8 +145,13 @@ def _operands(n: int, profile: FeatureProfile) -> tuple[np.ndarray, ...]:
     rows[21:23] = np.nextafter(0.0, 1.0)
     rows[23:25] = _SPEED_MAX / 2.0
     rows[25:29] = -0.5 * np.array([[profile.oob_x], [profile.oob_x], [profile.oob_y], [profile.oob_y]])
+    rows[29:40] = _LANDMARK_X
+    rows[40:51] = _LANDMARK_Y
     rows.flags.writeable = False
-    return rows[:12], rows[12:16], rows[16], rows[17:19], rows[19:21], rows[21:23], rows[23:25], rows[25:29]
+    return _Operands(
+        rows[:12], rows[12:16], rows[16], rows[17:19], rows[19:21], rows[21:23], rows[23:25], rows[25:29],
+        rows[29:40], rows[40:51],
+    )  # fmt: skip
 
 
 def constant_rows(out: np.ndarray) -> np.ndarray:
@@ -164,7 +183,7 @@ def feature_rows(
     n = px.shape[0]
     if scratch is None:
         scratch = np.empty((5, 12, n))
-    neg_two, zeros, stamina_max, speed_max, one, tiny, speed_halves, oob_divisors = _operands(n, profile)
+    ops = _operands(n, profile)
     if constants:
         constant_rows(out)
     # The flags as 2 f - 1. Rows 9 to 12 in one pass: row 10 (constant -1) is set to 0 for it.
@@ -181,7 +200,7 @@ def feature_rows(
     out[5], out[6] = sin_t, cos_t
     # Own and ball velocity in one pass: direction and speed (its temporaries in the scratch's first
     # two rows, free until the landmarks).
-    ux, uy, speed = _directions(vx, vy, scratch[:, :2], one, tiny)
+    ux, uy, speed = _directions(vx, vy, scratch[:, :2], ops.one, ops.tiny)
     # Own velocity direction relative to the body, as body minus velocity heading (sign order of HFO).
     t = scratch[3, 0]
     np.multiply(sin_t, ux[0], out=out[2])
@@ -191,23 +210,23 @@ def feature_rows(
     np.multiply(sin_t, uy[0], out=t)
     out[3] += t
     stamina_row = out[7]
-    np.maximum(stamina, zeros[0], out=stamina_row)
-    np.minimum(stamina_row, stamina_max, out=stamina_row)
+    np.maximum(stamina, ops.zeros[0], out=stamina_row)
+    np.minimum(stamina_row, ops.stamina_max, out=stamina_row)
     stamina_row /= STAMINA_MAX / 2.0
     stamina_row -= 1.0
     # The speeds are lengths, never negative: no lower clip.
     speed_rows = out[4:56:51]
-    np.minimum(speed, speed_max, out=speed_rows)
-    speed_rows /= speed_halves
+    np.minimum(speed, ops.speed_max, out=speed_rows)
+    speed_rows /= ops.speed_halves
     speed_rows -= 1.0
     out[56], out[57] = uy[1], ux[1]  # a ball at rest has heading 0: (sin, cos) = (0, 1)
     # Landmarks (rows 0-10) and the ball (row 11): bearing heading(L - p) - body as (sin, cos), proximity.
     # dx and dy side by side, so that each step below is one call for both.
     d, products, dist = scratch[:2], scratch[2:4], scratch[4]
     dx, dy = d[0], d[1]
-    np.subtract(_LANDMARK_X, px, out=dx[:11])
+    np.subtract(ops.landmark_x, px, out=dx[:11])
     np.subtract(bx, px, out=dx[11])
-    np.subtract(_LANDMARK_Y, py, out=dy[:11])
+    np.subtract(ops.landmark_y, py, out=dy[:11])
     np.subtract(by, py, out=dy[11])
     np.multiply(d, d, out=products)
     np.add(products[0], products[1], out=dist)
@@ -228,7 +247,7 @@ def feature_rows(
     np.add(dx_cos[:11], dy_sin[:11], out=out[14:46:3])
     np.add(dx_cos[11], dy_sin[11], out=out[52])
     dist /= -profile.max_dist / 2.0  # -2 q, then 1 + max(-2 q, -2); q >= 0 already
-    np.maximum(dist, neg_two, out=dist)
+    np.maximum(dist, ops.neg_two, out=dist)
     np.add(dist[:11], 1.0, out=out[15:46:3])
     np.add(dist[11], 1.0, out=out[53])
     # Out-of-bounds proximities, 1 - 2 clip(q, 0, 1) as 1 + clip(-2 q, -2, 0).
@@ -237,9 +256,9 @@ def feature_rows(
     np.subtract(PITCH_HALF_LENGTH, px, out=oob[1])
     np.add(PITCH_HALF_WIDTH, py, out=oob[2])
     np.subtract(PITCH_HALF_WIDTH, py, out=oob[3])
-    oob /= oob_divisors
-    np.minimum(oob, zeros, out=oob)
-    np.maximum(oob, neg_two[:4], out=oob)
+    oob /= ops.oob_divisors
+    np.minimum(oob, ops.zeros, out=oob)
+    np.maximum(oob, ops.neg_two[:4], out=oob)
     oob += 1.0
     return out
 
