@@ -1,6 +1,6 @@
-"""PASVG(0) on Platform, tuned preset, 4 seeds x 300k samples: curves, greedy returns, wall time.
+"""PASVG(0) on Platform, tuned preset, 5 seeds x 300k samples: curves, greedy returns, wall time.
 
-    python benchmarks/bench_pasvg_platform.py [--workers 1] [--scale 1.0] [--seeds 0,1,2,3] [--out DIR]
+    python benchmarks/bench_pasvg_platform.py [--workers 1] [--scale 1.0] [--seeds 0,1,2,3,4] [--out DIR]
 
 Writes benchmarks/pasvg_platform.md and benchmarks/results/pasvg_platform.png; the runs themselves go to
 results/bench (not committed) and resume if interrupted.
