@@ -104,6 +104,8 @@ def test_parameters_stay_in_bounds_and_unused_ones_are_zero():
         ({"updates_per_step": -1.0}, "updates_per_step = -1.0"),
         ({"activation": "swish"}, "activation = 'swish'"),
         ({"policy_lr": float("inf")}, "policy_lr = inf"),
+        ({"target_entropy": -0.1, "entropy_coef": 0.1}, "target_entropy = -0.1"),
+        ({"target_entropy": 0.5, "entropy_coef": 0.0}, "entropy_coef = 0.0"),
     ],
 )
 def test_bad_settings_raise_clear_errors(kwargs, match):
@@ -180,6 +182,31 @@ def test_save_load_predict_round_trip(tmp_path, save_replay):
         np.testing.assert_array_equal(loaded.replay.data["eta_a"][:200], model.replay.data["eta_a"][:200])
     loaded.learn(200, progress_bar=False)  # resumes: refills (or keeps) the buffer and goes on
     assert loaded.num_timesteps >= 400
+
+
+def test_target_entropy_above_ln_k_is_refused():
+    with pytest.raises(ValueError, match=r"target_entropy = 1.2; expected at most ln K = 1.0986"):
+        PASVG0("pamdp/Platform-v0", dataclasses.replace(SMALL, target_entropy=1.2, entropy_coef=0.1))
+
+
+@pytest.mark.parametrize("peaked, target, direction", [(False, 0.05, -1), (True, 1.0, 1)])
+def test_entropy_weight_moves_towards_the_target(tmp_path, peaked, target, direction):
+    # pi_d starts near uniform (entropy ~ln 3 = 1.10), far above a target of 0.05: the weight must fall at
+    # each update. Made peaked (logits 8, 0, 0: entropy ~0.003), it is far below a target of 1.0: it must rise.
+    cfg = dataclasses.replace(SMALL, target_entropy=target, entropy_coef=0.1, entropy_lr=0.01, learning_starts=64)
+    model = PASVG0("pamdp/Platform-v0", cfg)
+    if peaked:
+        with torch.no_grad():
+            model.policy.pi_d[-1].bias.copy_(torch.tensor([8.0, 0.0, 0.0]))
+    stats = []
+    model.learn(200, progress_bar=False, callback=lambda m, s: stats.append(s))
+    updates = sum(s["train/updates"] for s in stats)
+    change = float(model.entropy_weight.log_alpha.detach()) - np.log(0.1)
+    # Each Adam step moves log alpha by about entropy_lr in the sign of (target - entropy).
+    assert direction * change > 0.5 * 0.01 * updates > 0, (change, updates)
+    model.save(tmp_path / "m.pt")
+    loaded = PASVG0.load(tmp_path / "m.pt")
+    assert torch.equal(loaded.entropy_weight.log_alpha.detach(), model.entropy_weight.log_alpha.detach())
 
 
 def test_critic_loss_falls_on_a_fixed_batch():

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import math
 
 import numpy as np
 import torch
@@ -62,8 +63,16 @@ class PASVG0Config(AlgoConfig):
     )
     learn_std: bool = setting(True, "Train the parameter noise's log-std by the value gradient too (SVG); else fixed.")
     entropy_coef: float = setting(
-        0.0, "Weight of pi_d's entropy in the policy loss (0 in the paper); keeps the discrete choice exploring."
+        0.0,
+        "Weight of pi_d's entropy in the policy loss (0 in the paper); keeps the discrete choice exploring. "
+        "With target_entropy set, the weight's starting value.",
     )
+    target_entropy: float | None = setting(
+        None,
+        "If set, the entropy weight is tuned (as in SAC) to hold pi_d's mean entropy at this many nats, "
+        "between 0 and ln K; None keeps entropy_coef fixed.",
+    )
+    entropy_lr: float = setting(3e-4, "Adam learning rate of the log entropy weight when target_entropy is set.")
     critic_lr: float = setting(1e-3, "Adam learning rate of the critic (paper: 1e-3).")
     policy_lr: float = setting(1e-5, "Adam learning rate of pi_d and pi_c (paper: 1e-5, which learns slowly).")
     batch_size: int = setting(64, "Transitions per gradient update (DDPG's 64; the paper does not say).")
@@ -93,6 +102,10 @@ class PASVG0Config(AlgoConfig):
             LOG_STD_MIN <= self.init_log_std <= LOG_STD_MAX, "init_log_std", f"in [{LOG_STD_MIN}, {LOG_STD_MAX}]"
         )
         self._check(self.entropy_coef >= 0, "entropy_coef", "a non-negative number")
+        if self.target_entropy is not None:
+            self._check(self.target_entropy >= 0, "target_entropy", "None or a non-negative entropy in nats")
+            self._check(self.entropy_coef > 0, "entropy_coef", "a positive starting weight when target_entropy is set")
+        self._check(self.entropy_lr > 0, "entropy_lr", "a positive learning rate")
         self._check(self.critic_lr > 0, "critic_lr", "a positive learning rate")
         self._check(self.policy_lr > 0, "policy_lr", "a positive learning rate")
         self._check(self.batch_size >= 1, "batch_size", "an integer >= 1")
@@ -195,6 +208,22 @@ class GumbelHybridPolicy(nn.Module):
         return index, torch.tanh(self.pi_c(torch.cat([obs, onehot], dim=-1))) * self.mask[index]
 
 
+class EntropyWeight(nn.Module):
+    """The weight ``alpha = exp(log_alpha)`` of ``pi_d``'s entropy, tuned towards a target entropy (SAC's rule).
+
+    Its loss ``log_alpha * (H - target)`` lowers the weight while ``pi_d``'s entropy ``H`` is above the target
+    and raises it below, so the discrete policy keeps exploring about as much as asked, however the critic's
+    values scale.
+    """
+
+    def __init__(self, initial: float):
+        super().__init__()
+        self.log_alpha = nn.Parameter(torch.tensor(math.log(initial), dtype=torch.float32))
+
+    def forward(self) -> torch.Tensor:
+        return self.log_alpha.exp()
+
+
 class Critic(nn.Module):
     """``Q(s, a, x)`` with the discrete action as a one-hot (or soft sample) ``a``."""
 
@@ -223,6 +252,15 @@ class PASVG0(Algorithm):
         self.policy_params = [p for p in self.policy.parameters() if p.requires_grad]
         self.policy_optimizer = torch.optim.Adam(self.policy_params, lr=cfg.policy_lr, fused=True)
         self.critic_optimizer = torch.optim.Adam(self.critic.parameters(), lr=cfg.critic_lr, fused=True)
+        self.entropy_weight = self.entropy_optimizer = None
+        if cfg.target_entropy is not None:
+            if cfg.target_entropy > math.log(h.n_actions):
+                raise ValueError(
+                    f"PASVG0Config.target_entropy = {cfg.target_entropy!r}; expected at most ln K = "
+                    f"{math.log(h.n_actions):.4f} nats for this env's K = {h.n_actions} actions"
+                )
+            self.entropy_weight = EntropyWeight(cfg.entropy_coef)
+            self.entropy_optimizer = torch.optim.Adam(self.entropy_weight.parameters(), lr=cfg.entropy_lr)
         K, m, d = h.n_actions, h.max_param_size, self.obs_dim
         fields = {
             "obs": ((d,), np.float32),
@@ -239,15 +277,21 @@ class PASVG0(Algorithm):
         self.loop = OffPolicyLoop(h, self.replay, cfg.gamma)
 
     def _modules(self):
-        return {
+        modules = {
             "policy": self.policy,
             "critic": self.critic,
             "policy_target": self.policy_target,
             "critic_target": self.critic_target,
         }
+        if self.entropy_weight is not None:
+            modules["entropy_weight"] = self.entropy_weight
+        return modules
 
     def _optimizers(self):
-        return {"policy": self.policy_optimizer, "critic": self.critic_optimizer}
+        optimizers = {"policy": self.policy_optimizer, "critic": self.critic_optimizer}
+        if self.entropy_optimizer is not None:
+            optimizers["entropy_weight"] = self.entropy_optimizer
+        return optimizers
 
     def _extra_state(self):
         return {"loop": self.loop.state_dict(self.config.save_replay)}
@@ -310,13 +354,19 @@ class PASVG0(Algorithm):
         logits, _, a, x = self.policy.sample(obs, b["eta_a"], b["eta_x"], cfg.temperature, cfg.straight_through)
         q_pi = self.critic(obs, a, x)
         entropy = -(logits.softmax(-1) * logits.log_softmax(-1)).sum(-1).mean()
-        actor_loss = -q_pi.mean() - cfg.entropy_coef * entropy
+        alpha = cfg.entropy_coef if self.entropy_weight is None else float(self.entropy_weight().detach())
+        actor_loss = -q_pi.mean() - alpha * entropy
         # The policy loss differentiates Q in (a, x) only: asking for the policy's gradients alone skips the
         # critic's weight gradients, which backward() would compute and the critic must not receive.
         grads = torch.autograd.grad(actor_loss, self.policy_params)
         for p, g in zip(self.policy_params, grads):
             p.grad = g
         self._step(self.policy_optimizer, self.policy_params)
+        if self.entropy_weight is not None:
+            alpha_loss = self.entropy_weight.log_alpha * (float(entropy.detach()) - cfg.target_entropy)
+            self.entropy_optimizer.zero_grad(set_to_none=True)
+            alpha_loss.backward()
+            self.entropy_optimizer.step()
 
         soft_update(self.critic_target, self.critic, cfg.tau)
         soft_update(self.policy_target, self.policy, cfg.tau)
@@ -327,5 +377,6 @@ class PASVG0(Algorithm):
             "train/q_mean": float(q.detach().mean()),
             "train/q_pi_mean": float(q_pi.detach().mean()),
             "train/entropy": float(entropy.detach()),
+            "train/entropy_coef": alpha,
             "train/param_std": float(self.policy.log_std.detach().exp()[mask].mean()),
         }
