@@ -163,6 +163,25 @@ def test_same_seed_gives_identical_first_epoch():
     assert not torch.equal(runs[0], runs[2])
 
 
+def test_greedy_evaluations_during_training_are_logged_and_leave_training_unchanged(tmp_path):
+    plain = PASVG0("pamdp/Platform-v0", SMALL)
+    plain.learn(400, progress_bar=False)
+    evaluated = PASVG0("pamdp/Platform-v0", SMALL)
+    stats = []
+    evaluated.learn(
+        400, progress_bar=False, run_dir=tmp_path, eval_every=1, eval_episodes=7, callback=lambda m, s: stats.append(s)
+    )
+    torch.testing.assert_close(flat_params(plain), flat_params(evaluated), rtol=0, atol=0)
+    assert len(stats) == 2 and all(0 <= s["eval/mean_return"] <= 1 for s in stats)
+    # The logged figure is a greedy evaluation of the model as it was after that epoch: the same call reproduces it.
+    from pamdp.evaluation import evaluate
+
+    assert stats[-1]["eval/mean_return"] == evaluate(evaluated, episodes=7, seed=10_000)["mean_return"]
+    assert "eval/mean_return" in (tmp_path / "progress.csv").read_text().splitlines()[0]
+    with pytest.raises(ValueError, match="eval_every = -1"):
+        plain.learn(10, eval_every=-1)
+
+
 @pytest.mark.parametrize("save_replay", [False, True])
 def test_save_load_predict_round_trip(tmp_path, save_replay):
     model = PASVG0("pamdp/Platform-v0", dataclasses.replace(SMALL, save_replay=save_replay))

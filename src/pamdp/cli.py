@@ -112,6 +112,12 @@ def build_parser() -> argparse.ArgumentParser:
         p.add_argument(
             "--eval-episodes", type=int, default=1000, help="greedy evaluation episodes at the end (0: none)"
         )
+        p.add_argument(
+            "--eval-every",
+            type=int,
+            default=0,
+            help="epochs between greedy evaluations of 100 episodes during training, logged as eval/* (0: none)",
+        )
         p.add_argument("--no-progress", action="store_true", help="no progress bar")
         _add_config_flags(p, cls.config_class)
 
@@ -156,12 +162,23 @@ def _train_spec(args, cls) -> RunSpec:
     total = args.total_steps if args.total_steps is not None else DEFAULT_TOTAL_STEPS[args.algo]
     if total < 0:
         raise ValueError(f"--total-steps {total}; expected a non-negative number of steps")
+    if args.eval_every < 0:
+        raise ValueError(f"--eval-every {args.eval_every}; expected a non-negative number of epochs (0: none)")
     settings = {**file_values, **flags}
     if args.env_kwargs is not None and not isinstance(args.env_kwargs, dict):
         raise ValueError(f"--env-kwargs {args.env_kwargs!r}; expected a JSON object")
     env_kwargs = tuple(sorted((args.env_kwargs or {}).items()))
     return RunSpec(
-        args.algo, args.env, total, seed, preset, tuple(sorted(settings.items())), args.eval_episodes, "", env_kwargs
+        args.algo,
+        args.env,
+        total,
+        seed,
+        preset,
+        tuple(sorted(settings.items())),
+        args.eval_episodes,
+        "",
+        env_kwargs,
+        args.eval_every,
     )
 
 

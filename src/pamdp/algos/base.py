@@ -415,6 +415,8 @@ class Algorithm:
         progress_bar: bool = True,
         run_dir: str | os.PathLike | None = None,
         checkpoint_every: int = 1,
+        eval_every: int = 0,
+        eval_episodes: int = 100,
     ) -> Algorithm:
         """Train for ``total_timesteps`` more environment steps, in whole epochs.
 
@@ -424,11 +426,19 @@ class Algorithm:
             progress_bar: show a tqdm progress bar on the terminal.
             run_dir: where to write ``progress.csv``, TensorBoard logs (``tb/``) and ``checkpoint.pt``.
             checkpoint_every: epochs between checkpoints (with ``run_dir``).
+            eval_every: epochs between greedy evaluations (0: none), logged as ``eval/mean_return`` (and
+                ``eval/goal_rate`` on Half Field Offense). They play ``eval_episodes`` episodes on separate
+                env copies seeded ``10_000 + seed`` and draw nothing from the training's random streams.
         """
         from tqdm.auto import tqdm
 
         if total_timesteps < 0:
             raise ValueError(f"total_timesteps = {total_timesteps!r}; expected a non-negative integer")
+        if eval_every < 0 or (eval_every > 0 and eval_episodes < 1):
+            raise ValueError(
+                f"eval_every = {eval_every!r}, eval_episodes = {eval_episodes!r}; expected eval_every >= 0 "
+                "and, when it is positive, eval_episodes >= 1"
+            )
         torch.set_num_threads(self.config.torch_threads)
         target = self.num_timesteps + int(total_timesteps)
         logger = Logger(run_dir, resume_step=self.num_timesteps) if run_dir is not None else None
@@ -455,6 +465,8 @@ class Algorithm:
                         "charts/SPS": (self.num_timesteps - start_steps) / (time.perf_counter() - start_time),
                     }
                 )
+                if eval_every > 0 and self.epoch % eval_every == 0:
+                    stats.update(self._greedy_evaluation(eval_episodes))
                 if logger is not None:
                     logger.record(stats, self.num_timesteps)
                     if self.epoch % checkpoint_every == 0:
@@ -469,6 +481,17 @@ class Algorithm:
             if logger is not None:
                 logger.close()
         return self
+
+    def _greedy_evaluation(self, episodes: int) -> dict[str, float]:
+        from pamdp.evaluation import evaluate
+
+        if self.env_id is None:
+            raise ValueError("eval_every needs a registered env (an env id); this model's env has none")
+        result = evaluate(self, episodes=episodes, seed=10_000 + self.config.seed)
+        stats = {"eval/mean_return": result["mean_return"], "eval/mean_length": result["mean_length"]}
+        if "goal_rate" in result:
+            stats["eval/goal_rate"] = result["goal_rate"]
+        return stats
 
     def save(self, path: str | os.PathLike) -> None:
         """Write weights, optimiser states, settings, counters and RNG states to one file, atomically."""

@@ -33,6 +33,7 @@ class Experiment:
     eval_episodes: int
     runs: tuple[dict, ...]
     env_kwargs: dict = dataclasses.field(default_factory=dict)
+    eval_every: int = 0
 
     def specs(self, seeds=None, scale: float = 1.0) -> list[RunSpec]:
         """One :class:`RunSpec` per (run, seed); ``scale`` multiplies the step budget."""
@@ -55,6 +56,7 @@ class Experiment:
                         self.eval_episodes,
                         run["label"],
                         env_kwargs,
+                        self.eval_every,
                     )
                 )
         return out
@@ -93,4 +95,5 @@ def load_experiment(name_or_path: str | os.PathLike) -> Experiment:
         int(data.get("eval_episodes", 1000)),
         tuple(data["runs"]),
         dict(data.get("env_kwargs", {})),
+        int(data.get("eval_every", 0)),
     )

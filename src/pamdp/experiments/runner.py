@@ -66,6 +66,7 @@ class RunSpec:
     eval_episodes: int = 1000
     label: str = ""
     env_kwargs: tuple[tuple[str, Any], ...] = ()
+    eval_every: int = 0  # epochs between greedy evaluations of 100 episodes during training (0: none)
 
     def config(self):
         cls = algorithm_class(self.algo)
@@ -115,7 +116,12 @@ def train_run(spec: RunSpec, out: str | os.PathLike, progress_bar: bool = True, 
         model = cls(spec.env, config, env_kwargs=dict(spec.env_kwargs))
     run_file.write_text(json.dumps({**run_info, "command": sys.argv}, indent=2))
     start = time.time()
-    model.learn(max(spec.total_steps - model.num_timesteps, 0), progress_bar=progress_bar, run_dir=out)
+    model.learn(
+        max(spec.total_steps - model.num_timesteps, 0),
+        progress_bar=progress_bar,
+        run_dir=out,
+        eval_every=spec.eval_every,
+    )
     model.save(out / FINAL_MODEL)
     log(f"trained {model.num_timesteps:,} steps in {time.time() - start:.0f} s; model in {out / FINAL_MODEL}")
     if spec.eval_episodes <= 0:
