@@ -14,6 +14,10 @@ Random numbers are never drawn here: the env draws them from its own generator, 
 order and amounts, and passes them in. Two draws depend on the state mid-step (a player and ball at
 exactly the same spot, after the movement or after a placement), so the step is two kernels,
 :func:`act_and_move` and :func:`finish_step`, with those rare draws between them.
+
+Numba caches the compiled kernels by this file's modification time only, with the constants of
+``hfo_physics``, ``hfo_features`` and ``hfo_vector`` compiled in: after changing one of those, touch
+this file (``tests/test_hfo_kernel.py`` fails on a stale cache).
 """
 
 from __future__ import annotations

@@ -238,9 +238,10 @@ class HalfFieldOffenseVectorEnv(gymnasium.vector.VectorEnv):
     per game. ``reset(options=...)`` takes the scalar env's options, applied to every game (each
     value may also be given per game, with a leading axis of size N).
 
-    ``backend``: ``"numba"`` steps with the fused kernels of ``hfo_kernel.py`` (about twice as fast at
-    N = 1024; needs ``pip install pamdp[fast]``), ``"numpy"`` with NumPy alone, ``"auto"`` with Numba
-    when it imports. Both give the same numbers bit for bit, random draws included.
+    ``backend``: ``"numba"`` steps with the fused kernels of ``hfo_kernel.py`` (three times as fast at
+    N = 1024, eight at N = 64: ``benchmarks/hfo_speed.md``; needs ``pip install pamdp[fast]``),
+    ``"numpy"`` with NumPy alone, ``"auto"`` with Numba when it imports. Both give the same numbers bit
+    for bit, random draws included.
     """
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 10, "autoreset_mode": AutoresetMode.NEXT_STEP}
