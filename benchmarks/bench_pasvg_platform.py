@@ -1,4 +1,4 @@
-"""PASVG(0) on Platform, tuned preset, 5 seeds x 300k samples: curves, greedy returns, wall time.
+"""PASVG(0) on Platform, tuned preset, 5 seeds x 1M samples: curves, greedy returns, wall time.
 
     python benchmarks/bench_pasvg_platform.py [--workers 1] [--scale 1.0] [--seeds 0,1,2,3,4] [--out DIR]
 
