@@ -107,12 +107,12 @@ def dash_direction_rate(direction: float) -> float:
         rate = SIDE_DASH_RATE + (1.0 - SIDE_DASH_RATE) * (1.0 - d / 90.0)
     else:
         rate = BACK_DASH_RATE - (BACK_DASH_RATE - SIDE_DASH_RATE) * (1.0 - (d - 90.0) / 90.0)
-    return min(max(rate, 0.0), 1.0)
+    return 0.0 if rate < 0.0 else 1.0 if rate > 1.0 else rate  # min(max(rate, 0), 1)
 
 
 def round_dash_direction(direction: float) -> float:
     """Clamp to [-180, 180] and round to a multiple of 45 degrees, halves to even (spec 2.4.1)."""
-    direction = min(max(direction, -180.0), 180.0)
+    direction = -180.0 if direction < -180.0 else 180.0 if direction > 180.0 else direction
     return DASH_ANGLE_STEP * round(direction / DASH_ANGLE_STEP)
 
 
@@ -279,16 +279,16 @@ class HFOGame:
         recording shows the server's 1.085 m (a ball 1.046 m away was reported kickable and kicked;
         one such case in the trace, and no counter-example).
         """
-        px, py, _, _, _, _, bx, by, _, _ = self.seen
-        limit = KICKABLE_AREA if self.kicked else AGENT_KICKABLE_AREA
-        return norm(bx - px, by - py) <= limit
+        seen = self.seen
+        dx, dy = seen[6] - seen[0], seen[7] - seen[1]
+        return math.sqrt(dx * dx + dy * dy) <= (KICKABLE_AREA if self.kicked else AGENT_KICKABLE_AREA)
 
     def dash(self, power: float, direction: float) -> None:
         """DASH(power, direction): librcsc's conservation of stamina and speed, then the server's dash.
 
         The agent's side works from what it sees (``seen``); the server's side from the true state.
         """
-        power = min(max(power, -100.0), 100.0)
+        power = -100.0 if power < -100.0 else 100.0 if power > 100.0 else power
         direction = round_dash_direction(direction)
         rate = dash_direction_rate(direction)
         _, _, svx, svy, body, stamina, _, _, _, _ = self.seen
@@ -313,8 +313,11 @@ class HFOGame:
     def _server_dash(self, power: float, direction: float, rate: float) -> None:
         """The server's dash (spec 2.4): pay stamina, then accelerate along body + direction."""
         backward = power < 0.0
-        need = min(-2.0 * power if backward else power, self.stamina + EXTRA_STAMINA)
-        self.stamina = max(0.0, self.stamina - need)
+        need, available = -2.0 * power if backward else power, self.stamina + EXTRA_STAMINA
+        if available < need:
+            need = available
+        stamina = self.stamina - need
+        self.stamina = stamina if stamina > 0.0 else 0.0
         power = -need / 2.0 if backward else need
         accel = abs(self.effort * power * rate * DASH_POWER_RATE)
         phi = math.radians(self.body + direction + (180.0 if backward else 0.0))
@@ -324,7 +327,8 @@ class HFOGame:
     def turn(self, direction: float) -> None:
         """TURN(direction): the agent pre-multiplies by the inertia factor the server divides by."""
         seen_speed = norm(self.seen[2], self.seen[3])
-        moment = round_command(min(max(direction * (1.0 + INERTIA_MOMENT * seen_speed), -180.0), 180.0))
+        moment = direction * (1.0 + INERTIA_MOMENT * seen_speed)
+        moment = round_command(-180.0 if moment < -180.0 else 180.0 if moment > 180.0 else moment)
         inertia = 1.0 + INERTIA_MOMENT * norm(self.pvx, self.pvy)
         noise = 1.0 + self._uniform(-self.player_rand, self.player_rand) if self.player_rand else 1.0
         self.body = normalize_angle(self.body + noise * moment / inertia)
@@ -333,8 +337,8 @@ class HFOGame:
         """KICK(power, direction); returns False (and sends nothing) if the agent's test says unkickable."""
         if not self.agent_kickable():
             return False  # HFO sends (turn 0) instead: no effect on the state (spec 2.12.3)
-        power = round_command(min(max(power, 0.0), 100.0))
-        direction = min(max(direction, -180.0), 180.0)
+        power = round_command(0.0 if power < 0.0 else 100.0 if power > 100.0 else power)
+        direction = -180.0 if direction < -180.0 else 180.0 if direction > 180.0 else direction
         dx, dy = self.bx - self.px, self.by - self.py
         dist = norm(dx, dy)
         if dist > KICKABLE_AREA:
@@ -371,7 +375,8 @@ class HFOGame:
         )  # fmt: skip
         self.pax = self.pay = self.bax = self.bay = 0.0
         self.collided_post = post_p
-        self.collided_ball = norm(self.bx - self.px, self.by - self.py) < TOUCH_DISTANCE
+        dx, dy = self.bx - self.px, self.by - self.py
+        self.collided_ball = math.sqrt(dx * dx + dy * dy) < TOUCH_DISTANCE
         if self.collided_ball:
             self._resolve_overlap()
         status = self._referee()
@@ -381,15 +386,16 @@ class HFOGame:
 
     def _move(self, x, y, vx, vy, ax, ay, accel_max, speed_max, rand, decay, radius):
         """Spec 2.5.1 for one object; returns the new position, velocity and the post-collision flag."""
+        sqrt = math.sqrt
         if ax != 0.0 or ay != 0.0:
-            a = norm(ax, ay)
+            a = sqrt(ax * ax + ay * ay)
             shrink = accel_max / a if a > accel_max else 1.0
             vx, vy = vx + ax * shrink, vy + ay * shrink
-            speed = norm(vx, vy)
+            speed = sqrt(vx * vx + vy * vy)
             shrink = speed_max / speed if speed > speed_max else 1.0
             vx, vy = vx * shrink, vy * shrink
         if rand and (vx != 0.0 or vy != 0.0):
-            length = self._uniform(0.0, rand * norm(vx, vy))
+            length = self._uniform(0.0, rand * sqrt(vx * vx + vy * vy))
             angle = self._uniform(-math.pi, math.pi)
             vx, vy = vx + length * math.cos(angle), vy + length * math.sin(angle)
         x, y, vx, vy, collided = post_collisions(x, y, vx, vy, radius)
@@ -424,22 +430,34 @@ class HFOGame:
             status = OUT_OF_TIME
         else:
             self.untouched += 1
-            if norm(bx - self.px, by - self.py) <= KICKABLE_AREA:
+            dx, dy = bx - self.px, by - self.py
+            if math.sqrt(dx * dx + dy * dy) <= KICKABLE_AREA:
                 self.holder = True
                 self.untouched = 0
         self.prev_bx, self.prev_by = bx, by
         return status
 
     def _update_stamina(self) -> None:
-        """Spec 2.6: recovery and effort decay below 30% stamina, effort recovers above 60%."""
-        if self.stamina <= RECOVER_DEC_THR * STAMINA_MAX:
-            self.recovery = max(RECOVER_MIN, self.recovery - RECOVER_DEC)
-        if self.stamina <= EFFORT_DEC_THR * STAMINA_MAX:
-            self.effort = max(EFFORT_MIN, self.effort - EFFORT_DEC)
-        if self.stamina >= EFFORT_INC_THR * STAMINA_MAX and self.effort < EFFORT_MAX:
-            self.effort = min(EFFORT_MAX, self.effort + EFFORT_INC)
-        inc = min(self.recovery * STAMINA_INC_MAX, STAMINA_MAX - self.stamina, self.capacity)
-        self.stamina += inc
+        """Spec 2.6: recovery and effort decay below 30% stamina, effort recovers above 60%.
+
+        The clips are conditionals with the comparisons of ``min`` and ``max``, whose calls cost more.
+        """
+        stamina = self.stamina
+        if stamina <= RECOVER_DEC_THR * STAMINA_MAX:
+            recovery = self.recovery - RECOVER_DEC
+            self.recovery = recovery if recovery > RECOVER_MIN else RECOVER_MIN
+        if stamina <= EFFORT_DEC_THR * STAMINA_MAX:
+            effort = self.effort - EFFORT_DEC
+            self.effort = effort if effort > EFFORT_MIN else EFFORT_MIN
+        if stamina >= EFFORT_INC_THR * STAMINA_MAX and self.effort < EFFORT_MAX:
+            effort = self.effort + EFFORT_INC
+            self.effort = effort if effort < EFFORT_MAX else EFFORT_MAX
+        inc = self.recovery * STAMINA_INC_MAX
+        if STAMINA_MAX - stamina < inc:
+            inc = STAMINA_MAX - stamina
+        if self.capacity < inc:
+            inc = self.capacity
+        self.stamina = stamina + inc
         self.capacity -= inc
 
 
