@@ -141,7 +141,7 @@ class HalfFieldOffenseEnv(gymnasium.Env):
         terminated = goal or status == OUT_OF_BOUNDS or (timeout and self.timeout_terminal)
         truncated = timeout and not self.timeout_terminal
         info = {"status": STATUS_NAMES[status], "step": self._steps}
-        return np.array(features, dtype=np.float32), reward, terminated, truncated, info
+        return np.fromiter(features, np.float32, len(features)), reward, terminated, truncated, info
 
     def render(self):
         if self.render_mode != "rgb_array":
