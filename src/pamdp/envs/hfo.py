@@ -20,6 +20,7 @@ directions to [-180, 180]. Malformed or non-finite actions raise ``ValueError``.
 from __future__ import annotations
 
 import math
+import struct
 
 import gymnasium
 import numpy as np
@@ -94,6 +95,7 @@ class HalfFieldOffenseEnv(gymnasium.Env):
         self.terminal_deltas = bool(terminal_deltas)
         n = self.profile.n_features
         self.observation_space = spaces.Box(-1.0, 1.0, (n,), dtype=np.float32)
+        self._pack_observation = struct.Struct(f"{n}f").pack_into
         self.action_space = hfo_action_space()
         self.game = HFOGame(self.np_random, deterministic=self.deterministic)
         self._steps = 0
@@ -121,7 +123,7 @@ class HalfFieldOffenseEnv(gymnasium.Env):
         self._steps = 0
         self._kick_bonus_paid = False
         self._features = self._observe()
-        return np.array(self._features, dtype=np.float32), {"status": "IN_GAME", "step": 0}
+        return self._observation(self._features), {"status": "IN_GAME", "step": 0}
 
     def step(self, action):
         a, x0, x1 = self._parse_action(action)
@@ -141,7 +143,7 @@ class HalfFieldOffenseEnv(gymnasium.Env):
         terminated = goal or status == OUT_OF_BOUNDS or (timeout and self.timeout_terminal)
         truncated = timeout and not self.timeout_terminal
         info = {"status": STATUS_NAMES[status], "step": self._steps}
-        return np.fromiter(features, np.float32, len(features)), reward, terminated, truncated, info
+        return self._observation(features), reward, terminated, truncated, info
 
     def render(self):
         if self.render_mode != "rgb_array":
@@ -156,6 +158,13 @@ class HalfFieldOffenseEnv(gymnasium.Env):
         return low_level_features_one(
             g.seen, g.agent_kickable(), g.collided_ball, g.collided_post, g.last_action_ok, self.profile
         )
+
+    def _observation(self, features: list) -> np.ndarray:
+        """``features`` as a new float32 array. ``struct`` casts each to float as NumPy does, in half the
+        time of ``np.array`` on a list (a tenth of the step)."""
+        obs = np.empty(len(features), np.float32)
+        self._pack_observation(obs, 0, *features)
+        return obs
 
     @staticmethod
     def _parse_action(action) -> tuple[int, float, float]:
