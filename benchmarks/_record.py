@@ -49,6 +49,10 @@ def run_and_record(experiment_file: str, out_root: str, record: str, workers: in
     figure = HERE / "results" / f"{Path(record).stem}.png"
     figure.parent.mkdir(exist_ok=True)
     shutil.copy(report["png"], figure)
+    greedy_figure = None
+    if "greedy_png" in report:  # runs with eval_every: greedy evaluations during training
+        greedy_figure = HERE / "results" / f"{Path(record).stem}_greedy.png"
+        shutil.copy(report["greedy_png"], greedy_figure)
     per_run = {}  # training time of each run from its own log, so that resumed and skipped runs count too
     for o in outcomes:
         with open(Path(o.out) / "progress.csv", newline="") as f:
@@ -75,6 +79,14 @@ def run_and_record(experiment_file: str, out_root: str, record: str, workers: in
         "Greedy return: the mean over 1000 evaluation episodes of each seed's final model, then mean +- std over",
         "seeds. Curves: the mean episodic return of each epoch's (stochastic) training episodes.",
     ]
+    if greedy_figure is not None:
+        lines += [
+            "",
+            f"![greedy evaluations during training](results/{greedy_figure.name})",
+            "",
+            "Greedy evaluations during training: 100 episodes of the greedy policy every few epochs "
+            "(`eval_every`), mean +- std over seeds.",
+        ]
     failed = [o for o in outcomes if o.error]
     if failed:
         lines += ["", f"{len(failed)} runs failed:"] + [

@@ -107,3 +107,25 @@ def test_resume_after_a_killed_worker(tmp_path):
     with open(out / "tiny" / "small_delta" / "seed0" / "progress.csv", newline="") as f:
         steps = [float(r["time/total_timesteps"]) for r in csv.DictReader(f)]
     assert steps == sorted(set(steps)) and steps[-1] >= 3000
+
+
+def test_greedy_evaluations_get_their_own_figure(tmp_path):
+    from pamdp.experiments.plots import GREEDY_METRIC, aggregate, write_report
+
+    header = "time/total_timesteps,charts/episodic_return,eval/mean_return\n"
+    evals = {0: [0.2, 0.6], 1: [0.4, 1.0]}  # every second epoch of four
+    for seed, (e1, e2) in evals.items():
+        run = tmp_path / "exp" / "with_eval" / f"seed{seed}"
+        run.mkdir(parents=True)
+        rows = [f"{1000 * (i + 1)},{0.1 * i},{v}" for i, v in enumerate(["", e1, "", e2])]
+        (run / "progress.csv").write_text(header + "\n".join(rows) + "\n")
+    plain = tmp_path / "exp" / "without" / "seed0"
+    plain.mkdir(parents=True)
+    (plain / "progress.csv").write_text("time/total_timesteps,charts/episodic_return\n1000,0.1\n2000,0.2\n")
+
+    agg = aggregate(sorted((tmp_path / "exp" / "with_eval").iterdir()), GREEDY_METRIC)
+    assert agg["mean"][1] == pytest.approx(0.3) and agg["mean"][3] == pytest.approx(0.8)
+    assert agg["std"][3] == pytest.approx(0.2) and all(map(lambda v: v != v, agg["mean"][[0, 2]]))  # NaN
+    report = write_report([tmp_path / "exp"], tmp_path / "fig")
+    assert report["greedy_png"].exists() and report["greedy_svg"].exists()
+    assert "without" not in report["greedy_svg"].read_text() and "with_eval" in report["greedy_svg"].read_text()

@@ -218,9 +218,7 @@ def cmd_reproduce(args) -> int:
 
         outcomes = run_all(jobs, workers=args.workers, log=lambda m: print(m, file=sys.stderr))
     failed = [o for o in outcomes if o.error is not None]
-    report = write_report([Path(args.out) / exp.name], Path(args.out) / exp.name, exp.description)
-    print(report["table"].read_text())
-    print(f"figures: {report['png']}, {report['svg']}", file=sys.stderr)
+    _print_report(write_report([Path(args.out) / exp.name], Path(args.out) / exp.name, exp.description))
     if failed:
         print(f"{len(failed)} of {len(outcomes)} runs failed: {', '.join(o.out for o in failed)}", file=sys.stderr)
         return 1
@@ -230,10 +228,15 @@ def cmd_reproduce(args) -> int:
 def cmd_plot(args) -> int:
     from pamdp.experiments.plots import write_report
 
-    report = write_report(args.dirs, args.out or args.dirs[0], args.title)
-    print(report["table"].read_text())
-    print(f"figures: {report['png']}, {report['svg']}", file=sys.stderr)
+    _print_report(write_report(args.dirs, args.out or args.dirs[0], args.title))
     return 0
+
+
+def _print_report(report: dict) -> None:
+    """The results table on stdout, the figures' paths on stderr."""
+    print(report["table"].read_text())
+    figures = [report[k] for k in ("png", "svg", "greedy_png", "greedy_svg") if k in report]
+    print(f"figures: {', '.join(map(str, figures))}", file=sys.stderr)
 
 
 # -- evaluate, render ----------------------------------------------------------------------------

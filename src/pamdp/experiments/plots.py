@@ -10,6 +10,7 @@ from __future__ import annotations
 import csv
 import json
 import os
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -17,6 +18,8 @@ import numpy as np
 __all__ = ["find_groups", "aggregate", "plot_curves", "results_table", "write_report"]
 
 METRIC = "charts/episodic_return"
+GREEDY_METRIC = "eval/mean_return"  # logged every few epochs by runs with eval_every (``--eval-every``)
+LABELS = {METRIC: "average return", GREEDY_METRIC: "greedy return (100 episodes)"}
 
 
 def find_groups(roots: list[str | os.PathLike]) -> dict[str, list[Path]]:
@@ -47,7 +50,8 @@ def aggregate(runs: list[Path], metric: str = METRIC) -> dict[str, np.ndarray]:
     n = min(len(s) for s, _ in curves)
     steps = np.mean([s[:n] for s, _ in curves], axis=0)
     values = np.array([v[:n] for _, v in curves])
-    with np.errstate(all="ignore"):
+    with warnings.catch_warnings():  # epochs where no seed logged the metric are NaN, not a warning
+        warnings.simplefilter("ignore", RuntimeWarning)
         return {
             "epoch": np.arange(1, n + 1),
             "steps": steps,
@@ -69,14 +73,15 @@ def plot_curves(
     fig, ax = plt.subplots(figsize=(5.0, 3.4), dpi=110)
     for label, runs in groups.items():
         agg = aggregate(runs, metric)
-        x = agg["steps"] / 1e6
-        line = ax.plot(x, agg["mean"], label=f"{label} ({len(runs)} seeds)", linewidth=1.4)[0]
-        ax.fill_between(
-            x, agg["mean"] - agg["std"], agg["mean"] + agg["std"], color=line.get_color(), alpha=0.2
-        )
+        ok = np.isfinite(agg["mean"])  # a metric logged every few epochs only (greedy evaluations)
+        x, mean, std = agg["steps"][ok] / 1e6, agg["mean"][ok], agg["std"][ok]
+        line = ax.plot(
+            x, mean, label=f"{label} ({len(runs)} seeds)", linewidth=1.4, marker="." if ok.sum() < 40 else None
+        )[0]
+        ax.fill_between(x, mean - std, mean + std, color=line.get_color(), alpha=0.2)
     # Samples rather than epochs on the x axis: settings may differ in samples per epoch.
     ax.set_xlabel("environment samples (millions)")
-    ax.set_ylabel("average return" if metric == METRIC else metric)
+    ax.set_ylabel(LABELS.get(metric, metric))
     if title:
         ax.set_title(title)
     ax.grid(alpha=0.3)
@@ -115,12 +120,28 @@ def results_table(groups: dict[str, list[Path]]) -> str:
     return "\n".join(lines)
 
 
+def _logs(runs: list[Path], metric: str) -> bool:
+    for run in runs:
+        with open(run / "progress.csv", newline="") as f:
+            if any(row.get(metric) not in (None, "") for row in csv.DictReader(f)):
+                return True
+    return False
+
+
 def write_report(roots: list[str | os.PathLike], out: str | os.PathLike, title: str = "") -> dict[str, Path]:
-    """Curves (PNG, SVG), the per-epoch aggregate (CSV) and the results table (markdown) into ``out``."""
+    """Curves (PNG, SVG), the per-epoch aggregate (CSV) and the results table (markdown) into ``out``.
+
+    Runs that logged greedy evaluations during training (``eval_every``) also get ``greedy.png`` and
+    ``greedy.svg``: the mean +- std across seeds of those evaluations, at the epochs where they were made.
+    """
     groups = find_groups(roots)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     png, svg = plot_curves(groups, out / "curves", title)
+    greedy = {label: runs for label, runs in groups.items() if _logs(runs, GREEDY_METRIC)}
+    extra = {}
+    if greedy:
+        extra["greedy_png"], extra["greedy_svg"] = plot_curves(greedy, out / "greedy", title, GREEDY_METRIC)
     csv_path = out / "curves.csv"
     with open(csv_path, "w", newline="") as f:
         writer = csv.writer(f)
@@ -140,4 +161,4 @@ def write_report(roots: list[str | os.PathLike], out: str | os.PathLike, title: 
                 )
     table = out / "results.md"
     table.write_text(results_table(groups) + "\n")
-    return {"png": png, "svg": svg, "csv": csv_path, "table": table}
+    return {"png": png, "svg": svg, "csv": csv_path, "table": table, **extra}
