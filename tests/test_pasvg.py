@@ -106,6 +106,7 @@ def test_parameters_stay_in_bounds_and_unused_ones_are_zero():
         ({"policy_lr": float("inf")}, "policy_lr = inf"),
         ({"target_entropy": -0.1, "entropy_coef": 0.1}, "target_entropy = -0.1"),
         ({"target_entropy": 0.5, "entropy_coef": 0.0}, "entropy_coef = 0.0"),
+        ({"explore_epsilon": 1.5}, "explore_epsilon = 1.5"),
     ],
 )
 def test_bad_settings_raise_clear_errors(kwargs, match):
@@ -201,6 +202,26 @@ def test_save_load_predict_round_trip(tmp_path, save_replay):
         np.testing.assert_array_equal(loaded.replay.data["eta_a"][:200], model.replay.data["eta_a"][:200])
     loaded.learn(200, progress_bar=False)  # resumes: refills (or keeps) the buffer and goes on
     assert loaded.num_timesteps >= 400
+
+
+def test_explore_epsilon_draws_uniform_actions_with_their_own_parameters():
+    # pi_d made all but certain of action 0: what reaches replay besides action 0 comes from the epsilon draws,
+    # about eps * (K - 1) / K of the samples, each with pi_c's parameters for the action actually taken.
+    eps = 0.3
+    model = PASVG0("pamdp/Platform-v0", dataclasses.replace(SMALL, explore_epsilon=eps, learning_starts=10**6))
+    with torch.no_grad():
+        model.policy.pi_d[-1].bias.copy_(torch.tensor([30.0, 0.0, 0.0]))
+    model.learn(2000, progress_bar=False)
+    n = len(model.replay)
+    a = model.replay.data["a"][:n]
+    others = np.mean(a != 0)
+    assert abs(others - eps * 2 / 3) < 4 * np.sqrt(eps * 2 / 3 / n), (others, n)
+    np.testing.assert_array_equal(model.replay.data["a_in"][:n].argmax(1), a)
+    obs, eta_x = (torch.from_numpy(model.replay.data[k][:n]) for k in ("obs", "eta_x"))
+    onehot = torch.nn.functional.one_hot(torch.from_numpy(a), 3).float()
+    with torch.no_grad():
+        x = model.policy.params(obs, torch.from_numpy(a), onehot, eta_x)
+    np.testing.assert_allclose(x.numpy(), model.replay.data["x"][:n], atol=1e-6)
 
 
 def test_target_entropy_above_ln_k_is_refused():

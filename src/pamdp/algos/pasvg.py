@@ -73,6 +73,12 @@ class PASVG0Config(AlgoConfig):
         "between 0 and ln K; None keeps entropy_coef fixed.",
     )
     entropy_lr: float = setting(3e-4, "Adam learning rate of the log entropy weight when target_entropy is set.")
+    explore_epsilon: float = setting(
+        0.0,
+        "While collecting, the fraction of steps whose discrete action is drawn uniformly instead of from pi_d "
+        "(with pi_c's parameters for it), so that every action keeps appearing in replay; 0 in the paper. "
+        "The policy update does not see it: it replays the recorded noise through the current policy.",
+    )
     critic_lr: float = setting(1e-3, "Adam learning rate of the critic (paper: 1e-3).")
     policy_lr: float = setting(1e-5, "Adam learning rate of pi_d and pi_c (paper: 1e-5, which learns slowly).")
     batch_size: int = setting(64, "Transitions per gradient update (DDPG's 64; the paper does not say).")
@@ -106,6 +112,7 @@ class PASVG0Config(AlgoConfig):
             self._check(self.target_entropy >= 0, "target_entropy", "None or a non-negative entropy in nats")
             self._check(self.entropy_coef > 0, "entropy_coef", "a positive starting weight when target_entropy is set")
         self._check(self.entropy_lr > 0, "entropy_lr", "a positive learning rate")
+        self._check(0 <= self.explore_epsilon <= 1, "explore_epsilon", "a probability in [0, 1]")
         self._check(self.critic_lr > 0, "critic_lr", "a positive learning rate")
         self._check(self.policy_lr > 0, "policy_lr", "a positive learning rate")
         self._check(self.batch_size >= 1, "batch_size", "an integer >= 1")
@@ -197,9 +204,12 @@ class GumbelHybridPolicy(nn.Module):
         """``(logits, index, a, x)``: :meth:`forward` plus ``pi_d``'s logits, so an update runs ``pi_d`` once."""
         logits = self.pi_d(obs)
         index, a = gumbel_softmax_sample(logits, eta_a, temperature, hard)
+        return logits, index, a, self.params(obs, index, a, eta_x)
+
+    def params(self, obs: torch.Tensor, index: torch.Tensor, a: torch.Tensor, eta_x: torch.Tensor) -> torch.Tensor:
+        """``x = g(s, a, eta_x)``: ``pi_c``'s parameters for action ``a`` (one-hot or soft; ``index`` its argmax)."""
         std = self.log_std.clamp(LOG_STD_MIN, LOG_STD_MAX).exp()[index]
-        x = torch.tanh(self.pi_c(torch.cat([obs, a], dim=-1)) + std * eta_x) * self.mask[index]
-        return logits, index, a, x
+        return torch.tanh(self.pi_c(torch.cat([obs, a], dim=-1)) + std * eta_x) * self.mask[index]
 
     def mode(self, obs: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
         """The greedy action: the most probable discrete action and its mean parameters."""
@@ -311,8 +321,17 @@ class PASVG0(Algorithm):
         return index, x
 
     def _explore(self, obs: torch.Tensor, step: int, episode_start: np.ndarray):
+        cfg = self.config
         eta_a, eta_x = self._noise(len(obs))
-        index, a_in, x = self.policy(obs, eta_a, eta_x, self.config.temperature, self.config.straight_through)
+        index, a_in, x = self.policy(obs, eta_a, eta_x, cfg.temperature, cfg.straight_through)
+        if cfg.explore_epsilon > 0:  # drawn only when on, so that the paper's preset keeps its random stream
+            n, K = len(obs), self.hybrid.n_actions
+            flip = torch.rand(n, generator=self.torch_gen) < cfg.explore_epsilon
+            uniform = torch.randint(K, (n,), generator=self.torch_gen)
+            onehot = F.one_hot(uniform, K).to(a_in.dtype)
+            index = torch.where(flip, uniform, index)
+            a_in = torch.where(flip[:, None], onehot, a_in)
+            x = torch.where(flip[:, None], self.policy.params(obs, uniform, onehot, eta_x), x)
         return index, x, {"a_in": a_in.numpy(), "eta_a": eta_a.numpy(), "eta_x": eta_x.numpy()}
 
     def _run_epoch(self) -> dict[str, float]:
