@@ -107,6 +107,7 @@ def test_parameters_stay_in_bounds_and_unused_ones_are_zero():
         ({"target_entropy": -0.1, "entropy_coef": 0.1}, "target_entropy = -0.1"),
         ({"target_entropy": 0.5, "entropy_coef": 0.0}, "entropy_coef = 0.0"),
         ({"explore_epsilon": 1.5}, "explore_epsilon = 1.5"),
+        ({"policy_delay": 0}, "policy_delay = 0"),
     ],
 )
 def test_bad_settings_raise_clear_errors(kwargs, match):
@@ -222,6 +223,40 @@ def test_explore_epsilon_draws_uniform_actions_with_their_own_parameters():
     with torch.no_grad():
         x = model.policy.params(obs, torch.from_numpy(a), onehot, eta_x)
     np.testing.assert_allclose(x.numpy(), model.replay.data["x"][:n], atol=1e-6)
+
+
+def test_twin_critics_learn_towards_the_smaller_target(tmp_path):
+    model = PASVG0("pamdp/Platform-v0", dataclasses.replace(SMALL, twin_critics=True, learning_starts=10**6))
+    model.learn(200, progress_bar=False)  # fills replay, no update
+    batch = model.replay.sample(16, np.random.default_rng(0))
+    model.replay.sample = lambda n, rng: batch
+    outs = {}
+    for name in ("critic_target", "critic2_target"):
+        getattr(model, name).register_forward_hook(lambda m, i, o, name=name: outs.__setitem__(name, o.clone()))
+    with torch.no_grad():
+        model.critic2_target.net[-1].bias.fill_(-3.0)  # the second target critic is now the smaller one
+        q1, q2 = (c(batch["obs"], batch["a_in"], batch["x"]) for c in (model.critic, model.critic2))
+    stats = model._update()
+    assert torch.all(outs["critic2_target"] < outs["critic_target"])
+    y = batch["reward"] + 0.99 * (~batch["terminated"]).float() * torch.minimum(*outs.values())
+    expected = ((q1 - y) ** 2).mean() + ((q2 - y) ** 2).mean()
+    assert stats["losses/critic_loss"] == pytest.approx(float(expected), rel=1e-5)
+    model.save(tmp_path / "m.pt")
+    loaded = PASVG0.load(tmp_path / "m.pt")
+    torch.testing.assert_close(flat_params(loaded), flat_params(model), rtol=0, atol=0)
+    assert torch.equal(loaded.critic2.net[0].weight, model.critic2.net[0].weight) and loaded.critic_updates == 1
+
+
+def test_policy_delay_updates_the_policy_and_targets_every_kth_step():
+    model = PASVG0("pamdp/Platform-v0", dataclasses.replace(SMALL, policy_delay=3, learning_starts=10**6))
+    model.learn(200, progress_bar=False)
+    target = [p.clone() for p in model.policy_target.parameters()]
+    for k in range(1, 7):
+        model._update()
+        moved = not all(torch.equal(a, b) for a, b in zip(target, model.policy_target.parameters()))
+        assert moved == (k >= 3), k
+    steps = {int(s["step"]) for s in model.policy_optimizer.state.values()}
+    assert steps == {2} and {int(s["step"]) for s in model.critic_optimizer.state.values()} == {6}
 
 
 def test_target_entropy_above_ln_k_is_refused():

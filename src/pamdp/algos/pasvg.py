@@ -79,6 +79,14 @@ class PASVG0Config(AlgoConfig):
         "(with pi_c's parameters for it), so that every action keeps appearing in replay; 0 in the paper. "
         "The policy update does not see it: it replays the recorded noise through the current policy.",
     )
+    twin_critics: bool = setting(
+        False,
+        "Two critics trained on the same TD target, taken from the smaller of their two target networks "
+        "(TD3's clipped double Q, against overestimation); the policy follows the first. Not in the paper.",
+    )
+    policy_delay: int = setting(
+        1, "Critic updates per policy update (and soft target update); TD3 uses 2. 1 in the paper."
+    )
     critic_lr: float = setting(1e-3, "Adam learning rate of the critic (paper: 1e-3).")
     policy_lr: float = setting(1e-5, "Adam learning rate of pi_d and pi_c (paper: 1e-5, which learns slowly).")
     batch_size: int = setting(64, "Transitions per gradient update (DDPG's 64; the paper does not say).")
@@ -113,6 +121,7 @@ class PASVG0Config(AlgoConfig):
             self._check(self.entropy_coef > 0, "entropy_coef", "a positive starting weight when target_entropy is set")
         self._check(self.entropy_lr > 0, "entropy_lr", "a positive learning rate")
         self._check(0 <= self.explore_epsilon <= 1, "explore_epsilon", "a probability in [0, 1]")
+        self._check(self.policy_delay >= 1, "policy_delay", "an integer >= 1")
         self._check(self.critic_lr > 0, "critic_lr", "a positive learning rate")
         self._check(self.policy_lr > 0, "policy_lr", "a positive learning rate")
         self._check(self.batch_size >= 1, "batch_size", "an integer >= 1")
@@ -261,10 +270,19 @@ class PASVG0(Algorithm):
         self.critic = Critic(self.obs_dim, h.n_actions, h.max_param_size, cfg.hidden_sizes, cfg.activation)
         self.policy_target = copy.deepcopy(self.policy).requires_grad_(False)
         self.critic_target = copy.deepcopy(self.critic).requires_grad_(False)
+        self.critic2 = self.critic2_target = None
+        critic_params = list(self.critic.parameters())
+        if cfg.twin_critics:
+            self.critic2 = Critic(self.obs_dim, h.n_actions, h.max_param_size, cfg.hidden_sizes, cfg.activation)
+            self.critic2_target = copy.deepcopy(self.critic2).requires_grad_(False)
+            critic_params += list(self.critic2.parameters())
+        self.critic_params = critic_params
+        self.critic_updates = 0  # for policy_delay
+        self._policy_stats: dict[str, float] = {}
         # fused: one kernel per step instead of a dozen foreach passes, about 3x faster on a CPU.
         self.policy_params = [p for p in self.policy.parameters() if p.requires_grad]
         self.policy_optimizer = torch.optim.Adam(self.policy_params, lr=cfg.policy_lr, fused=True)
-        self.critic_optimizer = torch.optim.Adam(self.critic.parameters(), lr=cfg.critic_lr, fused=True)
+        self.critic_optimizer = torch.optim.Adam(self.critic_params, lr=cfg.critic_lr, fused=True)
         self.entropy_weight = self.entropy_optimizer = None
         if cfg.target_entropy is not None:
             if cfg.target_entropy > math.log(h.n_actions):
@@ -298,6 +316,8 @@ class PASVG0(Algorithm):
         }
         if self.entropy_weight is not None:
             modules["entropy_weight"] = self.entropy_weight
+        if self.critic2 is not None:
+            modules["critic2"], modules["critic2_target"] = self.critic2, self.critic2_target
         return modules
 
     def _optimizers(self):
@@ -307,10 +327,11 @@ class PASVG0(Algorithm):
         return optimizers
 
     def _extra_state(self):
-        return {"loop": self.loop.state_dict(self.config.save_replay)}
+        return {"loop": self.loop.state_dict(self.config.save_replay), "critic_updates": self.critic_updates}
 
     def _load_extra_state(self, state):
         self.loop.load_state_dict(state["loop"])
+        self.critic_updates = int(state.get("critic_updates", 0))  # absent from checkpoints before policy_delay
 
     def _noise(self, batch: int) -> tuple[torch.Tensor, torch.Tensor]:
         eta_a = gumbel_noise((batch, self.hybrid.n_actions), self.torch_gen)
@@ -356,7 +377,7 @@ class PASVG0(Algorithm):
         optimizer.step()
 
     def _update(self) -> dict[str, float]:
-        """One critic TD step and one value-gradient step of both policies on a replayed minibatch."""
+        """One critic TD step and (every ``policy_delay``-th call) one value-gradient step of both policies."""
         cfg = self.config
         b = self.replay.sample(cfg.batch_size, self.np_rng)
         obs, next_obs = b["obs"], b["next_obs"]
@@ -365,13 +386,28 @@ class PASVG0(Algorithm):
                 next_obs, *self._noise(len(obs)), cfg.temperature, cfg.straight_through
             )
             q_next = self.critic_target(next_obs, a_next, x_next)
+            if self.critic2 is not None:
+                q_next = torch.minimum(q_next, self.critic2_target(next_obs, a_next, x_next))
             y = b["reward"] + cfg.gamma * (~b["terminated"]).float() * q_next
         q = self.critic(obs, b["a_in"], b["x"])
         critic_loss = F.mse_loss(q, y)
+        if self.critic2 is not None:
+            critic_loss = critic_loss + F.mse_loss(self.critic2(obs, b["a_in"], b["x"]), y)
         self.critic_optimizer.zero_grad(set_to_none=True)
         critic_loss.backward()
-        self._step(self.critic_optimizer, self.critic.parameters())
+        self._step(self.critic_optimizer, self.critic_params)
+        self.critic_updates += 1
+        if self.critic_updates % cfg.policy_delay == 0:
+            self._policy_stats = self._policy_update(obs, b)
+        return {
+            "losses/critic_loss": float(critic_loss.detach()),
+            "train/q_mean": float(q.detach().mean()),
+            **self._policy_stats,
+        }
 
+    def _policy_update(self, obs: torch.Tensor, b: dict[str, torch.Tensor]) -> dict[str, float]:
+        """The value-gradient step of pi_d and pi_c, the entropy weight's step and the soft target updates."""
+        cfg = self.config
         # The recorded noise, pushed through the current policy: a = f(s, eta_a), x = g(s, a, eta_x).
         logits, _, a, x = self.policy.sample(obs, b["eta_a"], b["eta_x"], cfg.temperature, cfg.straight_through)
         q_pi = self.critic(obs, a, x)
@@ -391,12 +427,12 @@ class PASVG0(Algorithm):
             self.entropy_optimizer.step()
 
         soft_update(self.critic_target, self.critic, cfg.tau)
+        if self.critic2 is not None:
+            soft_update(self.critic2_target, self.critic2, cfg.tau)
         soft_update(self.policy_target, self.policy, cfg.tau)
         mask = self.policy.mask.bool()
         return {
-            "losses/critic_loss": float(critic_loss.detach()),
             "losses/actor_loss": float(actor_loss.detach()),
-            "train/q_mean": float(q.detach().mean()),
             "train/q_pi_mean": float(q_pi.detach().mean()),
             "train/entropy": float(entropy.detach()),
             "train/entropy_coef": alpha,
