@@ -121,7 +121,7 @@ def test_natural_step_improves_the_surrogate_within_the_trust_region():
     def kl():
         return kl_divergence(old, pol(obs), "chain_analytic").mean()
 
-    before = float(surrogate())
+    before = float(surrogate().detach())
     grad = flat_grad(surrogate(), params)
     fvp = FisherVectorProduct(kl(), params, 1e-5)
     d = conjugate_gradient(fvp, grad, 10)
