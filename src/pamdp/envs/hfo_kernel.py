@@ -15,14 +15,17 @@ order and amounts, and passes them in. Two draws depend on the state mid-step (a
 exactly the same spot, after the movement or after a placement), so the step is two kernels,
 :func:`act_and_move` and :func:`finish_step`, with those rare draws between them.
 
-Numba caches the compiled kernels by this file's modification time only, with the constants of
-``hfo_physics``, ``hfo_features`` and ``hfo_vector`` compiled in: after changing one of those, touch
-this file (``tests/test_hfo_kernel.py`` fails on a stale cache).
+Numba caches the compiled kernels on disk keyed by this file's modification time and size only, yet the
+constants of ``hfo_physics``, ``hfo_features``, ``hfo_vector`` and ``hfo_interface`` are compiled in. So
+:func:`refresh_cache` keeps a digest of those modules next to the cache and drops the cached kernels when it
+changes: an edit of any of them recompiles the kernels at the next import.
 """
 
 from __future__ import annotations
 
+import hashlib
 import math
+from pathlib import Path
 
 import numba
 import numpy as np
@@ -52,6 +55,36 @@ _MAGNITUDE_BITS = 0x7FFFFFFFFFFFFFFF
 _TINY_BITS = int(np.float64(1e-200).view(np.int64))
 _SELF_SPEED_MAX, _BALL_SPEED_MAX = 0.46, 5.0  # hfo_features.SELF_SPEED_MAX, BALL_SPEED_MAX
 
+
+DEPENDENCIES = ("hfo_physics.py", "hfo_features.py", "hfo_vector.py", "hfo_interface.py")
+
+
+def refresh_cache(directory: Path | None = None) -> bool:
+    """Drop this module's cached kernels if the modules whose constants they hold changed; True if it did.
+
+    The digest of :data:`DEPENDENCIES` is kept in ``__pycache__/hfo_kernel.deps``. A read-only install is
+    left alone: its files do not change, and an upgrade rewrites this file too, which Numba notices.
+    """
+    here = Path(__file__)
+    cache = directory if directory is not None else here.parent / "__pycache__"
+    digest = hashlib.sha256(b"".join(here.with_name(name).read_bytes() for name in DEPENDENCIES)).hexdigest()
+    stamp = cache / "hfo_kernel.deps"
+    try:
+        if stamp.read_text() == digest:
+            return False
+    except OSError:
+        pass
+    try:
+        cache.mkdir(exist_ok=True)
+        for stale in [*cache.glob("hfo_kernel.*.nbi"), *cache.glob("hfo_kernel.*.nbc")]:
+            stale.unlink()
+        stamp.write_text(digest)
+    except OSError:
+        return False
+    return True
+
+
+refresh_cache()  # before the first kernel is compiled or loaded from the cache
 _jit = numba.njit(cache=True, fastmath=False, nogil=True)
 
 
