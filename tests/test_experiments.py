@@ -1,6 +1,7 @@
 """The experiment runner end to end on tiny budgets: layout, aggregation, figures, resume, failures."""
 
 import csv
+import json
 import os
 import signal
 import subprocess
@@ -63,6 +64,9 @@ def test_tiny_experiment_end_to_end(tmp_path, capsys):
     assert {r["setting"] for r in agg} == {"small_delta"} and all(r["seeds"] == "2" for r in agg)
     table = capsys.readouterr().out
     assert "| small_delta | 2 |" in table
+    # Each seed's greedy return is listed after the mean and std, in seed order.
+    returns = [json.loads((out / "tiny" / "small_delta" / f"seed{s}" / "evaluation.json").read_text()) for s in (0, 1)]
+    assert "evaluated: {:.3f}, {:.3f})".format(*(r["mean_return"] for r in returns)) in table
     # A second call skips the finished runs.
     assert main(["reproduce", str(exp), "--out", str(out)]) == 0
     assert "already finished" in (out / "tiny" / "small_delta" / "seed0" / "stdout.log").read_text()

@@ -109,7 +109,8 @@ def results_table(groups: dict[str, list[Path]]) -> str:
         last = f"{agg['mean'][-1]:.3f} +- {agg['std'][-1]:.3f}" if len(agg["mean"]) else "-"
         if evals:
             ret = np.array([e["mean_return"] for e in evals])
-            greedy = f"{ret.mean():.3f} +- {ret.std():.3f} ({len(evals)} evaluated)"
+            per_seed = ", ".join(f"{r:.3f}" for r in ret)
+            greedy = f"{ret.mean():.3f} +- {ret.std():.3f} ({len(evals)} evaluated: {per_seed})"
             goals = [e["goal_rate"] for e in evals if "goal_rate" in e]
             steps = [e["mean_steps_to_goal"] for e in evals if e.get("mean_steps_to_goal") is not None]
             goal = f"{np.mean(goals):.3f}" if goals else "-"
