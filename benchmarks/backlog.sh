@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# The long learning runs still owed to issues 4, 5 and 7, in the order of what each CPU-hour buys.
+# The long learning runs still owed to issues 4, 5 and 7 (~60 core-hours), in the order of what each
+# CPU-hour buys. Per-run costs from benchmarks/offpolicy_speed.md (updates/s on one idle core).
 #
 #   nohup benchmarks/backlog.sh > backlog.log 2>&1 &      # at the start of a session, from the repo root
 #
@@ -12,7 +13,7 @@
 # Costs on the 2-core Intel Xeon of 2026-11-28, per run with another run on the other core:
 #   1. PASVG(0) tuned, 5 x 1M (issue 4's target):          ~85 min a run            ~7 core-hours
 #   2. step-size (2 x 5) and kl-estimators (3 x 5), PATRPO: ~16 min a run            ~6.5 core-hours
-#   3. platform: PATRPO (5 x ~16 min), PASVG(0) paper and PADDPG paper (10 x 3-5 h)  ~30 core-hours;
+#   3. platform: PATRPO (5 x ~16 min), PASVG(0) paper (5 x ~5 h), PADDPG paper (5 x ~3 h)  ~40 core-hours;
 #      its PASVG(0) and PADDPG arms are also issue 4's paper-preset and issue 5's benchmark runs
 #   4. PADDPG with Hausknecht & Stone's preset on Platform, 1 seed x 300k (issue 5)  ~4 core-hours
 #   5. soccer: PATRPO 3 x 5M (~1 h each); PADDPG 3 x 5M at one update per sample is ~15 core-hours a
