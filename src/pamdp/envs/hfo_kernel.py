@@ -30,6 +30,7 @@ from pathlib import Path
 import numba
 import numpy as np
 
+from pamdp.envs import hfo_features as feats
 from pamdp.envs import hfo_physics as phys
 from pamdp.envs.hfo_features import LANDMARKS
 from pamdp.envs.hfo_vector import _DASH_RATES, _SCALES, _THRESHOLD_BITS
@@ -53,7 +54,6 @@ _LANDMARK_X = LANDMARKS[:, 0].copy()
 _LANDMARK_Y = LANDMARKS[:, 1].copy()
 _MAGNITUDE_BITS = 0x7FFFFFFFFFFFFFFF
 _TINY_BITS = int(np.float64(1e-200).view(np.int64))
-_SELF_SPEED_MAX, _BALL_SPEED_MAX = 0.46, 5.0  # hfo_features.SELF_SPEED_MAX, BALL_SPEED_MAX
 
 
 DEPENDENCIES = ("hfo_physics.py", "hfo_features.py", "hfo_vector.py", "hfo_interface.py")
@@ -456,9 +456,9 @@ def finish_step(
             if obj == 0:
                 f[2] = sin_t * ux - cos_t * uy
                 f[3] = cos_t * ux + sin_t * uy
-                f[4] = min(speed, _SELF_SPEED_MAX) / (_SELF_SPEED_MAX / 2.0) - 1.0
+                f[4] = min(speed, feats.SELF_SPEED_MAX) / (feats.SELF_SPEED_MAX / 2.0) - 1.0
             else:
-                f[55] = min(speed, _BALL_SPEED_MAX) / (_BALL_SPEED_MAX / 2.0) - 1.0
+                f[55] = min(speed, feats.BALL_SPEED_MAX) / (feats.BALL_SPEED_MAX / 2.0) - 1.0
                 f[56], f[57] = uy, ux
         f[7] = min(max(seen[_STAMINA, g], 0.0), phys.STAMINA_MAX) / (phys.STAMINA_MAX / 2.0) - 1.0
         for k in range(12):  # the 11 landmarks, then the ball
