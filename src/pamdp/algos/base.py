@@ -439,6 +439,8 @@ class Algorithm:
                 f"eval_every = {eval_every!r}, eval_episodes = {eval_episodes!r}; expected eval_every >= 0 "
                 "and, when it is positive, eval_episodes >= 1"
             )
+        if eval_every > 0 and self.env_id is None:  # before training, not after its first epoch
+            raise ValueError("eval_every needs a registered env (an env id); this model's env has none")
         torch.set_num_threads(self.config.torch_threads)
         target = self.num_timesteps + int(total_timesteps)
         logger = Logger(run_dir, resume_step=self.num_timesteps) if run_dir is not None else None
@@ -485,8 +487,6 @@ class Algorithm:
     def _greedy_evaluation(self, episodes: int) -> dict[str, float]:
         from pamdp.evaluation import evaluate
 
-        if self.env_id is None:
-            raise ValueError("eval_every needs a registered env (an env id); this model's env has none")
         result = evaluate(self, episodes=episodes, seed=10_000 + self.config.seed)
         stats = {"eval/mean_return": result["mean_return"], "eval/mean_length": result["mean_length"]}
         if "goal_rate" in result:

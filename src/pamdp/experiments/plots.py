@@ -121,14 +121,6 @@ def results_table(groups: dict[str, list[Path]]) -> str:
     return "\n".join(lines)
 
 
-def _logs(runs: list[Path], metric: str) -> bool:
-    for run in runs:
-        with open(run / "progress.csv", newline="") as f:
-            if any(row.get(metric) not in (None, "") for row in csv.DictReader(f)):
-                return True
-    return False
-
-
 def write_report(roots: list[str | os.PathLike], out: str | os.PathLike, title: str = "") -> dict[str, Path]:
     """Curves (PNG, SVG), the per-epoch aggregate (CSV) and the results table (markdown) into ``out``.
 
@@ -139,7 +131,9 @@ def write_report(roots: list[str | os.PathLike], out: str | os.PathLike, title: 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     png, svg = plot_curves(groups, out / "curves", title)
-    greedy = {label: runs for label, runs in groups.items() if _logs(runs, GREEDY_METRIC)}
+    greedy = {
+        label: runs for label, runs in groups.items() if np.isfinite(aggregate(runs, GREEDY_METRIC)["mean"]).any()
+    }
     extra = {}
     if greedy:
         extra["greedy_png"], extra["greedy_svg"] = plot_curves(greedy, out / "greedy", title, GREEDY_METRIC)
