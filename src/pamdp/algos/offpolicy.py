@@ -25,7 +25,7 @@ from torch import nn
 from pamdp.algos.base import EpisodeTracker
 from pamdp.algos.replay import ReplayBuffer
 
-__all__ = ["OffPolicyLoop", "soft_update", "hard_update", "discounted_returns"]
+__all__ = ["OffPolicyLoop", "OUNoise", "soft_update", "hard_update", "discounted_returns"]
 
 # act(obs (N, d) tensor, global step, episode_start (N,) bool) -> (a (N,), x (N, m) in [-1, 1], extra fields)
 ActFn = Callable[[torch.Tensor, int, np.ndarray], tuple[torch.Tensor, torch.Tensor, dict[str, np.ndarray]]]
@@ -40,6 +40,26 @@ def soft_update(target: nn.Module, source: nn.Module, tau: float) -> None:
 
 def hard_update(target: nn.Module, source: nn.Module) -> None:
     target.load_state_dict(source.state_dict())
+
+
+class OUNoise:
+    """Ornstein-Uhlenbeck exploration noise, one process per env copy: ``n <- n - theta n + sigma N(0, 1)``.
+
+    A copy's process restarts at 0 with each of its episodes. ``theta = 1`` gives independent Gaussian noise
+    of standard deviation ``sigma`` at every step. The state is not checkpointed.
+    """
+
+    def __init__(self, theta: float, sigma: float):
+        self.theta, self.sigma = theta, sigma
+        self.state: np.ndarray | None = None
+
+    def __call__(self, shape: tuple[int, int], episode_start: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+        """The next noise ``(num_envs, size)``; ``episode_start`` marks the copies whose episode just began."""
+        if self.state is None or self.state.shape != shape:
+            self.state = np.zeros(shape)
+        self.state[episode_start] = 0.0
+        self.state += -self.theta * self.state + self.sigma * rng.standard_normal(shape)
+        return self.state
 
 
 def discounted_returns(rewards: np.ndarray, gamma: float, tail: float = 0.0) -> np.ndarray:

@@ -33,7 +33,7 @@ import torch.nn.functional as F
 from torch import nn
 
 from pamdp.algos.base import AlgoConfig, Algorithm, setting
-from pamdp.algos.offpolicy import OffPolicyLoop, soft_update
+from pamdp.algos.offpolicy import OffPolicyLoop, OUNoise, soft_update
 from pamdp.algos.replay import ReplayBuffer
 from pamdp.policies import ACTIVATIONS, mlp
 from pamdp.spaces import HybridActionSpace
@@ -199,7 +199,7 @@ class PADDPG(Algorithm):
         }
         self.replay = ReplayBuffer(cfg.buffer_size, fields)
         self.loop = OffPolicyLoop(h, self.replay, cfg.gamma, mc_returns=cfg.beta > 0, tail_value=self._target_value)
-        self._ou: np.ndarray | None = None
+        self._ou = OUNoise(cfg.ou_theta, cfg.ou_sigma)
 
     def _modules(self):
         return {
@@ -239,11 +239,8 @@ class PADDPG(Algorithm):
         cfg = self.config
         out = self.actor(obs)
         if cfg.ou_sigma > 0:
-            if self._ou is None or len(self._ou) != len(obs):
-                self._ou = np.zeros((len(obs), self.out_size - self.hybrid.n_actions))
-            self._ou[episode_start] = 0.0
-            self._ou += -cfg.ou_theta * self._ou + cfg.ou_sigma * self.np_rng.standard_normal(self._ou.shape)
-            noise = np.concatenate([np.zeros((len(obs), self.hybrid.n_actions)), self._ou], axis=1)
+            ou = self._ou((len(obs), self.out_size - self.hybrid.n_actions), episode_start, self.np_rng)
+            noise = np.concatenate([np.zeros((len(obs), self.hybrid.n_actions)), ou], axis=1)
             out = out + torch.from_numpy(noise.astype(np.float32))
         out = self._epsilon_greedy(out.clamp(-1.0, 1.0), self.epsilon(step))
         a, x = self.actor.action(out)
