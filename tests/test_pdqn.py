@@ -1,0 +1,351 @@
+"""P-DQN and MP-DQN: the multi-pass Q by hand, which parameters Q_k depends on, the actor's gradient by finite
+differences, acting and exploration, save/load, resuming, a tiny learning run, the CLI."""
+
+import csv
+import dataclasses
+import json
+
+import gymnasium
+import numpy as np
+import pytest
+import torch
+
+import pamdp
+from pamdp import PDQN
+from pamdp.algos.base import load_model
+from pamdp.algos.offpolicy import OUNoise
+from pamdp.algos.paddpg import invert_gradients
+from pamdp.algos.pdqn import ParamActor, PDQNConfig, QNetwork, backprop_actor, param_blocks
+from pamdp.cli import main
+from pamdp.spaces import HybridActionSpace
+
+SMALL = PDQNConfig(
+    hidden_sizes=(16,),
+    num_envs=4,
+    epoch_steps=200,
+    learning_starts=100,
+    batch_size=16,
+    buffer_size=5_000,
+    epsilon_steps=300,
+)
+# Three actions with 1, 2 and 1 parameters: the flat vector is [x_0 | x_1, x_1' | x_2], 4 values.
+HYBRID = HybridActionSpace(
+    (np.array([-1.0]), np.array([0.0, 0.0]), np.array([-2.0])), (np.array([1.0]), np.array([1.0, 3.0]), np.array([2.0]))
+)
+BLOCKS = [slice(0, 1), slice(1, 3), slice(3, 4)]
+
+
+def test_parameter_blocks_and_selection_by_hand():
+    np.testing.assert_array_equal(param_blocks(HYBRID), [[1, 0, 0, 0], [0, 1, 1, 0], [0, 0, 0, 1]])
+    actor = ParamActor(5, HYBRID, (8,), "relu", squash=False)
+    params = torch.tensor([[0.1, 0.2, 0.3, 0.4]] * 3)
+    x = actor.select(params, torch.tensor([0, 1, 2]))
+    torch.testing.assert_close(x, torch.tensor([[0.1, 0.0], [0.2, 0.3], [0.4, 0.0]]))
+
+
+def test_multi_pass_q_equals_k_single_action_passes():
+    torch.manual_seed(0)
+    q_net = QNetwork(5, HYBRID, (8, 8), "relu", multi_pass=True)
+    obs, params = torch.randn(6, 5), torch.randn(6, 4)
+    expected = torch.empty(6, 3)
+    for k, block in enumerate(BLOCKS):  # pass k: only action k's parameters, every other one zero
+        only_k = torch.zeros_like(params)
+        only_k[:, block] = params[:, block]
+        expected[:, k] = q_net.net(torch.cat([obs, only_k], dim=1))[:, k]
+    torch.testing.assert_close(q_net(obs, params), expected)
+    # Without multi_pass the same weights see the whole vector at once.
+    joint = QNetwork(5, HYBRID, (8, 8), "relu", multi_pass=False)
+    joint.load_state_dict(q_net.state_dict())
+    torch.testing.assert_close(joint(obs, params), q_net.net(torch.cat([obs, params], dim=1)))
+
+
+def test_only_p_dqn_q_depends_on_other_actions_parameters():
+    torch.manual_seed(1)
+    joint = QNetwork(5, HYBRID, (16,), "tanh", multi_pass=False)
+    multi = QNetwork(5, HYBRID, (16,), "tanh", multi_pass=True)
+    multi.load_state_dict(joint.state_dict())
+    obs, params = torch.randn(8, 5, dtype=torch.float64), torch.randn(8, 4, dtype=torch.float64)
+    joint.double(), multi.double()
+    h = 1e-4
+    for j, block in enumerate(BLOCKS):
+        moved = params.clone()
+        moved[:, block] += h
+        d_joint = (joint(obs, moved) - joint(obs, params)) / h  # (B, K) finite differences along block j
+        d_multi = (multi(obs, moved) - multi(obs, params)) / h
+        others = [k for k in range(3) if k != j]
+        assert d_joint[:, others].abs().min() > 1e-6, j  # P-DQN: Q_k moves with x_j, j != k
+        assert torch.all(d_multi[:, others] == 0), j  # MP-DQN: exactly not
+        assert d_multi[:, j].abs().min() > 1e-6, j  # ...but Q_j does move with x_j
+
+
+def _finite_difference(f, tensors, h=1e-6):
+    """Central differences of the scalar ``f()`` with respect to every entry of ``tensors`` (edited in place)."""
+    out = []
+    for t in tensors:
+        g = torch.zeros_like(t)
+        flat, gflat = t.data.view(-1), g.view(-1)
+        for i in range(flat.numel()):
+            old = flat[i].item()
+            flat[i] = old + h
+            up = f()
+            flat[i] = old - h
+            down = f()
+            flat[i] = old
+            gflat[i] = (up - down) / (2 * h)
+        out.append(g)
+    return out
+
+
+@pytest.mark.parametrize("multi_pass", [False, True])
+def test_actor_gradient_matches_finite_differences_of_sum_of_q(multi_pass):
+    torch.manual_seed(2)
+    actor = ParamActor(5, HYBRID, (6,), "tanh", squash=True).double()
+    q_net = QNetwork(5, HYBRID, (6,), "tanh", multi_pass=multi_pass).double()
+    obs = torch.randn(4, 5, dtype=torch.float64)
+    backprop_actor(actor, q_net, obs, "squash")  # Tanh outputs: the gradient is the plain one
+    assert all(p.grad is None for p in q_net.parameters())  # Q's weights are not trained by the actor loss
+
+    with torch.no_grad():
+        expected = _finite_difference(lambda: q_net(obs, actor(obs)).sum(-1).mean().item(), list(actor.parameters()))
+    for p, g in zip(actor.parameters(), expected):
+        torch.testing.assert_close(p.grad, -g, rtol=1e-6, atol=1e-8)  # descent on -mean sum_k Q_k
+
+
+def test_inverted_actor_gradient_matches_finite_differences():
+    torch.manual_seed(3)
+    actor = ParamActor(5, HYBRID, (6,), "tanh", squash=False).double()
+    with torch.no_grad():
+        actor.net[-1].weight.mul_(4.0)  # push some outputs past the bounds, where the inversion flips the sign
+    q_net = QNetwork(5, HYBRID, (6,), "tanh", multi_pass=True).double()
+    obs = torch.randn(4, 5, dtype=torch.float64)
+    backprop_actor(actor, q_net, obs, "invert")
+
+    with torch.no_grad():
+        p = actor(obs)
+        assert (p.abs() > 1).any()
+        (dq_dp,) = _finite_difference(lambda: q_net(obs, p).sum().item(), [p])  # d(sum_k Q_k)/dx per sample
+        g = invert_gradients(dq_dp, p)
+        expected = _finite_difference(lambda: -(g * actor(obs)).sum().item() / len(obs), list(actor.parameters()))
+    for param, e in zip(actor.parameters(), expected):
+        torch.testing.assert_close(param.grad, e, rtol=1e-6, atol=1e-8)
+
+
+@pytest.mark.parametrize("multi_pass", [False, True])
+def test_acted_action_is_the_argmax_with_its_own_parameters(multi_pass):
+    model = PDQN("pamdp/Platform-v0", dataclasses.replace(SMALL, multi_pass=multi_pass))
+    obs = torch.from_numpy(np.random.default_rng(0).uniform(0, 1, size=(64, 9)).astype(np.float32))
+    with torch.no_grad():
+        a, x = model._act(obs, deterministic=True)
+        params = model.actor(obs).clamp(-1, 1)
+        q = model.q_net(obs, params)
+    np.testing.assert_array_equal(a, q.argmax(-1))
+    torch.testing.assert_close(x[:, 0], params[torch.arange(64), a])  # Platform: action k's one parameter is k-th
+
+    env = gymnasium.make("pamdp/Platform-v0")
+    o, _ = env.reset(seed=0)
+    for _ in range(30):
+        action = model.predict(o)
+        assert env.action_space.contains(action)
+        with torch.no_grad():
+            t = torch.from_numpy(np.asarray(o, dtype=np.float32))[None]
+            p = model.actor(t).clamp(-1, 1)
+            k = int(model.q_net(t, p).argmax())
+        assert action[0] == k
+        np.testing.assert_allclose(action[1][k], model.hybrid.scale(k, [p[0, k].item()]), rtol=1e-6)
+        o, _, terminated, truncated, _ = env.step(action)
+        if terminated or truncated:
+            o, _ = env.reset()
+
+
+def test_epsilon_annealing_endpoints_and_exploration():
+    model = PDQN("pamdp/Platform-v0", dataclasses.replace(SMALL, epsilon_steps=1000, epsilon_end=0.05))
+    assert model.epsilon(0) == 1.0
+    assert model.epsilon(500) == pytest.approx(0.525)
+    assert model.epsilon(1000) == pytest.approx(0.05) and model.epsilon(10**6) == pytest.approx(0.05)
+
+    obs = torch.from_numpy(np.random.default_rng(0).uniform(0, 1, size=(3000, 9)).astype(np.float32))
+    starts = np.zeros(3000, dtype=bool)
+    with torch.no_grad():
+        greedy, _ = model._act(obs, deterministic=True)
+        a, x, extras = model._explore(obs, 0, starts)  # epsilon 1: uniform actions
+        np.testing.assert_allclose(np.bincount(a.numpy(), minlength=3) / 3000, [1 / 3] * 3, atol=0.04)
+        a, _, _ = model._explore(obs, 10**6, starts)  # epsilon 0.05: greedy but for about 5% x 2/3
+        assert np.mean(a.numpy() != greedy.numpy()) == pytest.approx(0.05 * 2 / 3, abs=0.015)
+
+
+def test_explore_params_redraws_only_the_random_actions_parameters():
+    cfg = dataclasses.replace(SMALL, explore_params=True, ou_sigma=0.0, epsilon_steps=1000)
+    model = PDQN("pamdp/Platform-v0", cfg)
+    obs = torch.from_numpy(np.random.default_rng(0).uniform(0, 1, size=(2000, 9)).astype(np.float32))
+    with torch.no_grad():
+        clean = model.actor(obs).clamp(-1, 1)
+        a, x, extras = model._explore(obs, 0, np.zeros(2000, dtype=bool))
+    params = torch.from_numpy(extras["params"])
+    chosen = torch.from_numpy(param_blocks(model.hybrid))[a]
+    torch.testing.assert_close(params[~chosen], clean[~chosen])  # the other actions keep the actor's
+    drawn = params[chosen].numpy()
+    assert drawn.min() < -0.9 and drawn.max() > 0.9 and abs(drawn.mean()) < 0.05  # uniform in [-1, 1]
+    torch.testing.assert_close(x[:, 0], params[torch.arange(2000), a])
+
+
+def test_ou_noise_restarts_per_episode_and_is_gaussian_at_theta_one():
+    rng = np.random.default_rng(0)
+    gauss = OUNoise(theta=1.0, sigma=0.3)
+    draws = np.stack([gauss((2, 3), np.zeros(2, dtype=bool), rng).copy() for _ in range(5000)])
+    assert draws.std() == pytest.approx(0.3, rel=0.03)
+    assert abs(np.corrcoef(draws[:-1, 0, 0], draws[1:, 0, 0])[0, 1]) < 0.05  # independent steps
+    ou = OUNoise(theta=0.15, sigma=0.3)
+    draws = np.stack([ou((1, 1), np.zeros(1, dtype=bool), rng).copy() for _ in range(20_000)])[:, 0, 0]
+    assert np.corrcoef(draws[:-1], draws[1:])[0, 1] == pytest.approx(0.85, abs=0.02)
+    zero_rng = np.random.default_rng(1)
+    state = ou((1, 1), np.array([True]), zero_rng)  # a restarted copy: the first step from 0
+    assert state[0, 0] == pytest.approx(0.3 * np.random.default_rng(1).standard_normal())
+
+
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        ({"bound": "clip"}, "bound = 'clip'"),
+        ({"tau_q": 0.0}, "tau_q = 0.0"),
+        ({"tau_actor": 1.5}, "tau_actor = 1.5"),
+        ({"epsilon_end": 1.5}, "epsilon_end = 1.5"),
+        ({"updates_per_step": 0.0}, "updates_per_step = 0.0"),
+        ({"beta": -0.1}, "beta = -0.1"),
+        ({"ou_theta": 0.0}, "ou_theta = 0.0"),
+        ({"hidden_sizes": ()}, "hidden_sizes = \\(\\)"),
+        ({"activation": "gelu"}, "activation = 'gelu'"),
+    ],
+)
+def test_bad_settings_raise_errors_naming_the_value(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        PDQNConfig(**kwargs)
+
+
+def test_bad_types_from_plain_data_are_named():
+    with pytest.raises(ValueError, match="'multi_pass' = 'yes'"):
+        PDQNConfig.from_dict({"multi_pass": "yes"})
+
+
+def test_presets():
+    presets = PDQNConfig.presets()
+    assert list(presets) == ["paper", "tuned"] and presets["paper"] == PDQNConfig()
+    paper, tuned = presets["paper"], presets["tuned"]
+    assert (paper.q_lr, paper.actor_lr, paper.tau_q, paper.tau_actor, paper.gamma) == (1e-3, 1e-4, 0.1, 0.001, 0.9)
+    assert (paper.batch_size, paper.buffer_size, paper.epsilon_end, paper.bound) == (128, 10_000, 0.01, "invert")
+    assert tuned.updates_per_step < 1 and tuned.num_envs >= 48  # batched env copies
+    assert not paper.multi_pass and not tuned.multi_pass  # the flag picks the method whatever the preset
+
+
+def test_replay_holds_what_q_saw_and_monte_carlo_returns():
+    model = PDQN("pamdp/Platform-v0", dataclasses.replace(SMALL, beta=0.5, ou_sigma=0.2, ou_theta=1.0))
+    model.learn(400, progress_bar=False)
+    n = len(model.replay)
+    d = {k: v[:n] for k, v in model.replay.data.items()}
+    assert np.abs(d["params"]).max() <= 1.0
+    np.testing.assert_array_equal(d["x"][:, 0], d["params"][np.arange(n), d["a"]])
+    term = d["terminated"]
+    np.testing.assert_allclose(d["mc"][term], d["reward"][term], rtol=1e-6)  # last step: return = reward
+    assert np.isfinite(d["mc"]).mean() > 0.9
+
+
+def flat_params(model):
+    return torch.cat([p.detach().flatten() for m in (model.actor, model.q_net) for p in m.parameters()])
+
+
+def test_same_seed_gives_identical_first_epochs():
+    runs = []
+    for seed in (0, 0, 1):
+        model = PDQN("pamdp/Platform-v0", dataclasses.replace(SMALL, seed=seed, multi_pass=True))
+        model.learn(200, progress_bar=False)
+        runs.append(flat_params(model))
+    torch.testing.assert_close(runs[0], runs[1], rtol=0, atol=0)
+    assert not torch.equal(runs[0], runs[2])
+
+
+@pytest.mark.parametrize("multi_pass", [False, True])
+def test_save_load_predict_round_trip(tmp_path, multi_pass):
+    model = PDQN("pamdp/Platform-v0", dataclasses.replace(SMALL, multi_pass=multi_pass))
+    model.learn(400, progress_bar=False)
+    model.save(tmp_path / "m.pt")
+    saved_rng = model.np_rng.bit_generator.state
+    for loaded in (PDQN.load(tmp_path / "m.pt"), load_model(tmp_path / "m.pt")):
+        model.np_rng.bit_generator.state = saved_rng  # the stochastic predictions below draw from it
+        assert isinstance(loaded, PDQN) and loaded.q_net.multi_pass == multi_pass
+        assert loaded.config == model.config and loaded.num_timesteps == model.num_timesteps
+        obs = np.random.default_rng(0).uniform(0, 1, size=(32, 9))
+        for deterministic in (True, False):
+            a1, p1 = model.predict(obs, deterministic=deterministic)
+            a2, p2 = loaded.predict(obs, deterministic=deterministic)
+            np.testing.assert_array_equal(a1, a2)
+            for x, y in zip(p1, p2):
+                np.testing.assert_array_equal(x, y)
+        for name, module in model._modules().items():
+            for p, q in zip(module.state_dict().values(), loaded._modules()[name].state_dict().values()):
+                assert torch.equal(p, q), name
+
+
+def _rows(run_dir):
+    with open(run_dir / "progress.csv", newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def test_resume_from_a_checkpoint(tmp_path):
+    cfg = dataclasses.replace(SMALL, save_replay=True, multi_pass=True, updates_per_step=0.5)
+    model = PDQN("pamdp/Platform-v0", cfg)
+    model.learn(600, progress_bar=False, run_dir=tmp_path)
+    resumed = PDQN.load(tmp_path / "checkpoint.pt")
+    assert (resumed.num_timesteps, resumed.epoch) == (model.num_timesteps, model.epoch)
+    assert len(resumed.replay) == len(model.replay) and resumed.loop.update_credit == model.loop.update_credit
+    n = len(model.replay)
+    np.testing.assert_array_equal(resumed.replay.data["params"][:n], model.replay.data["params"][:n])
+    steps = resumed.q_optimizer.state_dict()["state"][0]["step"]
+    assert steps == model.q_optimizer.state_dict()["state"][0]["step"] > 0
+
+    stats = []
+    resumed.learn(400, progress_bar=False, run_dir=tmp_path, callback=lambda m, s: stats.append(s))
+    assert stats[0]["train/updates"] > 0  # the replay came back, so no wait for learning_starts
+    rows = _rows(tmp_path)
+    assert [float(r["time/epoch"]) for r in rows] == [1.0, 2.0, 3.0, 4.0, 5.0]
+    assert float(rows[-1]["time/total_timesteps"]) == resumed.num_timesteps >= 1000
+
+    fresh = PDQN.load(tmp_path / "checkpoint.pt", env="pamdp/Platform-v0")
+    assert fresh.num_timesteps == resumed.num_timesteps
+    no_replay = PDQN("pamdp/Platform-v0", SMALL)
+    no_replay.learn(200, progress_bar=False)
+    no_replay.save(tmp_path / "n.pt")
+    assert len(PDQN.load(tmp_path / "n.pt").replay) == 0  # without save_replay it refills
+
+
+@pytest.mark.parametrize("multi_pass", [False, True])
+def test_tiny_learning_run_logs(tmp_path, multi_pass):
+    cfg = dataclasses.replace(SMALL, multi_pass=multi_pass, epoch_steps=500, epsilon_steps=1000, updates_per_step=0.25)
+    model = PDQN("pamdp/Platform-v0", cfg)
+    model.learn(2000, progress_bar=False, run_dir=tmp_path)
+    rows = _rows(tmp_path)
+    assert len(rows) == 4 and (tmp_path / "tb").is_dir() and (tmp_path / "checkpoint.pt").is_file()
+    last = rows[-1]
+    keys = ("losses/critic_loss", "losses/actor_loss", "train/q_mean", "train/epsilon", "train/updates")
+    keys += ("train/outputs_out_of_bounds", "charts/episodic_return", "charts/SPS", "train/action_freq_2")
+    for key in keys:
+        assert np.isfinite(float(last[key])), key
+    assert float(last["train/epsilon"]) == pytest.approx(cfg.epsilon_end)
+    assert 0.0 <= float(last["charts/episodic_return"]) <= 1.0
+
+
+def test_cli_trains_mp_dqn_resumes_and_evaluates(tmp_path, capsys):
+    out = tmp_path / "run"
+    tiny = ["--hidden-sizes", "16", "--num-envs", "4", "--epoch-steps", "200", "--learning-starts", "100"]
+    tiny += ["--batch-size", "16", "--buffer-size", "5000", "--no-progress", "--multi-pass", "true"]
+    assert main(["train", "pdqn", "--total-steps", "200", "--out", str(out), "--eval-episodes", "20", *tiny]) == 0
+    assert "greedy return over 20 episodes" in capsys.readouterr().out
+    run = json.loads((out / "run.json").read_text())
+    assert run["config"]["multi_pass"] is True and run["preset"] == "tuned"
+    assert PDQN.load(out).q_net.multi_pass
+    assert main(["train", "pdqn", "--total-steps", "400", "--out", str(out), "--eval-episodes", "0", *tiny]) == 0
+    assert "resuming" in capsys.readouterr().err
+    assert main(["evaluate", str(out), "--episodes", "10", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["episodes"] == 10
+
+
+def test_top_level_import():
+    assert pamdp.PDQN is PDQN
