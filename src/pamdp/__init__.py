@@ -13,7 +13,12 @@ __version__ = "0.1.0"
 
 register_envs()
 
-_ALGOS = {"PATRPO": "pamdp.algos.patrpo", "PASVG0": "pamdp.algos.pasvg", "PADDPG": "pamdp.algos.paddpg"}
+_ALGOS = {
+    "PATRPO": "pamdp.algos.patrpo",
+    "PASVG0": "pamdp.algos.pasvg",
+    "PADDPG": "pamdp.algos.paddpg",
+    "PDQN": "pamdp.algos.pdqn",
+}
 
 __all__ = ["HybridActionSpace", "register_envs", "__version__", *_ALGOS]
 

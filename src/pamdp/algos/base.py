@@ -309,7 +309,7 @@ def load_model(path: str | os.PathLike, env=None) -> Algorithm:
     payload = read_checkpoint(path)
     name = payload["algo"]
     if name not in _REGISTRY:
-        import_module_for = {"PATRPO": "patrpo", "PASVG0": "pasvg", "PADDPG": "paddpg"}
+        import_module_for = {"PATRPO": "patrpo", "PASVG0": "pasvg", "PADDPG": "paddpg", "PDQN": "pdqn"}
         if name in import_module_for:
             __import__(f"pamdp.algos.{import_module_for[name]}")
     if name not in _REGISTRY:

@@ -28,6 +28,7 @@ ALGORITHMS = {
     "patrpo": "pamdp.algos.patrpo:PATRPO",
     "pasvg0": "pamdp.algos.pasvg:PASVG0",
     "paddpg": "pamdp.algos.paddpg:PADDPG",
+    "pdqn": "pamdp.algos.pdqn:PDQN",
 }
 DEFAULT_PRESET = "tuned"
 
