@@ -49,8 +49,9 @@ __all__ = ["PDQN", "PDQNConfig", "ParamActor", "QNetwork", "param_blocks", "back
 
 @dataclasses.dataclass(frozen=True)
 class PDQNConfig(AlgoConfig):
-    """P-DQN's and MP-DQN's settings. The defaults are the ``paper`` preset: Bester et al.'s Platform settings
-    as far as their paper's text gives them; values it does not give are marked as assumptions in the help."""
+    """P-DQN's and MP-DQN's settings. The defaults are the ``paper`` preset: Bester et al.'s Platform settings,
+    recalled from their paper rather than checked against its text (provisional); values it does not give are
+    marked as assumptions in the help."""
 
     num_envs: int = setting(
         8, "Copies of the env stepped together; learning per sample is set by updates_per_step, not by this."
@@ -88,7 +89,7 @@ class PDQNConfig(AlgoConfig):
         "keeps the actor's, noise included (assumed for Bester et al.).",
     )
     ou_sigma: float = setting(
-        0.0001, "Scale of Ornstein-Uhlenbeck noise on the parameters, in [-1, 1] units; 0 turns it off."
+        0.0001, "Scale of Ornstein-Uhlenbeck noise on the parameters, in [-1, 1] units (Bester et al.: 1e-4); 0: off."
     )
     ou_theta: float = setting(0.15, "Mean reversion of the Ornstein-Uhlenbeck noise; 1 gives i.i.d. Gaussian noise.")
     buffer_size: int = setting(10_000, "Replay capacity (Bester et al. on Platform: 10 000).")
@@ -128,7 +129,7 @@ class PDQNConfig(AlgoConfig):
 
     @classmethod
     def presets(cls) -> dict[str, PDQNConfig]:
-        # "paper": from Bester et al.'s text as recalled here, without their code; grad_clip, learning_starts,
+        # "paper": Bester et al.'s text as recalled here (not re-read; never their code); grad_clip, learning_starts,
         # explore_params and the conversion of 1000 episodes to 5 000 samples are assumptions (see the help).
         # "tuned": the same learning rates and targets with a smaller Q-network and batch, 64 batched env copies
         # and a quarter of an update per sample. Single-seed probes of two minutes on this machine's shared core
