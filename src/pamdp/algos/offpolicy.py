@@ -1,4 +1,4 @@
-"""What PASVG(0) and PADDPG share: the collect-and-learn loop over a replay buffer, and target networks.
+"""What PASVG(0), PADDPG and PDQN share: the collect-and-learn loop over a replay buffer, and target networks.
 
 :class:`OffPolicyLoop` steps the batched env with the algorithm's exploration policy, stores every valid
 transition in the :class:`~pamdp.algos.replay.ReplayBuffer`, and interleaves gradient updates: once the

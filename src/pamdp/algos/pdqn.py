@@ -203,7 +203,9 @@ class QNetwork(nn.Module):
         return q.diagonal(dim1=1, dim2=2)  # Q_k of pass k
 
 
-def backprop_actor(actor: ParamActor, q_net: QNetwork, obs: torch.Tensor, bound: str) -> tuple[torch.Tensor, ...]:
+def backprop_actor(
+    actor: ParamActor, q_net: QNetwork, obs: torch.Tensor, bound: str
+) -> tuple[torch.Tensor, torch.Tensor]:
     """Back-propagate ``-mean_s sum_k Q_k(s, x(s))`` into the actor, with ``dQ/dx`` edited by ``bound``.
 
     Q's weights get no gradient. Returns the actor's outputs and ``Q(s, x(s))``, detached.
@@ -243,7 +245,7 @@ class PDQN(Algorithm):
             "reward": ((), np.float32),
             "next_obs": ((d,), np.float32),
             "terminated": ((), np.bool_),
-            "params": ((h.total_param_size,), np.float32),  # every action's parameters, as Q saw them
+            "params": ((h.total_param_size,), np.float32),  # every action's, after exploration: what Q learns on
         }
         if cfg.beta > 0:
             fields["mc"] = ((), np.float32)  # Monte-Carlo return-to-go, NaN until the episode ends
