@@ -8,7 +8,13 @@ import torch
 
 import pamdp
 from pamdp import PASVG0
-from pamdp.algos.pasvg import GumbelHybridPolicy, PASVG0Config, gumbel_noise, gumbel_softmax_sample
+from pamdp.algos.pasvg import (
+    GumbelHybridPolicy,
+    PASVG0Config,
+    expected_q,
+    gumbel_noise,
+    gumbel_softmax_sample,
+)
 from pamdp.spaces import HybridActionSpace
 
 SMALL = PASVG0Config(
@@ -85,6 +91,72 @@ def test_reparameterised_gradient_matches_finite_differences(hard):
         assert grads["pi_d.0.weight"].abs().sum() > 0  # the straight-through gradient reaches pi_d
 
 
+def test_expected_value_is_the_mean_over_gumbel_samples_and_its_gradient_is_exact():
+    torch.manual_seed(0)
+    policy = GumbelHybridPolicy(4, HYBRID, (8,), "tanh", init_log_std=-0.7).double()
+    for p in policy.parameters():
+        p.data.normal_(0, 0.5)
+    gen = torch.Generator().manual_seed(5)
+    obs = torch.randn(3, 4, generator=gen, dtype=torch.float64)
+    eta_x = torch.randn(3, 2, generator=gen, dtype=torch.float64)
+
+    def critic(s, a, x):  # toy_critic on (B, K, .) inputs
+        return toy_critic(s.reshape(-1, 4), a.reshape(-1, 3), x.reshape(-1, 2)).reshape(s.shape[:-1])
+
+    logits, value = expected_q(policy, critic, obs, eta_x)
+    torch.testing.assert_close(logits, policy.pi_d(obs))
+    # Monte-Carlo: the hard Gumbel-Softmax sample with the same parameter noise, averaged over eta_a.
+    n = 200_000
+    with torch.no_grad():
+        obs_n, eta_x_n = obs.repeat(n, 1), eta_x.repeat(n, 1)
+        _, a, x = policy(obs_n, gumbel_noise((3 * n, 3), gen).double(), eta_x_n, 1.0, True)
+        q = toy_critic(obs_n, a, x).reshape(n, 3)
+    np.testing.assert_allclose(value.detach(), q.mean(0), atol=4 * float(q.std(0).max()) / n**0.5)
+
+    # Its gradient reaches pi_d, pi_c and the std, and matches finite differences.
+    def objective():
+        return expected_q(policy, critic, obs, eta_x)[1].mean()
+
+    params = dict(policy.named_parameters())
+    grads = dict(zip(params, torch.autograd.grad(objective(), list(params.values()))))
+    h = 1e-6
+    for name in ("pi_d.0.weight", "pi_d.2.bias", "pi_c.0.weight", "pi_c.2.bias", "log_std"):
+        p = params[name]
+        assert grads[name].abs().sum() > 0, name
+        for flat in range(min(3, p.numel())):
+            with torch.no_grad():
+                orig = p.view(-1)[flat].item()
+                p.view(-1)[flat] = orig + h
+                up = objective().item()
+                p.view(-1)[flat] = orig - h
+                down = objective().item()
+                p.view(-1)[flat] = orig
+            assert grads[name].view(-1)[flat].item() == pytest.approx((up - down) / (2 * h), rel=1e-5, abs=1e-8), name
+
+
+def test_expected_td_target_averages_the_target_policys_actions():
+    model = PASVG0("pamdp/Platform-v0", dataclasses.replace(SMALL, discrete_gradient="expected", learning_starts=10**6))
+    model.learn(200, progress_bar=False)
+    batch = model.replay.sample(16, np.random.default_rng(0))
+    model.replay.sample = lambda n, rng: batch
+    gen_state = model.torch_gen.get_state()
+    with torch.no_grad():
+        q = model.critic(batch["obs"], batch["a_in"], batch["x"])
+        model.torch_gen.set_state(gen_state)
+        _, eta_x = model._noise(16)
+        model.torch_gen.set_state(gen_state)
+        s2, pt, K = batch["next_obs"], model.policy_target, 3
+        total = torch.zeros(16)
+        for k in range(K):  # one action at a time, by hand
+            onehot = torch.nn.functional.one_hot(torch.full((16,), k), K).float()
+            x_k = pt.params(s2, torch.full((16,), k), onehot, eta_x)
+            total += pt.pi_d(s2).softmax(-1)[:, k] * model.critic_target(s2, onehot, x_k)
+        y = batch["reward"] + 0.99 * (~batch["terminated"]).float() * total
+    stats = model._update()
+    assert stats["losses/critic_loss"] == pytest.approx(float(((q - y) ** 2).mean()), rel=1e-5)
+    assert {"losses/actor_loss", "train/q_pi_mean"} <= set(stats)
+
+
 def test_parameters_stay_in_bounds_and_unused_ones_are_zero():
     policy = GumbelHybridPolicy(4, HYBRID, (8,), "relu", init_log_std=1.5)
     gen = torch.Generator().manual_seed(0)
@@ -108,6 +180,8 @@ def test_parameters_stay_in_bounds_and_unused_ones_are_zero():
         ({"target_entropy": 0.5, "entropy_coef": 0.0}, "entropy_coef = 0.0"),
         ({"explore_epsilon": 1.5}, "explore_epsilon = 1.5"),
         ({"policy_delay": 0}, "policy_delay = 0"),
+        ({"discrete_gradient": "reinforce"}, "discrete_gradient = 'reinforce'"),
+        ({"discrete_gradient": "expected", "straight_through": False}, "straight_through = False"),
     ],
 )
 def test_bad_settings_raise_clear_errors(kwargs, match):

@@ -13,6 +13,11 @@ loss ``-Q`` trains ``pi_d`` and ``pi_c`` together. The noise ``eta = (eta_a, eta
 recorded with the transition: as the paper notes, the policy gradient at a replayed state reuses it, with no
 inference of ``p(eta | s, a, x)``.
 
+With ``discrete_gradient="expected"`` (not in the paper) the Gumbel-Softmax estimate of ``pi_d``'s gradient
+is replaced by the exact expectation over the K actions, ``J = E_s E_eta_x [sum_k pi_d(k|s) Q(s, k, g(s, k,
+eta_x))]``, and the TD target likewise averages the target policy's actions: with few actions (K = 3 on
+Platform) the K critic evaluations cost little and remove the straight-through estimator's bias.
+
 The critic ``Q(s, a, x)`` (the action as a one-hot, or the soft sample) is trained by TD from replay against
 target networks updated softly, as in DDPG; the next action in the target is drawn from the target policy
 with fresh noise, so ``Q`` estimates the value of the stochastic policy being optimised.
@@ -35,7 +40,7 @@ from pamdp.algos.replay import ReplayBuffer
 from pamdp.policies import ACTIVATIONS, mlp
 from pamdp.spaces import HybridActionSpace
 
-__all__ = ["PASVG0", "PASVG0Config", "GumbelHybridPolicy", "gumbel_noise", "gumbel_softmax_sample"]
+__all__ = ["PASVG0", "PASVG0Config", "GumbelHybridPolicy", "expected_q", "gumbel_noise", "gumbel_softmax_sample"]
 
 LOG_STD_MIN, LOG_STD_MAX = -5.0, 2.0
 
@@ -79,6 +84,13 @@ class PASVG0Config(AlgoConfig):
         "(with pi_c's parameters for it), so that every action keeps appearing in replay; 0 in the paper. "
         "The policy update does not see it: it replays the recorded noise through the current policy.",
     )
+    discrete_gradient: str = setting(
+        "gumbel",
+        "How pi_d's gradient is estimated: gumbel (the paper) differentiates Q through the Gumbel-Softmax "
+        "sample; expected takes the exact expectation over the K actions, sum_k pi_d(k|s) Q(s, k, x_k), in the "
+        "policy loss and in the TD target (pi_c's parameters for every action from the same recorded eta_x): "
+        "no estimator bias and lower variance, at K critic evaluations per state. Not in the paper.",
+    )
     twin_critics: bool = setting(
         False,
         "Two critics trained on the same TD target, taken from the smaller of their two target networks "
@@ -121,6 +133,11 @@ class PASVG0Config(AlgoConfig):
             self._check(self.entropy_coef > 0, "entropy_coef", "a positive starting weight when target_entropy is set")
         self._check(self.entropy_lr > 0, "entropy_lr", "a positive learning rate")
         self._check(0 <= self.explore_epsilon <= 1, "explore_epsilon", "a probability in [0, 1]")
+        self._check(self.discrete_gradient in ("gumbel", "expected"), "discrete_gradient", "'gumbel' or 'expected'")
+        if self.discrete_gradient == "expected":
+            self._check(
+                self.straight_through, "straight_through", "True with discrete_gradient 'expected' (Q sees one-hots)"
+            )
         self._check(self.policy_delay >= 1, "policy_delay", "an integer >= 1")
         self._check(self.critic_lr > 0, "critic_lr", "a positive learning rate")
         self._check(self.policy_lr > 0, "policy_lr", "a positive learning rate")
@@ -223,11 +240,36 @@ class GumbelHybridPolicy(nn.Module):
         std = self.log_std.clamp(LOG_STD_MIN, LOG_STD_MAX).exp()[index]
         return torch.tanh(self.pi_c(torch.cat([obs, a], dim=-1)) + std * eta_x) * self.mask[index]
 
+    def params_all(self, obs: torch.Tensor, eta_x: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+        """Every action's parameters for the noise ``eta_x``: ``(obs_k, onehots, x)``, each ``(B, K, .)``.
+
+        ``obs_k`` and ``onehots`` are the critic's matching state and action inputs, so that
+        ``critic(obs_k, onehots, x)`` is ``Q(s, k, x_k)`` for every ``k`` in one batched pass.
+        """
+        batch, K = obs.shape[0], self.n_actions
+        index = torch.arange(K).expand(batch, K)
+        onehots = torch.eye(K, dtype=obs.dtype).expand(batch, K, K)
+        obs_k = obs.unsqueeze(1).expand(batch, K, obs.shape[-1])
+        return obs_k, onehots, self.params(obs_k, index, onehots, eta_x.unsqueeze(1))
+
     def mode(self, obs: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
         """The greedy action: the most probable discrete action and its mean parameters."""
         index = self.pi_d(obs).argmax(-1)
         onehot = F.one_hot(index, self.n_actions).to(obs.dtype)
         return index, torch.tanh(self.pi_c(torch.cat([obs, onehot], dim=-1))) * self.mask[index]
+
+
+def expected_q(
+    policy: GumbelHybridPolicy, critic: nn.Module, obs: torch.Tensor, eta_x: torch.Tensor
+) -> tuple[torch.Tensor, torch.Tensor]:
+    """``(logits, E_{k ~ pi_d}[Q(s, k, g(s, k, eta_x))])``: the value the Gumbel-Softmax sample estimates, exactly.
+
+    Differentiable in both policies: in ``pi_d`` through the probabilities, in ``pi_c`` through every
+    action's parameters, each weighted by its probability.
+    """
+    logits = policy.pi_d(obs)
+    q_all = critic(*policy.params_all(obs, eta_x))
+    return logits, (logits.softmax(-1) * q_all).sum(-1)
 
 
 class EntropyWeight(nn.Module):
@@ -382,12 +424,17 @@ class PASVG0(Algorithm):
         b = self.replay.sample(cfg.batch_size, self.np_rng)
         obs, next_obs = b["obs"], b["next_obs"]
         with torch.no_grad():
-            _, a_next, x_next = self.policy_target(
-                next_obs, *self._noise(len(obs)), cfg.temperature, cfg.straight_through
-            )
-            q_next = self.critic_target(next_obs, a_next, x_next)
+            eta_a, eta_x = self._noise(len(obs))
+            if cfg.discrete_gradient == "expected":
+                inputs = self.policy_target.params_all(next_obs, eta_x)
+            else:
+                _, a_next, x_next = self.policy_target(next_obs, eta_a, eta_x, cfg.temperature, cfg.straight_through)
+                inputs = (next_obs, a_next, x_next)
+            q_next = self.critic_target(*inputs)
             if self.critic2 is not None:
-                q_next = torch.minimum(q_next, self.critic2_target(next_obs, a_next, x_next))
+                q_next = torch.minimum(q_next, self.critic2_target(*inputs))
+            if cfg.discrete_gradient == "expected":  # E_k~pi_d'[Q'(s', k, x'_k)]
+                q_next = (self.policy_target.pi_d(next_obs).softmax(-1) * q_next).sum(-1)
             y = b["reward"] + cfg.gamma * (~b["terminated"]).float() * q_next
         q = self.critic(obs, b["a_in"], b["x"])
         critic_loss = F.mse_loss(q, y)
@@ -409,8 +456,11 @@ class PASVG0(Algorithm):
         """The value-gradient step of pi_d and pi_c, the entropy weight's step and the soft target updates."""
         cfg = self.config
         # The recorded noise, pushed through the current policy: a = f(s, eta_a), x = g(s, a, eta_x).
-        logits, _, a, x = self.policy.sample(obs, b["eta_a"], b["eta_x"], cfg.temperature, cfg.straight_through)
-        q_pi = self.critic(obs, a, x)
+        if cfg.discrete_gradient == "expected":
+            logits, q_pi = expected_q(self.policy, self.critic, obs, b["eta_x"])
+        else:
+            logits, _, a, x = self.policy.sample(obs, b["eta_a"], b["eta_x"], cfg.temperature, cfg.straight_through)
+            q_pi = self.critic(obs, a, x)
         entropy = -(logits.softmax(-1) * logits.log_softmax(-1)).sum(-1).mean()
         alpha = cfg.entropy_coef if self.entropy_weight is None else float(self.entropy_weight().detach())
         actor_loss = -q_pi.mean() - alpha * entropy
