@@ -192,6 +192,22 @@ def test_save_load_predict_round_trip(tmp_path):
             assert torch.equal(p, q), name
 
 
+def test_beta_zero_stores_no_returns_and_learns_from_the_pure_td_target():
+    model = PADDPG("pamdp/Platform-v0", dataclasses.replace(SMALL, beta=0.0, learning_starts=10**6))
+    model.learn(200, progress_bar=False)
+    assert "mc" not in model.replay.data and len(model.replay) >= 200
+    batch = model.replay.sample(16, np.random.default_rng(0))
+    model.replay.sample = lambda n, rng: batch
+    with torch.no_grad():
+        q = model.critic(batch["obs"], batch["out"])
+        s2 = batch["next_obs"]
+        y = batch["reward"] + 0.99 * (~batch["terminated"]).float() * model.critic_target(
+            s2, model.actor_target(s2).clamp(-1, 1)
+        )
+    stats = model._update()
+    assert stats["losses/critic_loss"] == pytest.approx(float(((q - y) ** 2).mean()), rel=1e-5)
+
+
 def test_critic_loss_falls_on_a_fixed_batch():
     model = PADDPG("pamdp/Platform-v0", dataclasses.replace(SMALL, learning_starts=10**6, hidden_sizes=(64, 64)))
     model.learn(200, progress_bar=False)

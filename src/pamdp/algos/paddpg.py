@@ -195,8 +195,9 @@ class PADDPG(Algorithm):
             "next_obs": ((d,), np.float32),
             "terminated": ((), np.bool_),
             "out": ((self.out_size,), np.float32),  # the output vector the critic sees (after exploration)
-            "mc": ((), np.float32),  # Monte-Carlo return-to-go, NaN until the episode ends
         }
+        if cfg.beta > 0:  # the loop fills it only when asked to compute Monte-Carlo returns
+            fields["mc"] = ((), np.float32)  # Monte-Carlo return-to-go, NaN until the episode ends
         self.replay = ReplayBuffer(cfg.buffer_size, fields)
         self.loop = OffPolicyLoop(h, self.replay, cfg.gamma, mc_returns=cfg.beta > 0, tail_value=self._target_value)
         self._ou = OUNoise(cfg.ou_theta, cfg.ou_sigma)
