@@ -113,6 +113,41 @@ def test_resume_after_a_killed_worker(tmp_path):
     assert steps == sorted(set(steps)) and steps[-1] >= 3000
 
 
+@pytest.mark.skipif(not os.path.isdir("/proc/self/fd"), reason="finds the worker through /proc")
+def test_a_killed_worker_fails_its_run_alone(tmp_path):
+    exp = write_experiment(tmp_path / "tiny.toml")
+    exp.write_text(exp.read_text().replace("total_steps = 600", "total_steps = 3000"))
+    out = tmp_path / "results"
+    runs = out / "tiny" / "small_delta"
+    cmd = [sys.executable, "-m", "pamdp.cli", "reproduce", str(exp), "--out", str(out), "--workers", "2"]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+
+    def worker_writing(log):  # the process that holds seed 1's log open
+        for fd_dir in (f"/proc/{pid}/fd" for pid in os.listdir("/proc") if pid.isdigit()):
+            try:
+                if any(os.readlink(os.path.join(fd_dir, fd)) == str(log) for fd in os.listdir(fd_dir)):
+                    return int(fd_dir.split("/")[2])
+            except OSError:
+                continue
+        return None
+
+    deadline, victim = time.time() + 120, None
+    while victim is None and time.time() < deadline:
+        time.sleep(0.1)
+        if (runs / "seed1" / "checkpoint.pt").exists():
+            victim = worker_writing(runs / "seed1" / "stdout.log")
+    assert victim is not None and victim != proc.pid
+    os.kill(victim, signal.SIGKILL)
+    _, err = proc.communicate(timeout=300)
+    assert proc.returncode == 1, err
+    assert "FAILED" in err and "seed1" in err and "1 of 2 runs failed" in err
+    assert (runs / "seed0" / "evaluation.json").exists()  # the run beside it finished
+    assert not (runs / "seed1" / "evaluation.json").exists()
+    again = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
+    assert again.returncode == 0, again.stderr
+    assert "resuming" in (runs / "seed1" / "stdout.log").read_text()
+
+
 def test_greedy_evaluations_get_their_own_figure(tmp_path):
     from pamdp.experiments.plots import GREEDY_METRIC, aggregate, write_report
 

@@ -167,17 +167,21 @@ def run_all(jobs: list[tuple[RunSpec, str]], workers: int = 1, log=print) -> lis
             log(_describe(outcomes[-1]))
         return outcomes
     ctx = multiprocessing.get_context("spawn")
-    with cf.ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
-        started = {pool.submit(_worker, spec, out): (spec, out, time.time()) for spec, out in jobs}
-        for fut in cf.as_completed(started):
-            spec, out, t0 = started[fut]
-            try:
-                outcome = RunOutcome(spec, out, fut.result(), None, time.time() - t0)
-            except Exception as exc:
-                detail = "".join(traceback.format_exception(exc))
-                outcome = RunOutcome(spec, out, None, detail, time.time() - t0)
-            outcomes.append(outcome)
-            log(_describe(outcome))
+
+    def run_one(spec: RunSpec, out: str) -> RunOutcome:
+        # A process pool of its own per run: a worker that dies (killed, out of memory) breaks only its own
+        # pool, so it fails that run alone while the runs beside it go on.
+        t0 = time.time()
+        try:
+            with cf.ProcessPoolExecutor(max_workers=1, mp_context=ctx) as pool:
+                return RunOutcome(spec, out, pool.submit(_worker, spec, out).result(), None, time.time() - t0)
+        except Exception as exc:
+            return RunOutcome(spec, out, None, "".join(traceback.format_exception(exc)), time.time() - t0)
+
+    with cf.ThreadPoolExecutor(max_workers=workers) as threads:
+        for fut in cf.as_completed([threads.submit(run_one, spec, out) for spec, out in jobs]):
+            outcomes.append(fut.result())
+            log(_describe(outcomes[-1]))
     return outcomes
 
 
