@@ -11,12 +11,13 @@
 # and the experiments' directories, to be committed by hand with notes.
 #
 # Costs on the 2-core Intel Xeon of 2026-11-28, per run with another run on the other core:
-#   1. PASVG(0) tuned, 5 x 1M (issue 4's target):          ~85 min a run            ~7 core-hours
+#   1. PASVG(0) tuned (preset G), 5 x 1M (issue 4's target): ~55 min a run          ~5 core-hours
 #   2. step-size (2 x 5) and kl-estimators (3 x 5), PATRPO: ~16 min a run            ~6.5 core-hours
-#   3. platform: PATRPO (5 x ~16 min), PASVG(0) paper (5 x ~5 h), PADDPG paper (5 x ~3 h)  ~40 core-hours;
+#   3. MP-DQN and P-DQN tuned, 2 x 5 x 300k (beyond the paper): a few minutes a run       ~1 core-hour
+#   4. platform: PATRPO (5 x ~16 min), PASVG(0) paper (5 x ~5 h), PADDPG paper (5 x ~3 h)  ~40 core-hours;
 #      its PASVG(0) and PADDPG arms are also issue 4's paper-preset and issue 5's benchmark runs
-#   4. PADDPG with Hausknecht & Stone's preset on Platform, 1 seed x 300k (issue 5)  ~4 core-hours
-#   5. soccer: PATRPO 3 x 5M (~1 h each); PADDPG 3 x 5M at one update per sample is ~15 core-hours a
+#   5. PADDPG with Hausknecht & Stone's preset on Platform, 1 seed x 300k (issue 5)  ~4 core-hours
+#   6. soccer: PATRPO 3 x 5M (~1 h each); PADDPG 3 x 5M at one update per sample is ~15 core-hours a
 #      run here, so it runs as far as the sessions allow (issue 7 asks for "as far as the machine allows")
 set -euo pipefail
 cd "$(dirname "$0")"
@@ -25,6 +26,7 @@ RUNS=${PAMDP_RUNS:-/root/pamdp-runs}
 python bench_pasvg_platform.py --workers 2 --out "$RUNS/bench"
 pamdp reproduce step-size --workers 2 --out "$RUNS/repro"
 pamdp reproduce kl-estimators --workers 2 --out "$RUNS/repro"
+python bench_pdqn_platform.py --workers 2 --out "$RUNS/bench"
 pamdp reproduce platform --workers 2 --out "$RUNS/repro"
 pamdp train paddpg --preset hausknecht_stone --seed 0 --total-steps 300000 --save-replay true \
     --eval-every 5 --no-progress --out "$RUNS/bench/paddpg_hausknecht_stone/seed0"
