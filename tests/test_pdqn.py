@@ -14,8 +14,8 @@ import pamdp
 from pamdp import PDQN
 from pamdp.algos.base import load_model
 from pamdp.algos.offpolicy import OUNoise
-from pamdp.algos.paddpg import invert_gradients
-from pamdp.algos.pdqn import ParamActor, PDQNConfig, QNetwork, backprop_actor, param_blocks
+from pamdp.algos.paddpg import backprop_actor, invert_gradients
+from pamdp.algos.pdqn import ParamActor, PDQNConfig, QNetwork, param_blocks
 from pamdp.cli import main
 from pamdp.spaces import HybridActionSpace
 

@@ -7,7 +7,7 @@ import pytest
 import torch
 from torch import nn
 
-from pamdp.algos.offpolicy import discounted_returns, soft_update
+from pamdp.algos.offpolicy import clipped_step, discounted_returns, linear_epsilon, mixed_target, soft_update
 from pamdp.algos.replay import ReplayBuffer
 
 FIELDS = {"obs": ((2,), np.float32), "a": ((), np.int64), "eta": ((3,), np.float32)}
@@ -102,3 +102,21 @@ def test_soft_update_is_polyak_averaging():
     before = target.weight.detach().clone()
     soft_update(target, source, 0.25)
     torch.testing.assert_close(target.weight.detach(), 0.75 * before + 0.25 * source.weight.detach())
+
+
+def test_mixed_target_by_hand_keeps_td_where_the_return_is_unknown():
+    y = torch.tensor([1.0, 2.0, 3.0])
+    mc = torch.tensor([0.0, float("nan"), 5.0])
+    torch.testing.assert_close(mixed_target(y, mc, 0.25), torch.tensor([0.75, 2.0, 3.5]))
+
+
+def test_linear_epsilon_endpoints():
+    assert [linear_epsilon(s, 1.0, 0.1, 100) for s in (0, 50, 100, 10**6)] == pytest.approx([1.0, 0.55, 0.1, 0.1])
+
+
+@pytest.mark.parametrize("max_norm, expected_norm", [(0.0, 5.0), (1.0, 1.0), (10.0, 5.0)])
+def test_clipped_step_clips_the_gradient_norm_before_stepping(max_norm, expected_norm):
+    w = nn.Parameter(torch.zeros(2))
+    w.grad = torch.tensor([3.0, 4.0])  # norm 5
+    clipped_step(torch.optim.SGD([w], lr=1.0), [w], max_norm)
+    assert float(w.detach().norm()) == pytest.approx(expected_norm)

@@ -25,7 +25,16 @@ from torch import nn
 from pamdp.algos.base import EpisodeTracker
 from pamdp.algos.replay import ReplayBuffer
 
-__all__ = ["OffPolicyLoop", "OUNoise", "soft_update", "hard_update", "discounted_returns"]
+__all__ = [
+    "OffPolicyLoop",
+    "OUNoise",
+    "soft_update",
+    "hard_update",
+    "clipped_step",
+    "linear_epsilon",
+    "mixed_target",
+    "discounted_returns",
+]
 
 # act(obs (N, d) tensor, global step, episode_start (N,) bool) -> (a (N,), x (N, m) in [-1, 1], extra fields)
 ActFn = Callable[[torch.Tensor, int, np.ndarray], tuple[torch.Tensor, torch.Tensor, dict[str, np.ndarray]]]
@@ -60,6 +69,26 @@ class OUNoise:
         self.state[episode_start] = 0.0
         self.state += -self.theta * self.state + self.sigma * rng.standard_normal(shape)
         return self.state
+
+
+def clipped_step(optimizer: torch.optim.Optimizer, params, max_norm: float) -> None:
+    """One optimizer step, the gradient's total norm first clipped to ``max_norm`` (0: no clipping)."""
+    if max_norm > 0:
+        nn.utils.clip_grad_norm_(params, max_norm)
+    optimizer.step()
+
+
+def linear_epsilon(step: int, start: float, end: float, steps: int) -> float:
+    """An exploration rate falling linearly from ``start`` to ``end`` over ``steps`` samples, then held."""
+    return start + min(step / steps, 1.0) * (end - start)
+
+
+def mixed_target(y: torch.Tensor, mc: torch.Tensor, beta: float) -> torch.Tensor:
+    """Hausknecht & Stone's mixed target ``beta * MC + (1 - beta) * y`` where the Monte-Carlo return is known.
+
+    ``mc`` is NaN for transitions whose episode has not ended yet; those keep the TD target ``y``.
+    """
+    return torch.where(torch.isnan(mc), y, beta * mc.nan_to_num() + (1 - beta) * y)
 
 
 def discounted_returns(rewards: np.ndarray, gamma: float, tail: float = 0.0) -> np.ndarray:

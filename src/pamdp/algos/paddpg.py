@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+from collections.abc import Callable
 
 import numpy as np
 import torch
@@ -33,12 +34,12 @@ import torch.nn.functional as F
 from torch import nn
 
 from pamdp.algos.base import AlgoConfig, Algorithm, setting
-from pamdp.algos.offpolicy import OffPolicyLoop, OUNoise, soft_update
+from pamdp.algos.offpolicy import OffPolicyLoop, OUNoise, clipped_step, linear_epsilon, mixed_target, soft_update
 from pamdp.algos.replay import ReplayBuffer
 from pamdp.policies import ACTIVATIONS, mlp
 from pamdp.spaces import HybridActionSpace
 
-__all__ = ["PADDPG", "PADDPGConfig", "invert_gradients", "zero_gradients", "BOUNDS"]
+__all__ = ["PADDPG", "PADDPGConfig", "invert_gradients", "zero_gradients", "backprop_actor", "BOUNDS"]
 
 BOUNDS = ("invert", "squash", "zero")
 
@@ -131,6 +132,29 @@ def zero_gradients(grad: torch.Tensor, p: torch.Tensor, low: float = -1.0, high:
     """Zero the components of the ascent direction ``grad`` that push an output at or past a bound further out."""
     leaving = ((grad > 0) & (p >= high)) | ((grad < 0) & (p <= low))
     return torch.where(leaving, torch.zeros_like(grad), grad)
+
+
+def backprop_actor(
+    actor: Callable[[torch.Tensor], torch.Tensor],
+    critic: Callable[[torch.Tensor, torch.Tensor], torch.Tensor],
+    obs: torch.Tensor,
+    bound: str,
+) -> tuple[torch.Tensor, torch.Tensor]:
+    """Back-propagate ``-mean_s Q(s, mu(s))`` into the actor, with ``dQ/dmu`` edited by ``bound`` on the way.
+
+    ``Q`` is summed over its last axis if it has one (P-DQN's K values). The critic's weights get no gradient.
+    Returns the actor's outputs and ``Q(s, mu(s))``, detached.
+    """
+    out = actor(obs)
+    p = out.detach().requires_grad_(True)
+    q = critic(obs, p)
+    (dq_dp,) = torch.autograd.grad(q.sum(), p)  # per-sample dQ/dp, the ascent direction
+    if bound == "invert":
+        dq_dp = invert_gradients(dq_dp, p.detach())
+    elif bound == "zero":
+        dq_dp = zero_gradients(dq_dp, p.detach())
+    out.backward(-dq_dp / len(out))  # descend on -mean Q
+    return out.detach(), q.detach()
 
 
 class Actor(nn.Module):
@@ -228,8 +252,7 @@ class PADDPG(Algorithm):
     def epsilon(self, step: int) -> float:
         """The exploration rate after ``step`` samples: linear from epsilon_start to epsilon_end."""
         cfg = self.config
-        frac = min(step / cfg.epsilon_steps, 1.0)
-        return cfg.epsilon_start + frac * (cfg.epsilon_end - cfg.epsilon_start)
+        return linear_epsilon(step, cfg.epsilon_start, cfg.epsilon_end, cfg.epsilon_steps)
 
     def _epsilon_greedy(self, out: torch.Tensor, eps: float) -> torch.Tensor:
         random = self.np_rng.random(len(out)) < eps
@@ -268,11 +291,6 @@ class PADDPG(Algorithm):
         stats["train/epsilon"] = self.epsilon(self.num_timesteps + stats["steps"])
         return stats
 
-    def _step(self, optimizer: torch.optim.Optimizer, params) -> None:
-        if self.config.grad_clip > 0:
-            nn.utils.clip_grad_norm_(params, self.config.grad_clip)
-        optimizer.step()
-
     def _update(self) -> dict[str, float]:
         """One critic step on the mixed target and one actor step along the bounded ``dQ/dmu``."""
         cfg = self.config
@@ -282,32 +300,23 @@ class PADDPG(Algorithm):
             q_next = self.critic_target(next_obs, self.actor_target(next_obs).clamp(-1.0, 1.0))
             y = b["reward"] + cfg.gamma * (~b["terminated"]).float() * q_next
             if cfg.beta > 0:
-                known = ~torch.isnan(b["mc"])
-                y = torch.where(known, cfg.beta * b["mc"].nan_to_num() + (1 - cfg.beta) * y, y)
+                y = mixed_target(y, b["mc"], cfg.beta)
         q = self.critic(obs, b["out"])
         critic_loss = F.mse_loss(q, y)
         self.critic_optimizer.zero_grad(set_to_none=True)
         critic_loss.backward()
-        self._step(self.critic_optimizer, self.critic.parameters())
+        clipped_step(self.critic_optimizer, self.critic.parameters(), cfg.grad_clip)
 
-        out = self.actor(obs)
-        p = out.detach().requires_grad_(True)
-        q_mu = self.critic(obs, p)
-        (dq_dp,) = torch.autograd.grad(q_mu.sum(), p)  # per-sample dQ/dp, the ascent direction
-        if cfg.bound == "invert":
-            dq_dp = invert_gradients(dq_dp, p.detach())
-        elif cfg.bound == "zero":
-            dq_dp = zero_gradients(dq_dp, p.detach())
         self.actor_optimizer.zero_grad(set_to_none=True)
-        out.backward(-dq_dp / len(out))  # descend on -mean Q
-        self._step(self.actor_optimizer, self.actor.parameters())
+        out, q_mu = backprop_actor(self.actor, self.critic, obs, cfg.bound)
+        clipped_step(self.actor_optimizer, self.actor.parameters(), cfg.grad_clip)
 
         soft_update(self.critic_target, self.critic, cfg.tau)
         soft_update(self.actor_target, self.actor, cfg.tau)
-        outside = (out.detach().abs() > 1.0).float().mean()
+        outside = (out.abs() > 1.0).float().mean()
         return {
             "losses/critic_loss": float(critic_loss.detach()),
-            "losses/actor_loss": float(-q_mu.detach().mean()),
+            "losses/actor_loss": float(-q_mu.mean()),
             "train/q_mean": float(q.detach().mean()),
             "train/outputs_out_of_bounds": float(outside),
         }

@@ -35,7 +35,7 @@ import torch.nn.functional as F
 from torch import nn
 
 from pamdp.algos.base import AlgoConfig, Algorithm, setting
-from pamdp.algos.offpolicy import OffPolicyLoop, soft_update
+from pamdp.algos.offpolicy import OffPolicyLoop, clipped_step, soft_update
 from pamdp.algos.replay import ReplayBuffer
 from pamdp.policies import ACTIVATIONS, mlp
 from pamdp.spaces import HybridActionSpace
@@ -419,11 +419,6 @@ class PASVG0(Algorithm):
             self.np_rng,
         )
 
-    def _step(self, optimizer: torch.optim.Optimizer, params) -> None:
-        if self.config.grad_clip > 0:
-            nn.utils.clip_grad_norm_(params, self.config.grad_clip)
-        optimizer.step()
-
     def _update(self) -> dict[str, float]:
         """One critic TD step and (every ``policy_delay``-th call) one value-gradient step of both policies."""
         cfg = self.config
@@ -448,7 +443,7 @@ class PASVG0(Algorithm):
             critic_loss = critic_loss + F.mse_loss(self.critic2(obs, b["a_in"], b["x"]), y)
         self.critic_optimizer.zero_grad(set_to_none=True)
         critic_loss.backward()
-        self._step(self.critic_optimizer, self.critic_params)
+        clipped_step(self.critic_optimizer, self.critic_params, cfg.grad_clip)
         self.critic_updates += 1
         if self.critic_updates % cfg.policy_delay == 0:
             self._policy_stats = self._policy_update(obs, b)
@@ -475,7 +470,7 @@ class PASVG0(Algorithm):
         grads = torch.autograd.grad(actor_loss, self.policy_params)
         for p, g in zip(self.policy_params, grads):
             p.grad = g
-        self._step(self.policy_optimizer, self.policy_params)
+        clipped_step(self.policy_optimizer, self.policy_params, cfg.grad_clip)
         if self.entropy_weight is not None:
             alpha_loss = self.entropy_weight.log_alpha * (float(entropy.detach()) - cfg.target_entropy)
             self.entropy_optimizer.zero_grad(set_to_none=True)

@@ -38,13 +38,13 @@ import torch.nn.functional as F
 from torch import nn
 
 from pamdp.algos.base import AlgoConfig, Algorithm, setting
-from pamdp.algos.offpolicy import OffPolicyLoop, OUNoise, soft_update
-from pamdp.algos.paddpg import BOUNDS, invert_gradients, zero_gradients
+from pamdp.algos.offpolicy import OffPolicyLoop, OUNoise, clipped_step, linear_epsilon, mixed_target, soft_update
+from pamdp.algos.paddpg import BOUNDS, backprop_actor
 from pamdp.algos.replay import ReplayBuffer
 from pamdp.policies import ACTIVATIONS, mlp
 from pamdp.spaces import HybridActionSpace
 
-__all__ = ["PDQN", "PDQNConfig", "ParamActor", "QNetwork", "param_blocks", "backprop_actor"]
+__all__ = ["PDQN", "PDQNConfig", "ParamActor", "QNetwork", "param_blocks"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -203,25 +203,6 @@ class QNetwork(nn.Module):
         return q.diagonal(dim1=1, dim2=2)  # Q_k of pass k
 
 
-def backprop_actor(
-    actor: ParamActor, q_net: QNetwork, obs: torch.Tensor, bound: str
-) -> tuple[torch.Tensor, torch.Tensor]:
-    """Back-propagate ``-mean_s sum_k Q_k(s, x(s))`` into the actor, with ``dQ/dx`` edited by ``bound``.
-
-    Q's weights get no gradient. Returns the actor's outputs and ``Q(s, x(s))``, detached.
-    """
-    x = actor(obs)
-    p = x.detach().requires_grad_(True)
-    q = q_net(obs, p)
-    (dq_dp,) = torch.autograd.grad(q.sum(), p)  # per-sample d(sum_k Q_k)/dx, the ascent direction
-    if bound == "invert":
-        dq_dp = invert_gradients(dq_dp, p.detach())
-    elif bound == "zero":
-        dq_dp = zero_gradients(dq_dp, p.detach())
-    x.backward(-dq_dp / len(x))
-    return x.detach(), q.detach()
-
-
 class PDQN(Algorithm):
     """P-DQN (Xiong et al. 2018) and, with ``multi_pass``, MP-DQN (Bester et al. 2019). See :class:`PDQNConfig`."""
 
@@ -276,8 +257,7 @@ class PDQN(Algorithm):
     def epsilon(self, step: int) -> float:
         """The exploration rate after ``step`` samples: linear from epsilon_start to epsilon_end."""
         cfg = self.config
-        frac = min(step / cfg.epsilon_steps, 1.0)
-        return cfg.epsilon_start + frac * (cfg.epsilon_end - cfg.epsilon_start)
+        return linear_epsilon(step, cfg.epsilon_start, cfg.epsilon_end, cfg.epsilon_steps)
 
     def _epsilon_greedy(self, a: torch.Tensor, params: torch.Tensor, eps: float):
         """With probability ``eps`` a uniform discrete action (with ``explore_params``, uniform parameters for it)."""
@@ -320,11 +300,6 @@ class PDQN(Algorithm):
         stats["train/epsilon"] = self.epsilon(self.num_timesteps + stats["steps"])
         return stats
 
-    def _step(self, optimizer: torch.optim.Optimizer, params) -> None:
-        if self.config.grad_clip > 0:
-            nn.utils.clip_grad_norm_(params, self.config.grad_clip)
-        optimizer.step()
-
     def _update(self) -> dict[str, float]:
         """One TD step of the Q-network, one actor step along the bounded ``d sum_k Q_k / dx``, soft target updates."""
         cfg = self.config
@@ -334,17 +309,16 @@ class PDQN(Algorithm):
             q_next = self.q_target(next_obs, self.actor_target(next_obs).clamp(-1.0, 1.0)).max(-1).values
             y = b["reward"] + cfg.gamma * (~b["terminated"]).float() * q_next
             if cfg.beta > 0:
-                known = ~torch.isnan(b["mc"])
-                y = torch.where(known, cfg.beta * b["mc"].nan_to_num() + (1 - cfg.beta) * y, y)
+                y = mixed_target(y, b["mc"], cfg.beta)
         q = self.q_net(obs, b["params"]).gather(1, b["a"][:, None]).squeeze(1)
         q_loss = F.mse_loss(q, y)
         self.q_optimizer.zero_grad(set_to_none=True)
         q_loss.backward()
-        self._step(self.q_optimizer, self.q_net.parameters())
+        clipped_step(self.q_optimizer, self.q_net.parameters(), cfg.grad_clip)
 
         self.actor_optimizer.zero_grad(set_to_none=True)
         x, q_x = backprop_actor(self.actor, self.q_net, obs, cfg.bound)
-        self._step(self.actor_optimizer, self.actor.parameters())
+        clipped_step(self.actor_optimizer, self.actor.parameters(), cfg.grad_clip)
 
         soft_update(self.q_target, self.q_net, cfg.tau_q)
         soft_update(self.actor_target, self.actor, cfg.tau_actor)
