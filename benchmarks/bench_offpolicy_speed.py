@@ -31,11 +31,14 @@ import tempfile
 import time
 from pathlib import Path
 
+# (algorithm, preset, settings on top of the preset, label)
 CASES = [
-    ("PASVG0", "paper"),
-    ("PASVG0", "tuned"),
-    ("PADDPG", "paper"),
-    ("PADDPG", "hausknecht_stone"),
+    ("PASVG0", "paper", {}, "paper"),
+    ("PASVG0", "tuned", {}, "tuned"),
+    ("PADDPG", "paper", {}, "paper"),
+    ("PADDPG", "hausknecht_stone", {}, "hausknecht_stone"),
+    ("PDQN", "tuned", {"multi_pass": False}, "tuned (P-DQN)"),
+    ("PDQN", "tuned", {"multi_pass": True}, "tuned (MP-DQN)"),
 ]
 REPO = Path(__file__).resolve().parents[1]
 
@@ -51,8 +54,9 @@ def cpu_name() -> str:
 def config_classes():
     from pamdp.algos.paddpg import PADDPG, PADDPGConfig
     from pamdp.algos.pasvg import PASVG0, PASVG0Config
+    from pamdp.algos.pdqn import PDQN, PDQNConfig
 
-    return {"PASVG0": (PASVG0, PASVG0Config), "PADDPG": (PADDPG, PADDPGConfig)}
+    return {"PASVG0": (PASVG0, PASVG0Config), "PADDPG": (PADDPG, PADDPGConfig), "PDQN": (PDQN, PDQNConfig)}
 
 
 def worker(algo: str, config_json: str, n_updates: int, n_samples: int) -> int:
@@ -138,7 +142,7 @@ def main(argv=None) -> int:
     import torch
 
     classes = config_classes()
-    head = "# Off-policy training speed (PASVG(0), PADDPG) on Platform"
+    head = "# Off-policy training speed (PASVG(0), PADDPG, P-DQN, MP-DQN) on Platform"
     cols = "| algorithm | preset | hidden layers | batch | num_envs | updates/sample | updates/s | samples/s |"
     rule = "|---|---|---|---|---|---|---|---|"
     if args.baseline:
@@ -171,10 +175,10 @@ def main(argv=None) -> int:
     ]
     with tempfile.TemporaryDirectory() as tmp:
         sources = [None] + ([export_source(args.baseline, tmp)] if args.baseline else [])
-        for name, preset in CASES:
-            cfg = classes[name][1].preset(preset)
+        for name, preset, overrides, label in CASES:
+            cfg = dataclasses.replace(classes[name][1].preset(preset), **overrides)
             results = measure(name, cfg.to_dict(), args, sources)
-            cells = [name, preset, "-".join(map(str, cfg.hidden_sizes)), cfg.batch_size, cfg.num_envs]
+            cells = [name, label, "-".join(map(str, cfg.hidden_sizes)), cfg.batch_size, cfg.num_envs]
             cells.append(f"{cfg.updates_per_step:g}")
             now = results[0]
             if args.baseline:
