@@ -53,6 +53,25 @@ def toy_critic(obs, a, x):
     return torch.sin(obs.sum(-1)) * (a @ w) + (a @ w) * (x - 0.3).pow(2).sum(-1) + torch.cos(3 * x[:, 0])
 
 
+def assert_gradients_match_finite_differences(objective, params: dict, names, picks: int = 4, h: float = 1e-6):
+    """Autograd's gradient of ``objective()`` against central differences, at ``picks`` entries of each named tensor."""
+    grads = dict(zip(params, torch.autograd.grad(objective(), list(params.values()))))
+    rng = np.random.default_rng(3)
+    for name in names:
+        p = params[name]
+        for flat in rng.choice(p.numel(), size=min(picks, p.numel()), replace=False):
+            with torch.no_grad():
+                orig = p.view(-1)[flat].item()
+                p.view(-1)[flat] = orig + h
+                up = objective().item()
+                p.view(-1)[flat] = orig - h
+                down = objective().item()
+                p.view(-1)[flat] = orig
+            fd = (up - down) / (2 * h)
+            assert grads[name].view(-1)[flat].item() == pytest.approx(fd, rel=1e-5, abs=1e-8), name
+    return grads
+
+
 @pytest.mark.parametrize("hard", [False, True])
 def test_reparameterised_gradient_matches_finite_differences(hard):
     torch.manual_seed(0)
@@ -69,24 +88,10 @@ def test_reparameterised_gradient_matches_finite_differences(hard):
         return toy_critic(obs, a, x).mean()
 
     params = dict(policy.named_parameters())
-    grads = dict(zip(params, torch.autograd.grad(objective(), list(params.values()))))
     # With soft samples J is smooth in every parameter. With hard samples the forward pass is piecewise
     # constant in pi_d (straight-through is a biased estimator by design), but exact for pi_c and the std.
     names = list(params) if not hard else [n for n in params if not n.startswith("pi_d")]
-    rng = np.random.default_rng(3)
-    h = 1e-6
-    for name in names:
-        p = params[name]
-        for flat in rng.choice(p.numel(), size=min(4, p.numel()), replace=False):
-            with torch.no_grad():
-                orig = p.view(-1)[flat].item()
-                p.view(-1)[flat] = orig + h
-                up = objective().item()
-                p.view(-1)[flat] = orig - h
-                down = objective().item()
-                p.view(-1)[flat] = orig
-            fd = (up - down) / (2 * h)
-            assert grads[name].view(-1)[flat].item() == pytest.approx(fd, rel=1e-5, abs=1e-8), name
+    grads = assert_gradients_match_finite_differences(objective, params, names)
     if hard:
         assert grads["pi_d.0.weight"].abs().sum() > 0  # the straight-through gradient reaches pi_d
 
@@ -117,21 +122,9 @@ def test_expected_value_is_the_mean_over_gumbel_samples_and_its_gradient_is_exac
     def objective():
         return expected_q(policy, critic, obs, eta_x)[1].mean()
 
-    params = dict(policy.named_parameters())
-    grads = dict(zip(params, torch.autograd.grad(objective(), list(params.values()))))
-    h = 1e-6
-    for name in ("pi_d.0.weight", "pi_d.2.bias", "pi_c.0.weight", "pi_c.2.bias", "log_std"):
-        p = params[name]
-        assert grads[name].abs().sum() > 0, name
-        for flat in range(min(3, p.numel())):
-            with torch.no_grad():
-                orig = p.view(-1)[flat].item()
-                p.view(-1)[flat] = orig + h
-                up = objective().item()
-                p.view(-1)[flat] = orig - h
-                down = objective().item()
-                p.view(-1)[flat] = orig
-            assert grads[name].view(-1)[flat].item() == pytest.approx((up - down) / (2 * h), rel=1e-5, abs=1e-8), name
+    names = ("pi_d.0.weight", "pi_d.2.bias", "pi_c.0.weight", "pi_c.2.bias", "log_std")
+    grads = assert_gradients_match_finite_differences(objective, dict(policy.named_parameters()), names, picks=3)
+    assert all(grads[name].abs().sum() > 0 for name in names)
 
 
 def test_expected_td_target_averages_the_target_policys_actions():
