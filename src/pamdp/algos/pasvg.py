@@ -419,6 +419,11 @@ class PASVG0(Algorithm):
             self.np_rng,
         )
 
+    def _target_q(self, obs: torch.Tensor, a: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
+        """The target critic's ``Q'``; with ``twin_critics`` the smaller of the two target critics' values."""
+        q = self.critic_target(obs, a, x)
+        return q if self.critic2 is None else torch.minimum(q, self.critic2_target(obs, a, x))
+
     def _update(self) -> dict[str, float]:
         """One critic TD step and (every ``policy_delay``-th call) one value-gradient step of both policies."""
         cfg = self.config
@@ -426,16 +431,11 @@ class PASVG0(Algorithm):
         obs, next_obs = b["obs"], b["next_obs"]
         with torch.no_grad():
             eta_a, eta_x = self._noise(len(obs))
-            if cfg.discrete_gradient == "expected":
-                inputs = self.policy_target.params_all(next_obs, eta_x)
+            if cfg.discrete_gradient == "expected":  # E_k~pi_d'[Q'(s', k, x'_k)]
+                _, q_next = expected_q(self.policy_target, self._target_q, next_obs, eta_x)
             else:
                 _, a_next, x_next = self.policy_target(next_obs, eta_a, eta_x, cfg.temperature, cfg.straight_through)
-                inputs = (next_obs, a_next, x_next)
-            q_next = self.critic_target(*inputs)
-            if self.critic2 is not None:
-                q_next = torch.minimum(q_next, self.critic2_target(*inputs))
-            if cfg.discrete_gradient == "expected":  # E_k~pi_d'[Q'(s', k, x'_k)]
-                q_next = (self.policy_target.pi_d(next_obs).softmax(-1) * q_next).sum(-1)
+                q_next = self._target_q(next_obs, a_next, x_next)
             y = b["reward"] + cfg.gamma * (~b["terminated"]).float() * q_next
         q = self.critic(obs, b["a_in"], b["x"])
         critic_loss = F.mse_loss(q, y)
