@@ -6,6 +6,7 @@ Importing the package registers its environments with Gymnasium (``pamdp/Platfor
 
 from importlib import import_module
 
+from pamdp.algos import MODULE_OF as _ALGOS
 from pamdp.envs import register_envs
 from pamdp.spaces import HybridActionSpace
 
@@ -13,12 +14,6 @@ __version__ = "0.1.0"
 
 register_envs()
 
-_ALGOS = {
-    "PATRPO": "pamdp.algos.patrpo",
-    "PASVG0": "pamdp.algos.pasvg",
-    "PADDPG": "pamdp.algos.paddpg",
-    "PDQN": "pamdp.algos.pdqn",
-}
 
 __all__ = ["HybridActionSpace", "register_envs", "__version__", *_ALGOS]
 

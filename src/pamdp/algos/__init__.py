@@ -1,1 +1,12 @@
 """Learning algorithms for parameterized action spaces, sharing one API (see ``base.py``)."""
+
+# Command-line name -> "module:Class", the one list of algorithms. Modules are imported on first use only:
+# they import torch, and `import pamdp` stays light.
+ALGORITHMS = {
+    "patrpo": "pamdp.algos.patrpo:PATRPO",
+    "pasvg0": "pamdp.algos.pasvg:PASVG0",
+    "paddpg": "pamdp.algos.paddpg:PADDPG",
+    "pdqn": "pamdp.algos.pdqn:PDQN",
+}
+MODULE_OF = {target.partition(":")[2]: target.partition(":")[0] for target in ALGORITHMS.values()}
+"""Class name -> its module, e.g. ``"PATRPO" -> "pamdp.algos.patrpo"``."""

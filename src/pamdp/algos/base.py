@@ -31,6 +31,7 @@ from gymnasium import spaces
 from gymnasium.vector import AutoresetMode
 
 import pamdp
+from pamdp.algos import MODULE_OF
 from pamdp.spaces import HybridActionSpace
 
 __all__ = ["AlgoConfig", "Algorithm", "setting", "load_model", "make_vector_env", "EpisodeTracker", "Logger"]
@@ -309,9 +310,8 @@ def load_model(path: str | os.PathLike, env=None) -> Algorithm:
     payload = read_checkpoint(path)
     name = payload["algo"]
     if name not in _REGISTRY:
-        import_module_for = {"PATRPO": "patrpo", "PASVG0": "pasvg", "PADDPG": "paddpg", "PDQN": "pdqn"}
-        if name in import_module_for:
-            __import__(f"pamdp.algos.{import_module_for[name]}")
+        if name in MODULE_OF:
+            __import__(MODULE_OF[name])
     if name not in _REGISTRY:
         raise ValueError(f"{path} was written by unknown algorithm {name!r}")
     return _REGISTRY[name]._from_payload(payload, env)

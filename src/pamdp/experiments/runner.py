@@ -22,14 +22,10 @@ import traceback
 from pathlib import Path
 from typing import Any
 
+from pamdp.algos import ALGORITHMS
+
 __all__ = ["RunSpec", "default_preset", "train_run", "run_all", "algorithm_class", "ALGORITHMS", "DEFAULT_PRESET"]
 
-ALGORITHMS = {
-    "patrpo": "pamdp.algos.patrpo:PATRPO",
-    "pasvg0": "pamdp.algos.pasvg:PASVG0",
-    "paddpg": "pamdp.algos.paddpg:PADDPG",
-    "pdqn": "pamdp.algos.pdqn:PDQN",
-}
 DEFAULT_PRESET = "tuned"
 
 
