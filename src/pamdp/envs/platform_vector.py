@@ -10,6 +10,9 @@ is proportional to the total number of sub-steps (~72 per copy for a random poli
 With the noise switched off (``venv.np_random = ZeroNoise()`` after ``reset()``), every copy follows the
 scalar env bit for bit. With noise on the statistics are the same, but the draws are batched and in a
 different order, so individual trajectories differ from a scalar env driven by the same generator.
+
+With Numba installed (``pip install pamdp[fast]``) the sub-step loop runs instead as one compiled loop
+(``platform_kernel.py``), with the same numbers bit for bit; this NumPy loop stays the reference.
 """
 
 from __future__ import annotations
@@ -18,6 +21,7 @@ import numpy as np
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
+from pamdp.envs.hfo_vector import _pick_backend
 from pamdp.envs.platform import (
     AX_MAX,
     AY_MAX,
@@ -44,6 +48,7 @@ from pamdp.envs.platform import (
     VY_MAX,
     X_GOAL,
     PlatformEnv,
+    ZeroNoise,
     draw_platform,
     platform_observation,
 )
@@ -121,6 +126,12 @@ class PlatformVectorEnv(VectorEnv):
         max_episode_steps: episodes are truncated after this many agent steps (the registration's 200;
             ``make_vec`` passes it in). ``None`` never truncates.
         render_mode: ``None`` or ``"rgb_array"``; :meth:`render` then returns one frame per copy.
+        backend: ``"numba"`` runs the sub-steps in the compiled loop of ``platform_kernel.py`` (needs
+            ``pip install pamdp[fast]``), ``"numpy"`` with NumPy alone, ``"auto"`` with Numba when it imports.
+            Both give the same numbers bit for bit, and leave ``np_random`` in the same state. The Numba loop
+            reads NumPy generators' streams (``Generator``, ``RandomState``) or :class:`ZeroNoise`; with any
+            other noise source a step runs the NumPy loop. ``gymnasium.make_vec(..., backend=...)`` passes
+            it in.
     """
 
     metadata = {
@@ -129,7 +140,14 @@ class PlatformVectorEnv(VectorEnv):
         "autoreset_mode": AutoresetMode.NEXT_STEP,
     }
 
-    def __init__(self, num_envs: int = 1, max_episode_steps: int | None = 200, render_mode: str | None = None):
+    def __init__(
+        self,
+        num_envs: int = 1,
+        max_episode_steps: int | None = 200,
+        render_mode: str | None = None,
+        backend: str = "auto",
+    ):
+        self.backend = _pick_backend(backend)
         if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) or num_envs < 1:
             raise ValueError(f"num_envs must be a positive integer, got {num_envs!r}")
         if max_episode_steps is not None and (
@@ -153,6 +171,7 @@ class PlatformVectorEnv(VectorEnv):
         self._state = np.repeat(INITIAL_STATE[:, None], self.num_envs, axis=1)
         self._elapsed = np.zeros(self.num_envs, dtype=np.int64)
         self._autoreset = np.zeros(self.num_envs, dtype=bool)
+        self._kernel_setup()
 
     @property
     def state(self) -> dict[str, np.ndarray]:
@@ -190,7 +209,7 @@ class PlatformVectorEnv(VectorEnv):
         terminated = np.zeros(self.num_envs, dtype=bool)
         substeps = np.zeros(self.num_envs, dtype=np.int64)
         idx = np.flatnonzero(stepping)
-        if idx.size:
+        if idx.size and not self._kernel_substeps(idx, a, p, rewards, terminated, substeps):
             self._run_substeps(idx, a[idx], p[idx], rewards, terminated, substeps)
 
         self._elapsed[stepping] += 1
@@ -300,6 +319,64 @@ class PlatformVectorEnv(VectorEnv):
                     w, idx, is_run, on = w.compress(live, axis=1), idx[live], is_run[live], on[live]
                     n, live = n_live, np.ones(n_live, dtype=bool)
                     e1x_at = E1X * n + np.arange(n)
+
+    def _kernel_substeps(self, idx, a, p, rewards, terminated, substeps) -> bool:
+        """:meth:`_run_substeps` in ``platform_kernel`` (``a`` and ``p`` for every copy). False, having done
+        nothing, with the NumPy backend or if ``np_random`` is no NumPy generator, whose stream the kernel reads.
+
+        The kernel takes the step's draws as one array of standard normals, whose length is known only at
+        the end: drawn in chunks, the last of which is drawn again up to the last number used after
+        rewinding the generator, so that it ends where the NumPy loop leaves it.
+        """
+        if self._kernel is None:
+            return False
+        rng = self.np_random
+        if isinstance(rng, ZeroNoise):
+            draw, snapshot, rewind = np.zeros, lambda: None, lambda saved: None
+        elif isinstance(rng, np.random.Generator):
+            bits = rng.bit_generator
+            draw, snapshot, rewind = (
+                rng.standard_normal,
+                lambda: bits.state,
+                lambda saved: setattr(bits, "state", saved),
+            )
+        elif isinstance(rng, np.random.RandomState):
+            draw, snapshot, rewind = rng.standard_normal, rng.get_state, rng.set_state
+        else:
+            return False
+        # The first chunk is 3/4 of the last step's draws, the later ones 1/8: the last chunk is drawn twice,
+        # and each chunk after the first costs a call and a snapshot, as much as drawing several hundred numbers.
+        guess = self._draws_guess
+        saved, start = snapshot(), 0
+        draws = draw(max(3 * guess // 4, 2 * idx.size))
+        cursor = np.zeros(4, dtype=np.int64)
+        run = self._kernel.run_substeps
+        while not run(idx, a, p, self._state, draws, *self._kernel_scratch, cursor, rewards, terminated, substeps):
+            saved, start = snapshot(), draws.size
+            draws = np.concatenate([draws, draw(max(guess // 8, 2 * idx.size, 1024))])
+        used = int(cursor[self._kernel.USED])
+        if used < draws.size:
+            rewind(saved)
+            draw(used - start)
+        self._draws_guess = used
+        return True
+
+    def _kernel_setup(self) -> None:
+        """The kernel's module and scratch space (``backend="numba"``), or ``_kernel = None``."""
+        self._kernel = None
+        if self.backend != "numba":
+            return
+        from pamdp.envs import platform_kernel
+
+        n = self.num_envs
+        self._kernel = platform_kernel
+        self._kernel_scratch = (
+            np.empty((platform_kernel.WORK_ROWS, n)),
+            np.empty(n, dtype=np.int64),
+            np.empty(n, dtype=bool),
+            np.empty(n, dtype=bool),
+        )
+        self._draws_guess = 0
 
     def _observations(self) -> np.ndarray:
         s = self._state
