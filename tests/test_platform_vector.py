@@ -9,6 +9,13 @@ import pamdp  # noqa: F401  (registers pamdp/Platform-v0)
 from pamdp.envs.platform import PlatformEnv, PlatformVectorEnv, ZeroNoise
 from pamdp.spaces import HybridActionSpace
 
+try:
+    import numba  # noqa: F401
+
+    HAVE_NUMBA = True
+except ImportError:
+    HAVE_NUMBA = False
+
 SCRIPT = [(1, 480), (0, 30), (0, 0), (1, 720), (1, 480), (0, 5), (0, 5), (1, 720), (0, 5), (0, 30)]
 
 
@@ -34,11 +41,16 @@ def test_make_vec_returns_the_batched_env():
     np.testing.assert_array_equal(info["substeps"], 0)
 
 
-def test_equals_scalar_envs_without_noise():
+BACKENDS = ["numpy", pytest.param("numba", marks=pytest.mark.skipif(not HAVE_NUMBA, reason="needs numba"))]
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_equals_scalar_envs_without_noise(backend):
     """Random actions in odd copies; the scripted policy then standing still (to reach the time limit) in
     even ones. Compared with Gymnasium's SyncVectorEnv over scalar envs, so autoreset is compared too."""
     n = 12
-    venv = gymnasium.make_vec("pamdp/Platform-v0", num_envs=n, vectorization_mode="vector_entry_point")
+    venv = gymnasium.make_vec("pamdp/Platform-v0", num_envs=n, vectorization_mode="vector_entry_point", backend=backend)
+    assert venv.backend == backend
     ref = SyncVectorEnv([lambda: gymnasium.make("pamdp/Platform-v0") for _ in range(n)])
     venv.reset(seed=0)
     ref.reset(seed=0)
@@ -77,11 +89,12 @@ def test_next_step_autoreset():
     assert reward[0] == 0.0 and not terminated[0] and not truncated[0] and info["substeps"].tolist() == [0, 20]
 
 
-def test_random_policy_statistics_with_noise():
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_random_policy_statistics_with_noise(backend):
     # Spec §8: mean return ~0.154 (std ~0.10), ~2.2 steps per episode, ~72 sub-steps per step. Only each
     # copy's first episode counts, so that short episodes are not over-represented.
     n = 3000
-    venv = PlatformVectorEnv(num_envs=n)
+    venv = PlatformVectorEnv(num_envs=n, backend=backend)
     venv.reset(seed=0)
     venv.action_space.seed(0)
     returns, first_done = np.zeros(n), np.zeros(n, dtype=bool)
