@@ -48,6 +48,21 @@ def test_the_papers_experiments_are_available_with_its_settings():
         load_experiment("nope")
 
 
+def test_runs_selects_an_experiments_arms_by_label_or_directory_name(tmp_path, capsys):
+    platform = load_experiment("platform")
+    assert [s.label for s in platform.specs(seeds=[0], labels=["PATRPO", "PASVG_0_"])] == ["PATRPO", "PASVG(0)"]
+    assert {s.seed for s in platform.specs(labels=["PADDPG"])} == {0, 1, 2, 3, 4}
+    with pytest.raises(ValueError, match=r"run labels 'PPO' not in experiment 'platform'; expected .*'PADDPG'"):
+        platform.specs(labels=["PATRPO", "PPO"])
+    exp = write_experiment(tmp_path / "two.toml", '[[runs]]\nlabel = "other"\nalgo = "patrpo"\n' + TINY_SETTINGS)
+    out = tmp_path / "results"
+    assert main(["reproduce", str(exp), "--out", str(out), "--seeds", "0", "--runs", "other"]) == 0
+    assert (out / "two" / "other" / "seed0" / "evaluation.json").exists()
+    assert not (out / "two" / "small_delta").exists()
+    assert main(["reproduce", str(exp), "--out", str(out), "--runs", "nope"]) == 2
+    assert "run labels 'nope' not in experiment 'two'" in capsys.readouterr().err
+
+
 def test_tiny_experiment_end_to_end(tmp_path, capsys):
     exp = write_experiment(tmp_path / "tiny.toml")
     out = tmp_path / "results"

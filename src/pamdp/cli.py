@@ -132,6 +132,7 @@ def build_parser() -> argparse.ArgumentParser:
     rp = sub.add_parser("reproduce", help="run one of the paper's experiments (all settings and seeds) and plot it")
     rp.add_argument("name", help="platform, step-size, kl-estimators, soccer, or an experiment TOML file")
     rp.add_argument("--seeds", default=None, help="comma-separated seeds (default: the experiment's)")
+    rp.add_argument("--runs", default=None, help="comma-separated run labels to run (default: all), e.g. --runs PATRPO")
     rp.add_argument("--scale", type=float, default=1.0, help="multiply the step budget, e.g. 0.1 for a quick look")
     rp.add_argument("--workers", type=int, default=1, help="runs side by side in processes (one torch thread each)")
     rp.add_argument("--out", default="results", help="results root (default: %(default)s)")
@@ -206,7 +207,8 @@ def cmd_reproduce(args) -> int:
 
     exp = load_experiment(args.name)
     seeds = [int(s) for s in args.seeds.split(",")] if args.seeds else None
-    jobs = [(spec, str(exp.run_dir(args.out, spec))) for spec in exp.specs(seeds, args.scale)]
+    labels = [label.strip() for label in args.runs.split(",")] if args.runs is not None else None
+    jobs = [(spec, str(exp.run_dir(args.out, spec))) for spec in exp.specs(seeds, args.scale, labels)]
     for spec, _ in jobs:
         spec.config()  # every setting is checked before the first run starts
     print(f"{exp.name}: {exp.description}; {len(jobs)} runs of {jobs[0][0].total_steps:,} steps", file=sys.stderr)

@@ -35,13 +35,24 @@ class Experiment:
     env_kwargs: dict = dataclasses.field(default_factory=dict)
     eval_every: int = 0
 
-    def specs(self, seeds=None, scale: float = 1.0) -> list[RunSpec]:
-        """One :class:`RunSpec` per (run, seed); ``scale`` multiplies the step budget."""
+    def specs(self, seeds=None, scale: float = 1.0, labels=None) -> list[RunSpec]:
+        """One :class:`RunSpec` per (run, seed); ``scale`` multiplies the step budget; ``labels`` (run labels
+        or their directory names) keeps only those runs, in the experiment's order."""
         if scale <= 0:
             raise ValueError(f"scale = {scale!r}; expected a positive factor")
         steps = max(1, int(round(self.total_steps * scale)))
+        runs = self.runs
+        if labels is not None:
+            names = {name for run in self.runs for name in (run["label"], _slug(run["label"]))}
+            unknown = [label for label in labels if label not in names]
+            if unknown or not labels:
+                raise ValueError(
+                    f"run labels {', '.join(map(repr, unknown)) or '(none given)'} not in experiment {self.name!r}; "
+                    "expected some of " + ", ".join(repr(run["label"]) for run in self.runs)
+                )
+            runs = [run for run in self.runs if run["label"] in labels or _slug(run["label"]) in labels]
         out = []
-        for run in self.runs:
+        for run in runs:
             for seed in self.seeds if seeds is None else seeds:
                 settings = tuple(sorted(run.get("settings", {}).items()))
                 env_kwargs = tuple(sorted({**self.env_kwargs, **run.get("env_kwargs", {})}.items()))
@@ -62,8 +73,12 @@ class Experiment:
         return out
 
     def run_dir(self, root: str | os.PathLike, spec: RunSpec) -> Path:
-        slug = re.sub(r"[^A-Za-z0-9_.=-]+", "_", spec.label)
-        return Path(root) / self.name / slug / f"seed{spec.seed}"
+        return Path(root) / self.name / _slug(spec.label) / f"seed{spec.seed}"
+
+
+def _slug(label: str) -> str:
+    """A run label as a directory name."""
+    return re.sub(r"[^A-Za-z0-9_.=-]+", "_", label)
 
 
 def load_experiment(name_or_path: str | os.PathLike) -> Experiment:
