@@ -14,6 +14,7 @@ One epoch, as section "Parameterized Actions TRPO" of the paper reads:
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 
 import numpy as np
 import torch
@@ -22,8 +23,9 @@ from pamdp.algos.base import AlgoConfig, Algorithm, EpisodeTracker, setting
 from pamdp.algos.trpo import FisherVectorProduct, backtracking_line_search, conjugate_gradient, flat_grad
 from pamdp.distributions import KL_ESTIMATORS, kl_divergence
 from pamdp.policies import ACTIVATIONS, HybridPolicy, ValueNetwork
+from pamdp.spaces import HybridActionSpace
 
-__all__ = ["PATRPO", "PATRPOConfig", "LinearFeatureBaseline", "gae"]
+__all__ = ["PATRPO", "PATRPOConfig", "LinearFeatureBaseline", "Rollout", "advantage_batch", "gae"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -138,6 +140,98 @@ def gae(
     return adv
 
 
+class Rollout:
+    """On-policy sampling of a :class:`~pamdp.policies.HybridPolicy` in a vector env (PATRPO's and PAPPO's).
+
+    Episodes run on across epochs (an epoch's last step bootstraps from the value function), so no partial
+    episode is thrown away; a new ``Rollout`` (as after loading a model) starts new episodes. Gymnasium's
+    vector envs reset a finished copy on the *next* step, ignoring its action: those autoreset steps are
+    marked invalid and carry no sample.
+    """
+
+    KEYS = ("obs", "a", "x", "reward", "terminated", "done", "valid", "next_obs", "t")
+
+    def __init__(self):
+        # (observation, autoreset pending, step within episode) of every env copy between epochs
+        self.state: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+        self.tracker: EpisodeTracker | None = None
+
+    def collect(
+        self,
+        env,
+        policy: HybridPolicy,
+        hybrid: HybridActionSpace,
+        n_samples: int,
+        np_rng: np.random.Generator,
+        torch_gen: torch.Generator,
+    ) -> dict[str, np.ndarray]:
+        """Step ``env`` with ``(a, x) ~ policy`` until ``n_samples`` valid samples; ``(T, N, ...)`` arrays of
+        :attr:`KEYS` (``t``: the step within the episode; ``terminated`` and ``done`` are false when not valid).
+        """
+        n = env.num_envs
+        if self.state is None:
+            obs, _ = env.reset(seed=int(np_rng.integers(2**31 - 1)))
+            self.state = (obs, np.zeros(n, dtype=bool), np.zeros(n, dtype=np.int64))
+            self.tracker = EpisodeTracker(n)
+        obs, prev_done, t_ep = self.state
+        rows: dict[str, list] = {k: [] for k in self.KEYS}
+        n_valid = 0
+        while n_valid < n_samples:
+            with torch.no_grad():
+                a, x = policy(torch.as_tensor(np.asarray(obs, dtype=np.float32))).sample(torch_gen)
+            next_obs, reward, terminated, truncated, _ = env.step(hybrid.to_env_batch(a.numpy(), x.numpy()))
+            valid = ~prev_done
+            done = (terminated | truncated) & valid
+            row = (obs, a.numpy(), x.numpy(), reward, terminated & valid, done, valid, next_obs, t_ep)
+            for k, v in zip(self.KEYS, row):
+                rows[k].append(np.array(v))
+            self.tracker.step(np.asarray(reward, dtype=np.float64), done, valid)
+            n_valid += int(valid.sum())
+            t_ep = np.where(valid, t_ep + 1, 0)
+            prev_done, obs = done, next_obs
+        self.state = (obs, prev_done, t_ep)
+        return {k: np.stack(v) for k, v in rows.items()}
+
+    def epoch_stats(self, a: np.ndarray, n_actions: int) -> dict[str, float]:
+        """The discrete actions' frequencies, the episodes completed since the last call, and ``steps``."""
+        freq = np.bincount(a, minlength=n_actions) / len(a)
+        stats = {f"train/action_freq_{k}": float(f) for k, f in enumerate(freq)}
+        stats.update(self.tracker.pop())
+        stats["steps"] = len(a)
+        return stats
+
+
+def advantage_batch(
+    batch: dict[str, np.ndarray],
+    values_fn: Callable[[np.ndarray, np.ndarray], np.ndarray],
+    gamma: float,
+    lam: float,
+    normalize: bool,
+) -> tuple[dict[str, np.ndarray], float]:
+    """GAE over a :meth:`Rollout.collect` batch, flattened to its valid samples.
+
+    ``values_fn(obs, t)`` is the baseline's value ``(B,)`` of observations at step ``t`` of their episodes.
+    Returns the valid samples' ``obs, t, a, x``, ``adv`` (standardised within the batch when ``normalize``),
+    ``returns`` (``adv + values``, the baseline's regression target) and ``values``, with the fraction of
+    the returns' variance the values explain.
+    """
+    T, N = batch["reward"].shape
+    flat = lambda arr: arr.reshape(T * N, *arr.shape[2:])  # noqa: E731
+    values = values_fn(flat(batch["obs"]), flat(batch["t"])).reshape(T, N)
+    next_values = values_fn(flat(batch["next_obs"]), flat(batch["t"]) + 1).reshape(T, N)
+    adv = gae(batch["reward"], values, next_values, batch["terminated"], batch["done"], gamma, lam)
+    returns = adv + values
+
+    valid = flat(batch["valid"])
+    data = {k: flat(batch[k])[valid] for k in ("obs", "t", "a", "x")}
+    data.update(adv=flat(adv)[valid], returns=flat(returns)[valid], values=flat(values)[valid])
+    var_ret = np.var(data["returns"])
+    explained_var = float(1 - np.var(data["returns"] - data["values"]) / var_ret) if var_ret > 0 else float("nan")
+    if normalize:
+        data["adv"] = (data["adv"] - data["adv"].mean()) / (data["adv"].std() + 1e-8)
+    return data, explained_var
+
+
 class LinearFeatureBaseline:
     """rllab's baseline: ridge regression of returns on ``[clip(s), s^2, t/100, (t/100)^2, (t/100)^3, 1]``."""
 
@@ -180,10 +274,7 @@ class PATRPO(Algorithm):
             self.vf_optimizer = torch.optim.Adam(self.value.parameters(), lr=cfg.vf_lr)
         else:
             self.linear_baseline = LinearFeatureBaseline(self.obs_dim)
-        self.tracker = EpisodeTracker(cfg.num_envs)
-        # (observation, autoreset pending, step within episode) of every env copy between epochs; a loaded
-        # model starts new episodes.
-        self._rollout: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+        self.rollout = Rollout()  # a loaded model starts new episodes
 
     def _modules(self):
         return {"policy": self.policy, **({"value": self.value} if self.config.baseline == "mlp" else {})}
@@ -229,81 +320,21 @@ class PATRPO(Algorithm):
             return float((self.value(obs_t) - ret_t).pow(2).mean())
 
     # -- one epoch -------------------------------------------------------------------------------
-    def _collect(self) -> dict[str, np.ndarray]:
-        """Step the batched env until ``batch_size`` valid samples; returns ``(T, N, ...)`` arrays.
-
-        Episodes run on across epochs (an epoch's last step bootstraps from the value function), so no
-        partial episode is thrown away. Gymnasium's vector envs reset a finished copy on the *next* step,
-        ignoring its action: those autoreset steps are marked invalid and carry no sample.
-        """
-        env = self.vec_env
-        n = env.num_envs
-        if self._rollout is None:
-            obs, _ = env.reset(seed=int(self.np_rng.integers(2**31 - 1)))
-            self._rollout = (obs, np.zeros(n, dtype=bool), np.zeros(n, dtype=np.int64))
-            self.tracker = EpisodeTracker(n)
-        obs, prev_done, t_ep = self._rollout
-        keys = ("obs", "a", "x", "reward", "terminated", "done", "valid", "next_obs", "t")
-        rows: dict[str, list] = {k: [] for k in keys}
-        n_valid = 0
-        while n_valid < self.config.batch_size:
-            with torch.no_grad():
-                a, x = self.policy(self._obs_tensor(obs)).sample(self.torch_gen)
-            next_obs, reward, terminated, truncated, _ = env.step(self.hybrid.to_env_batch(a.numpy(), x.numpy()))
-            valid = ~prev_done
-            done = (terminated | truncated) & valid
-            for k, v in zip(keys, (obs, a.numpy(), x.numpy(), reward, terminated & valid, done, valid, next_obs, t_ep)):
-                rows[k].append(np.array(v))
-            self.tracker.step(np.asarray(reward, dtype=np.float64), done, valid)
-            n_valid += int(valid.sum())
-            t_ep = np.where(valid, t_ep + 1, 0)
-            prev_done, obs = done, next_obs
-        self._rollout = (obs, prev_done, t_ep)
-        return {k: np.stack(v) for k, v in rows.items()}
-
     def _run_epoch(self) -> dict[str, float]:
         cfg = self.config
-        batch = self._collect()
-        T, N = batch["reward"].shape
-        flat = lambda arr: arr.reshape(T * N, *arr.shape[2:])  # noqa: E731
-        values = self._values(flat(batch["obs"]), flat(batch["t"])).reshape(T, N)
-        next_values = self._values(flat(batch["next_obs"]), flat(batch["t"]) + 1).reshape(T, N)
-        adv = gae(
-            batch["reward"],
-            values,
-            next_values,
-            batch["terminated"],
-            batch["done"],
-            cfg.gamma,
-            cfg.gae_lambda,
+        batch = self.rollout.collect(
+            self.vec_env, self.policy, self.hybrid, cfg.batch_size, self.np_rng, self.torch_gen
         )
-        returns = adv + values
-
-        valid = flat(batch["valid"])
-        obs, t, a, x = (
-            flat(batch["obs"])[valid],
-            flat(batch["t"])[valid],
-            flat(batch["a"])[valid],
-            flat(batch["x"])[valid],
-        )
-        adv_v, ret_v, val_v = flat(adv)[valid], flat(returns)[valid], flat(values)[valid]
-        var_ret = np.var(ret_v)
-        explained_var = float(1 - np.var(ret_v - val_v) / var_ret) if var_ret > 0 else float("nan")
-        if cfg.normalize_advantages:
-            adv_v = (adv_v - adv_v.mean()) / (adv_v.std() + 1e-8)
-
+        data, explained_var = advantage_batch(batch, self._values, cfg.gamma, cfg.gae_lambda, cfg.normalize_advantages)
         stats = self._update_policy(
-            self._obs_tensor(obs),
-            torch.as_tensor(a),
-            torch.as_tensor(x),
-            torch.as_tensor(adv_v, dtype=torch.float32),
+            self._obs_tensor(data["obs"]),
+            torch.as_tensor(data["a"]),
+            torch.as_tensor(data["x"]),
+            torch.as_tensor(data["adv"], dtype=torch.float32),
         )
-        stats["losses/value_loss"] = self._fit_baseline(obs, t, ret_v)
+        stats["losses/value_loss"] = self._fit_baseline(data["obs"], data["t"], data["returns"])
         stats["train/explained_variance"] = explained_var
-        freq = np.bincount(a, minlength=self.hybrid.n_actions) / len(a)
-        stats.update({f"train/action_freq_{k}": float(f) for k, f in enumerate(freq)})
-        stats.update(self.tracker.pop())
-        stats["steps"] = len(a)
+        stats.update(self.rollout.epoch_stats(data["a"], self.hybrid.n_actions))
         return stats
 
     def _update_policy(self, obs, a, x, adv) -> dict[str, float]:
