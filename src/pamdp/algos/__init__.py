@@ -4,6 +4,7 @@
 # they import torch, and `import pamdp` stays light.
 ALGORITHMS = {
     "patrpo": "pamdp.algos.patrpo:PATRPO",
+    "pappo": "pamdp.algos.pappo:PAPPO",
     "pasvg0": "pamdp.algos.pasvg:PASVG0",
     "paddpg": "pamdp.algos.paddpg:PADDPG",
     "pdqn": "pamdp.algos.pdqn:PDQN",

@@ -1,0 +1,231 @@
+"""PAPPO: Proximal Policy Optimization of the hierarchical policy, H-PPO style (Fan et al., IJCAI 2019).
+
+The policy, the sampling and the advantages are PATRPO's (``pi(a,x|s) = pi_d(a|s) pi_c(x|s,a)``,
+:class:`~pamdp.algos.patrpo.Rollout`, :func:`~pamdp.algos.patrpo.advantage_batch`); PPO's clipped
+surrogate (Schulman et al. 2017, eq. 7) replaces the trust-region step. One epoch:
+
+1. Sample ``batch_size`` steps with ``(a, x) ~ pi_d(a|s) pi_c(x|s,a)`` from the batched env.
+2. Advantages ``A`` by GAE(``gamma``, ``gae_lambda``) from the value network ``V(s)``; the returns
+   ``R = A + V(s)`` are ``V``'s regression targets.
+3. ``n_epochs`` passes over the batch in shuffled minibatches of about ``minibatch_size``, each one Adam step
+   (gradient norm clipped to ``max_grad_norm``) on
+
+       L = -E[min(r A, clip(r, 1 - eps, 1 + eps) A)] + vf_coef E[(V(s) - R)^2]
+           - ent_coef_d E[H(pi_d(.|s))] - ent_coef_c E[sum_a pi_d(a|s) H(pi_c(.|s,a))]
+
+   with the joint ratio ``r = pi(a,x|s) / pi_old(a,x|s) = exp(log pi_d(a|s) + log pi_c(x|s,a) - log pi_old)``
+   and ``eps = clip_range``. The two entropy terms are the chain rule's split of the joint entropy, weighted
+   apart because the discrete one decides which actions keep being tried and the continuous one only
+   widens the parameter noise. With ``target_kl > 0`` the passes stop at the first minibatch whose
+   chain-rule ``KL(pi_old || pi)`` (the paper's ``chain_analytic`` estimator) exceeds it.
+
+Fan et al. clip the discrete and the parameter policies' ratios separately, with parameter heads that do
+not see the discrete action; here ``pi_c`` is conditioned on ``a`` and the ratio is the joint one, so the
+clip bounds the change of the whole hierarchical policy, as PATRPO's KL does.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import torch
+
+from pamdp.algos.base import AlgoConfig, Algorithm, setting
+from pamdp.algos.patrpo import Rollout, advantage_batch
+from pamdp.distributions import HybridDistribution, kl_divergence
+from pamdp.policies import ACTIVATIONS, HybridPolicy, ValueNetwork
+
+__all__ = ["PAPPO", "PAPPOConfig", "clipped_surrogate", "ppo_loss"]
+
+
+@dataclasses.dataclass(frozen=True)
+class PAPPOConfig(AlgoConfig):
+    """PAPPO's settings; the defaults are the common PPO ones (Schulman et al. 2017; CleanRL, Stable-Baselines3)
+    on PATRPO's hierarchical policy, with a separate value network trained in the same loss.
+    """
+
+    num_envs: int = setting(
+        64,
+        "Copies of the env stepped together (batched from 48 on, twice as fast as 32 scalar copies on Platform).",
+    )
+    hidden_sizes: tuple[int, ...] = setting((64, 64), "Hidden layers of pi_d and pi_c (each its own network).")
+    activation: str = setting("tanh", "Hidden activation of the policies: tanh (PPO's usual), relu, leaky_relu or elu.")
+    init_log_std: float = setting(0.0, "Initial log-std of the parameter noise, in [-1, 1] units.")
+    batch_size: int = setting(4096, "Samples per epoch, collected with the current policy before its update.")
+    n_epochs: int = setting(10, "Passes over each batch; more reuse per sample, and more drift from pi_old.")
+    minibatch_size: int = setting(
+        256, "Samples per gradient step (the batch is split into equal minibatches of about this size)."
+    )
+    lr: float = setting(3e-4, "Adam learning rate of the policy and the value network (one optimiser, one loss).")
+    clip_range: float = setting(
+        0.2, "eps: the ratio pi / pi_old is clipped to [1 - eps, 1 + eps] in the surrogate; 0.1-0.3 is usual."
+    )
+    gamma: float = setting(0.99, "Discount factor.")
+    gae_lambda: float = setting(0.95, "GAE lambda: lower trades bias for less variance in the advantages.")
+    ent_coef_d: float = setting(
+        0.01, "Weight of pi_d's entropy in the loss: keeps every discrete action tried while the values settle."
+    )
+    ent_coef_c: float = setting(
+        0.0,
+        "Weight of the parameter policy's entropy (expected over pi_d) in the loss; it only widens the noise.",
+    )
+    vf_coef: float = setting(0.5, "Weight of the value loss E[(V(s) - R)^2] in the joint loss.")
+    max_grad_norm: float = setting(0.5, "Clip the joint gradient's norm to this before each Adam step.")
+    target_kl: float = setting(
+        0.0,
+        "Stop an epoch's passes once a minibatch's chain-rule KL(pi_old || pi) exceeds this (0: never; 0.01-0.05).",
+    )
+    normalize_advantages: bool = setting(True, "Standardise advantages within the batch.")
+    vf_hidden_sizes: tuple[int, ...] = setting((64, 64), "Hidden layers of the value network.")
+
+    def __post_init__(self):
+        super().__post_init__()
+        for name in ("hidden_sizes", "vf_hidden_sizes"):
+            sizes = getattr(self, name)
+            self._check(len(sizes) > 0 and all(h > 0 for h in sizes), name, "positive layer sizes")
+        self._check(self.activation in ACTIVATIONS, "activation", f"one of {', '.join(ACTIVATIONS)}")
+        self._check(self.batch_size >= 1, "batch_size", "an integer >= 1")
+        self._check(self.n_epochs >= 1, "n_epochs", "an integer >= 1")
+        self._check(
+            1 <= self.minibatch_size <= self.batch_size,
+            "minibatch_size",
+            f"an integer in [1, batch_size={self.batch_size}]",
+        )
+        self._check(self.lr > 0, "lr", "a positive learning rate")
+        self._check(0 < self.clip_range < 1, "clip_range", "a number in (0, 1)")
+        self._check(0 <= self.gamma <= 1, "gamma", "a number in [0, 1]")
+        self._check(0 <= self.gae_lambda <= 1, "gae_lambda", "a number in [0, 1]")
+        self._check(self.ent_coef_d >= 0, "ent_coef_d", "a non-negative weight")
+        self._check(self.ent_coef_c >= 0, "ent_coef_c", "a non-negative weight")
+        self._check(self.vf_coef > 0, "vf_coef", "a positive weight")
+        self._check(self.max_grad_norm > 0, "max_grad_norm", "a positive norm")
+        self._check(self.target_kl >= 0, "target_kl", "a non-negative KL (0: no early stop)")
+
+    @classmethod
+    def presets(cls) -> dict[str, PAPPOConfig]:
+        return {"default": cls(), "tuned": cls(target_kl=0.02)}
+
+
+def clipped_surrogate(logp: torch.Tensor, old_logp: torch.Tensor, adv: torch.Tensor, clip_range: float) -> torch.Tensor:
+    """PPO's clipped surrogate as a loss to minimise: ``-mean(min(r A, clip(r, 1 - eps, 1 + eps) A))``.
+
+    ``r = exp(logp - old_logp)``. A sample whose ratio has left the clip range on the side its advantage
+    pushes (``r > 1 + eps`` with ``A > 0``, ``r < 1 - eps`` with ``A < 0``) contributes no gradient.
+    """
+    ratio = torch.exp(logp - old_logp)
+    return -torch.min(ratio * adv, ratio.clamp(1.0 - clip_range, 1.0 + clip_range) * adv).mean()
+
+
+def ppo_loss(
+    dist: HybridDistribution,
+    values: torch.Tensor,
+    a: torch.Tensor,
+    x: torch.Tensor,
+    old_logp: torch.Tensor,
+    adv: torch.Tensor,
+    returns: torch.Tensor,
+    cfg: PAPPOConfig,
+) -> tuple[torch.Tensor, dict[str, torch.Tensor]]:
+    """The joint loss ``L`` of the module docstring on a minibatch, and its parts (detached) for logging."""
+    logp = dist.log_prob(a, x)
+    policy_loss = clipped_surrogate(logp, old_logp, adv, cfg.clip_range)
+    value_loss = (values - returns).pow(2).mean()
+    entropy_c = (dist.probs_d * dist.entropy_c()).sum(-1).mean()
+    entropy_d = dist.entropy().mean() - entropy_c
+    loss = policy_loss + cfg.vf_coef * value_loss - cfg.ent_coef_d * entropy_d - cfg.ent_coef_c * entropy_c
+    with torch.no_grad():
+        clipped = ((logp - old_logp).exp() - 1.0).abs() > cfg.clip_range
+    parts = {
+        "losses/policy_loss": policy_loss,
+        "losses/value_loss": value_loss,
+        "losses/entropy_d": entropy_d,
+        "losses/entropy_c": entropy_c,
+        "train/clip_fraction": clipped.float().mean(),
+    }
+    return loss, {k: v.detach() for k, v in parts.items()}
+
+
+class PAPPO(Algorithm):
+    """PPO of the hierarchical policy. See the module docstring for the update and :class:`PAPPOConfig`."""
+
+    config_class = PAPPOConfig
+    config: PAPPOConfig
+
+    def _build(self) -> None:
+        cfg = self.config
+        self.policy = HybridPolicy(self.obs_dim, self.hybrid, cfg.hidden_sizes, cfg.activation, cfg.init_log_std)
+        self.value = ValueNetwork(self.obs_dim, cfg.vf_hidden_sizes)
+        self.optimizer = torch.optim.Adam([*self.policy.parameters(), *self.value.parameters()], lr=cfg.lr)
+        self.rollout = Rollout()  # a loaded model starts new episodes
+
+    def _modules(self):
+        return {"policy": self.policy, "value": self.value}
+
+    def _optimizers(self):
+        return {"adam": self.optimizer}
+
+    def _act(self, obs, deterministic):
+        dist = self.policy(obs)
+        return dist.mode() if deterministic else dist.sample(self.torch_gen)
+
+    def _values(self, obs: np.ndarray, t: np.ndarray) -> np.ndarray:
+        with torch.no_grad():
+            return self.value(self._obs_tensor(obs)).double().numpy()
+
+    def _run_epoch(self) -> dict[str, float]:
+        cfg = self.config
+        batch = self.rollout.collect(
+            self.vec_env, self.policy, self.hybrid, cfg.batch_size, self.np_rng, self.torch_gen
+        )
+        data, explained_var = advantage_batch(batch, self._values, cfg.gamma, cfg.gae_lambda, cfg.normalize_advantages)
+        stats = self._update(
+            self._obs_tensor(data["obs"]),
+            torch.as_tensor(data["a"]),
+            torch.as_tensor(data["x"]),
+            torch.as_tensor(data["adv"], dtype=torch.float32),
+            torch.as_tensor(data["returns"], dtype=torch.float32),
+        )
+        stats["train/explained_variance"] = explained_var
+        stats.update(self.rollout.epoch_stats(data["a"], self.hybrid.n_actions))
+        return stats
+
+    def _update(self, obs, a, x, adv, returns) -> dict[str, float]:
+        """``n_epochs`` passes of minibatch Adam steps on the joint loss, stopped early by ``target_kl``."""
+        cfg = self.config
+        with torch.no_grad():
+            old = self.policy(obs).detach()
+            old_logp = old.log_prob(a, x)
+        params = [p for group in self.optimizer.param_groups for p in group["params"]]
+        n = len(adv)
+        n_minibatches = max(1, n // cfg.minibatch_size)
+        sums: dict[str, float] = {}
+        updates, stopped_at_kl = 0, False
+        for _ in range(cfg.n_epochs):
+            for idx in torch.tensor_split(torch.randperm(n, generator=self.torch_gen), n_minibatches):
+                dist = self.policy(obs[idx])
+                if cfg.target_kl > 0:
+                    with torch.no_grad():
+                        stopped_at_kl = float(kl_divergence(old[idx], dist.detach()).mean()) > cfg.target_kl
+                    if stopped_at_kl:
+                        break
+                loss, parts = ppo_loss(
+                    dist, self.value(obs[idx]), a[idx], x[idx], old_logp[idx], adv[idx], returns[idx], cfg
+                )
+                self.optimizer.zero_grad()
+                loss.backward()
+                grad_norm = torch.nn.utils.clip_grad_norm_(params, cfg.max_grad_norm)
+                self.optimizer.step()
+                parts["train/grad_norm"] = grad_norm
+                for k, v in parts.items():
+                    sums[k] = sums.get(k, 0.0) + float(v)
+                updates += 1
+            if stopped_at_kl:
+                break
+        stats = {k: v / updates for k, v in sums.items()}  # the first minibatch always runs: pi == pi_old there
+        with torch.no_grad():
+            stats["train/kl"] = float(kl_divergence(old, self.policy(obs)).mean())
+        stats["train/updates"] = float(updates)
+        stats["train/early_stop"] = float(stopped_at_kl)
+        stats["train/param_std"] = float(self.policy.log_std.detach().exp()[self.policy.mask].mean())
+        return stats

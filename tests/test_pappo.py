@@ -1,0 +1,280 @@
+"""PAPPO: the clipped surrogate and its gradient by hand, the whole loss against torch.distributions and
+finite differences, the value loss, the KL early stop, settings, save/load, resuming and the command line."""
+
+import csv
+import dataclasses
+import json
+import math
+
+import gymnasium
+import numpy as np
+import pytest
+import torch
+from torch.distributions import Categorical, Normal
+
+import pamdp
+from pamdp import PAPPO
+from pamdp.algos.pappo import PAPPOConfig, clipped_surrogate, ppo_loss
+from pamdp.cli import main
+from pamdp.experiments.runner import default_preset
+from pamdp.policies import HybridPolicy, ValueNetwork
+from pamdp.spaces import HybridActionSpace
+
+SMALL = PAPPOConfig(
+    hidden_sizes=(16, 16), vf_hidden_sizes=(16,), batch_size=500, minibatch_size=100, n_epochs=2, num_envs=4
+)
+# Three actions with 1, 2 and 1 parameters, so that pi_c's padding (mask) is exercised.
+HYBRID = HybridActionSpace(
+    (np.array([-1.0]), np.array([0.0, 0.0]), np.array([-2.0])), (np.array([1.0]), np.array([1.0, 3.0]), np.array([2.0]))
+)
+
+
+def test_clipped_surrogate_and_its_gradient_by_hand():
+    eps = 0.2
+    ratio = torch.tensor([1.1, 1.5, 0.5, 0.5, 1.5, 0.9], dtype=torch.float64)
+    adv = torch.tensor([2.0, 1.0, 1.0, -1.0, -2.0, -1.0], dtype=torch.float64)
+    # min(r A, clip(r) A) per sample: inside the range; clipped above with A > 0 (1.2 * 1); below the range with
+    # A > 0 (not clipped: 0.5 < 0.8); clipped below with A < 0 (0.8 * -1); above the range with A < 0 (not
+    # clipped: -3 < -2.4); inside the range.
+    objective = [2.2, 1.2, 0.5, -0.8, -3.0, -0.9]
+    clipped = [False, True, False, True, False, False]
+    old_logp = torch.tensor([-1.0, 0.3, -2.0, 0.0, -0.5, 1.0], dtype=torch.float64)
+    logp = (old_logp + ratio.log()).requires_grad_()
+    loss = clipped_surrogate(logp, old_logp, adv, eps)
+    assert loss.item() == pytest.approx(-sum(objective) / 6, rel=1e-12)
+    loss.backward()
+    # d(r A)/d logp = r A where unclipped; a sample clipped on its advantage's side gives no gradient.
+    expected = [0.0 if c else -r * a / 6 for r, a, c in zip(ratio.tolist(), adv.tolist(), clipped)]
+    np.testing.assert_allclose(logp.grad.numpy(), expected, rtol=1e-12, atol=0)
+    assert (logp.grad[torch.tensor(clipped)] == 0).all() and (logp.grad[~torch.tensor(clipped)] != 0).all()
+
+
+def _tiny_problem(seed=0):
+    """A float64 policy and value net on HYBRID, six samples with ratios inside and outside the clip range."""
+    torch.manual_seed(seed)
+    policy = HybridPolicy(5, HYBRID, (4,), "tanh", init_log_std=-0.3).double()
+    value = ValueNetwork(5, (4,)).double()
+    with torch.no_grad():
+        policy.log_std.add_(0.2 * torch.randn_like(policy.log_std))
+        policy.pi_d[-1].weight.mul_(300.0)  # a non-uniform pi_d, so that every entropy term has a gradient
+    obs = torch.randn(6, 5, dtype=torch.float64)
+    a = torch.tensor([0, 1, 2, 1, 0, 2])
+    with torch.no_grad():
+        x = policy(obs).sample(torch.Generator().manual_seed(seed))[1]
+        ratio = torch.tensor([0.5, 0.9, 1.1, 1.5, 0.6, 1.4], dtype=torch.float64)
+        old_logp = policy(obs).log_prob(a, x) - ratio.log()
+    adv = torch.tensor([1.0, -1.0, 2.0, -0.5, -1.5, 0.7], dtype=torch.float64)
+    returns = torch.randn(6, dtype=torch.float64)
+    return policy, value, obs, a, x, old_logp, adv, returns
+
+
+def _independent_loss(policy, value, obs, a, x, old_logp, adv, returns, cfg):
+    """The PAPPO loss sample by sample with torch.distributions, evaluating pi_c for one action at a time."""
+    surrogate, entropy_d, entropy_c = [], [], []
+    for i in range(len(obs)):
+        pi_d = Categorical(logits=policy.pi_d(obs[i]))
+        pi_c = []
+        for k, m in enumerate(HYBRID.param_sizes):
+            mean = policy.pi_c(torch.cat([obs[i], torch.eye(3, dtype=obs.dtype)[k]]))[:m]
+            pi_c.append(Normal(mean, policy.log_std[k, :m].exp()))
+        k = int(a[i])
+        logp = pi_d.log_prob(a[i]) + pi_c[k].log_prob(x[i, : HYBRID.param_sizes[k]]).sum()
+        r = torch.exp(logp - old_logp[i])
+        surrogate.append(torch.min(r * adv[i], torch.clamp(r, 1 - cfg.clip_range, 1 + cfg.clip_range) * adv[i]))
+        entropy_d.append(pi_d.entropy())
+        entropy_c.append(sum(pi_d.probs[k] * pi_c[k].entropy().sum() for k in range(3)))
+    mse = (value(obs) - returns).pow(2).mean()
+    mean = lambda xs: torch.stack(xs).mean()  # noqa: E731
+    return -mean(surrogate) + cfg.vf_coef * mse - cfg.ent_coef_d * mean(entropy_d) - cfg.ent_coef_c * mean(entropy_c)
+
+
+def _finite_difference(f, params, h=1e-6):
+    grads = []
+    for p in params:
+        g = torch.zeros_like(p)
+        flat, gflat = p.data.view(-1), g.view(-1)
+        for i in range(flat.numel()):
+            old = flat[i].item()
+            flat[i] = old + h
+            up = f()
+            flat[i] = old - h
+            down = f()
+            flat[i] = old
+            gflat[i] = (up - down) / (2 * h)
+        grads.append(g)
+    return grads
+
+
+def test_loss_matches_an_independent_computation_and_finite_differences():
+    cfg = PAPPOConfig(clip_range=0.2, vf_coef=0.7, ent_coef_d=0.3, ent_coef_c=0.2)
+    policy, value, obs, a, x, old_logp, adv, returns = _tiny_problem()
+    loss, parts = ppo_loss(policy(obs), value(obs), a, x, old_logp, adv, returns, cfg)
+    independent = _independent_loss(policy, value, obs, a, x, old_logp, adv, returns, cfg)
+    assert loss.item() == pytest.approx(independent.item(), rel=1e-12)
+    assert parts["train/clip_fraction"].item() == pytest.approx(4 / 6)  # 0.5, 0.6, 1.4, 1.5 leave [0.8, 1.2]
+
+    params = [*policy.parameters(), *value.parameters()]
+    loss.backward()
+    with torch.no_grad():
+        expected = _finite_difference(
+            lambda: _independent_loss(policy, value, obs, a, x, old_logp, adv, returns, cfg).item(), params
+        )
+    for p, e in zip(params, expected):
+        torch.testing.assert_close(p.grad, e, rtol=1e-6, atol=1e-8)
+    assert policy.log_std.grad[1, 1] != 0 and policy.log_std.grad[0, 1] == 0  # action 0 has one parameter
+
+
+def test_value_loss_by_hand():
+    policy = HybridPolicy(2, HYBRID, (4,))
+    obs = torch.zeros(3, 2)
+    dist = policy(obs)
+    a, x = dist.mode()
+    cfg = PAPPOConfig(vf_coef=0.25, ent_coef_d=0.0)
+    values, returns = torch.tensor([1.0, 2.0, 3.0]), torch.tensor([0.0, 2.0, 5.0])
+    # Zero advantages: the surrogate vanishes, and the loss is vf_coef * mean((V - R)^2) = 0.25 * 5 / 3.
+    loss, parts = ppo_loss(dist, values, a, x, dist.log_prob(a, x), torch.zeros(3), returns, cfg)
+    assert parts["losses/value_loss"].item() == pytest.approx(5 / 3)
+    assert loss.item() == pytest.approx(0.25 * 5 / 3)
+    assert parts["losses/entropy_d"].item() == pytest.approx(math.log(3), rel=1e-3)  # pi_d starts near uniform
+
+
+def test_entropy_parts_add_up_to_the_chain_rule_entropy():
+    policy, value, obs, a, x, old_logp, adv, returns = _tiny_problem(1)
+    dist = policy(obs)
+    _, parts = ppo_loss(dist, value(obs), a, x, old_logp, adv, returns, PAPPOConfig())
+    total = parts["losses/entropy_d"] + parts["losses/entropy_c"]
+    torch.testing.assert_close(total, dist.entropy().mean())
+    torch.testing.assert_close(parts["losses/entropy_d"], Categorical(logits=dist.logits).entropy().mean())
+
+
+def test_update_improves_the_surrogate_and_target_kl_stops_it_early():
+    model = PAPPO("pamdp/Platform-v0", SMALL)
+    batch = model.rollout.collect(model.vec_env, model.policy, model.hybrid, 500, model.np_rng, model.torch_gen)
+    valid = batch["valid"].reshape(-1)
+    obs = model._obs_tensor(batch["obs"].reshape(-1, model.obs_dim)[valid])
+    a, x = torch.as_tensor(batch["a"].reshape(-1)[valid]), torch.as_tensor(batch["x"].reshape(-1, 1)[valid])
+    adv = torch.randn(len(a), generator=torch.Generator().manual_seed(0))
+    returns = torch.zeros(len(a))
+    with torch.no_grad():
+        old_logp = model.policy(obs).log_prob(a, x)
+    stats = model._update(obs, a, x, adv, returns)
+    n_minibatches = len(a) // SMALL.minibatch_size
+    assert stats["train/updates"] == SMALL.n_epochs * n_minibatches and stats["train/early_stop"] == 0
+    assert stats["train/kl"] > 0
+    with torch.no_grad():
+        ratio = (model.policy(obs).log_prob(a, x) - old_logp).exp()
+    assert (ratio * adv).mean() > 0.05  # the surrogate E[r A] started at E[A] ~ 0
+
+    strict = PAPPO("pamdp/Platform-v0", dataclasses.replace(SMALL, target_kl=1e-7, n_epochs=5))
+    stats = strict._update(obs, a, x, adv, returns)
+    assert stats["train/early_stop"] == 1 and 1 <= stats["train/updates"] < 5 * n_minibatches
+
+
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        ({"clip_range": 0.0}, "PAPPOConfig.clip_range = 0.0"),
+        ({"clip_range": 1.5}, "clip_range = 1.5"),
+        ({"n_epochs": 0}, "n_epochs = 0"),
+        ({"minibatch_size": 8192}, "minibatch_size = 8192; expected an integer in \\[1, batch_size=4096\\]"),
+        ({"lr": -1e-3}, "lr = -0.001"),
+        ({"ent_coef_d": -0.1}, "ent_coef_d = -0.1"),
+        ({"ent_coef_c": -1.0}, "ent_coef_c = -1.0"),
+        ({"vf_coef": 0.0}, "vf_coef = 0.0"),
+        ({"max_grad_norm": 0.0}, "max_grad_norm = 0.0"),
+        ({"target_kl": -0.01}, "target_kl = -0.01"),
+        ({"gae_lambda": 1.5}, "gae_lambda = 1.5"),
+        ({"gamma": float("nan")}, "gamma = nan"),
+        ({"activation": "sigmoid"}, "activation = 'sigmoid'"),
+        ({"vf_hidden_sizes": (0,)}, "vf_hidden_sizes = \\(0,\\)"),
+        ({"num_envs": 0}, "num_envs = 0"),
+    ],
+)
+def test_bad_settings_raise_errors_naming_the_field(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        PAPPOConfig(**kwargs)
+
+
+def test_presets_and_plain_data():
+    presets = PAPPOConfig.presets()
+    assert presets["default"] == PAPPOConfig() and default_preset(PAPPOConfig) == "tuned"
+    with pytest.raises(ValueError, match="unknown PAPPOConfig setting"):
+        PAPPOConfig.from_dict({"clip": 0.1})
+    with pytest.raises(ValueError, match="'n_epochs' = 2.5"):
+        PAPPOConfig.from_dict({"n_epochs": 2.5})
+
+
+def test_same_seed_gives_identical_first_epochs():
+    params = []
+    for _ in range(2):
+        model = PAPPO("pamdp/Platform-v0", SMALL)
+        model.learn(500, progress_bar=False)
+        params.append(torch.cat([p.detach().flatten() for p in model.policy.parameters()]))
+    torch.testing.assert_close(params[0], params[1], rtol=0, atol=0)
+
+
+def test_save_load_predict_round_trip(tmp_path):
+    model = PAPPO("pamdp/Platform-v0", SMALL)
+    model.learn(500, progress_bar=False)
+    model.save(tmp_path / "m.pt")
+    loaded = PAPPO.load(tmp_path / "m.pt")
+    assert loaded.config == model.config and loaded.num_timesteps == model.num_timesteps
+    obs = np.random.default_rng(0).uniform(0, 1, size=(16, 9))
+    for deterministic in (True, False):  # stochastic predictions continue the same random stream
+        a1, p1 = model.predict(obs, deterministic=deterministic)
+        a2, p2 = loaded.predict(obs, deterministic=deterministic)
+        np.testing.assert_array_equal(a1, a2)
+        for u, v in zip(p1, p2):
+            np.testing.assert_array_equal(u, v)
+    env = gymnasium.make("pamdp/Platform-v0")
+    o, _ = env.reset(seed=0)
+    for deterministic in (True, False):
+        action = loaded.predict(o, deterministic=deterministic)
+        assert env.action_space.contains(action)
+        env.step(action)
+    assert pamdp.PAPPO is PAPPO
+
+
+def _rows(run_dir):
+    with open(run_dir / "progress.csv", newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def test_resume_from_a_checkpoint(tmp_path):
+    model = PAPPO("pamdp/Platform-v0", SMALL)
+    model.learn(1000, progress_bar=False, run_dir=tmp_path)
+    resumed = PAPPO.load(tmp_path / "checkpoint.pt")
+    assert (resumed.num_timesteps, resumed.epoch) == (model.num_timesteps, model.epoch) and model.epoch == 2
+    for p, q in zip(
+        [*model.policy.parameters(), *model.value.parameters()],
+        [*resumed.policy.parameters(), *resumed.value.parameters()],
+    ):
+        torch.testing.assert_close(p, q, rtol=0, atol=0)
+    steps = resumed.optimizer.state_dict()["state"][0]["step"]
+    assert steps == model.optimizer.state_dict()["state"][0]["step"] == 2 * 2 * (500 // 100)
+
+    resumed.learn(500, progress_bar=False, run_dir=tmp_path)
+    rows = _rows(tmp_path)
+    assert [float(r["time/epoch"]) for r in rows] == [1.0, 2.0, 3.0]
+    assert float(rows[-1]["time/total_timesteps"]) == resumed.num_timesteps >= 1500
+
+
+def test_cli_trains_resumes_and_evaluates(tmp_path, capsys):
+    out = tmp_path / "run"
+    tiny = ["--hidden-sizes", "16,16", "--vf-hidden-sizes", "16", "--batch-size", "1000", "--minibatch-size", "250"]
+    tiny += ["--num-envs", "8", "--no-progress"]
+    assert main(["train", "pappo", "--total-steps", "3000", "--out", str(out), "--eval-episodes", "20", *tiny]) == 0
+    assert "greedy return over 20 episodes" in capsys.readouterr().out
+    run = json.loads((out / "run.json").read_text())
+    assert run["preset"] == "tuned" and run["config"]["minibatch_size"] == 250
+    rows = _rows(out)
+    assert len(rows) == 3
+    for key in ("losses/policy_loss", "losses/value_loss", "losses/entropy_d", "train/kl", "train/clip_fraction"):
+        assert np.isfinite(float(rows[-1][key])), key
+    assert 0.0 <= float(rows[-1]["charts/episodic_return"]) <= 1.0
+    assert 0.0 <= json.loads((out / "evaluation.json").read_text())["mean_return"] <= 1.0
+
+    assert main(["train", "pappo", "--total-steps", "4000", "--out", str(out), "--eval-episodes", "0", *tiny]) == 0
+    assert "resuming" in capsys.readouterr().err and len(_rows(out)) == 4
+    assert main(["train", "pappo", "--clip-range", "2", "--out", str(tmp_path / "bad")]) == 2
+    assert "clip_range = 2.0" in capsys.readouterr().err
