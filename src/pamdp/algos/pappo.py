@@ -64,7 +64,9 @@ class PAPPOConfig(AlgoConfig):
     gamma: float = setting(0.99, "Discount factor.")
     gae_lambda: float = setting(0.95, "GAE lambda: lower trades bias for less variance in the advantages.")
     ent_coef_d: float = setting(
-        0.01, "Weight of pi_d's entropy in the loss: keeps every discrete action tried while the values settle."
+        0.01,
+        "Weight of pi_d's entropy in the loss: keeps every discrete action tried. Platform needs 0.3; at 0.01-0.1 "
+        "pi_d turns deterministic within ~150k samples and the return stays at 0.80-0.90.",
     )
     ent_coef_c: float = setting(
         0.0,
@@ -104,7 +106,12 @@ class PAPPOConfig(AlgoConfig):
 
     @classmethod
     def presets(cls) -> dict[str, PAPPOConfig]:
-        return {"default": cls(), "tuned": cls(target_kl=0.02)}
+        # "tuned": single runs of 300k samples on Platform (this project's shared 2-core machine; probes, not a
+        # benchmark). The defaults and six variations (target_kl 0.02; ent_coef_d 0.05 or 0.1; init_log_std -1 or
+        # -0.5; ent_coef_c 0.01 with gae_lambda 0.97; relu {200, 100, 50}) settled within 150k samples at greedy
+        # returns of 0.80 to 0.90, falling into the second gap: pi_d's entropy had dropped to ~0.01 nats. With
+        # ent_coef_d = 0.3 it keeps ~0.2 nats; greedy returns after 300k samples 1.000, 0.970, 0.958 (seeds 0-2).
+        return {"default": cls(), "tuned": cls(ent_coef_d=0.3, target_kl=0.02)}
 
 
 def clipped_surrogate(logp: torch.Tensor, old_logp: torch.Tensor, adv: torch.Tensor, clip_range: float) -> torch.Tensor:
