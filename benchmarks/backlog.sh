@@ -15,7 +15,7 @@
 #   1. PASVG(0) tuned (preset G), 5 x 1M (issue 4's target): ~55 min a run          ~5 core-hours
 #   2. step-size (2 x 5) and kl-estimators (3 x 5), PATRPO: ~16 min a run            ~6.5 core-hours
 #   3. the PATRPO arms of platform (5 x ~16 min) and soccer (3 x 5M, ~1 h each)      ~4.5 core-hours
-#   4. MP-DQN and P-DQN tuned, 2 x 5 x 300k (beyond the paper): a few minutes a run       ~1 core-hour
+#   4. MP-DQN, P-DQN and PAPPO tuned, 3 x 5 x 300k (beyond the paper): a few minutes a run ~1.5 core-hours
 #   5. platform's off-policy arms: PASVG(0) paper (5 x ~5 h), PADDPG paper (5 x ~3 h)    ~40 core-hours;
 #      they are also issue 4's paper-preset and issue 5's benchmark runs
 #   6. PADDPG with Hausknecht & Stone's preset on Platform, 1 seed x 300k (issue 5)  ~4 core-hours
@@ -30,7 +30,7 @@ pamdp reproduce step-size --workers 2 --out "$RUNS/repro"
 pamdp reproduce kl-estimators --workers 2 --out "$RUNS/repro"
 pamdp reproduce platform --runs PATRPO --workers 2 --out "$RUNS/repro"
 pamdp reproduce soccer --runs PATRPO --workers 2 --out "$RUNS/repro"
-python bench_pdqn_platform.py --workers 2 --out "$RUNS/bench"
+python bench_later_platform.py --workers 2 --out "$RUNS/bench"
 pamdp reproduce platform --workers 2 --out "$RUNS/repro"
 pamdp train paddpg --preset hausknecht_stone --seed 0 --total-steps 300000 --save-replay true \
     --eval-every 5 --no-progress --out "$RUNS/bench/paddpg_hausknecht_stone/seed0"
