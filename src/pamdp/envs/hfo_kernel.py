@@ -23,7 +23,6 @@ changes: an edit of any of them recompiles the kernels at the next import.
 
 from __future__ import annotations
 
-import hashlib
 import math
 from pathlib import Path
 
@@ -32,6 +31,7 @@ import numpy as np
 
 from pamdp.envs import hfo_features as feats
 from pamdp.envs import hfo_physics as phys
+from pamdp.envs import numba_cache
 from pamdp.envs.hfo_features import LANDMARKS
 from pamdp.envs.hfo_vector import _DASH_RATES, _SCALES, _THRESHOLD_BITS
 
@@ -60,28 +60,8 @@ DEPENDENCIES = ("hfo_physics.py", "hfo_features.py", "hfo_vector.py", "hfo_inter
 
 
 def refresh_cache(directory: Path | None = None) -> bool:
-    """Drop this module's cached kernels if the modules whose constants they hold changed; True if it did.
-
-    The digest of :data:`DEPENDENCIES` is kept in ``__pycache__/hfo_kernel.deps``. A read-only install is
-    left alone: its files do not change, and an upgrade rewrites this file too, which Numba notices.
-    """
-    here = Path(__file__)
-    cache = directory if directory is not None else here.parent / "__pycache__"
-    digest = hashlib.sha256(b"".join(here.with_name(name).read_bytes() for name in DEPENDENCIES)).hexdigest()
-    stamp = cache / "hfo_kernel.deps"
-    try:
-        if stamp.read_text() == digest:
-            return False
-    except OSError:
-        pass
-    try:
-        cache.mkdir(exist_ok=True)
-        for stale in [*cache.glob("hfo_kernel.*.nbi"), *cache.glob("hfo_kernel.*.nbc")]:
-            stale.unlink()
-        stamp.write_text(digest)
-    except OSError:
-        return False
-    return True
+    """Drop this module's cached kernels if :data:`DEPENDENCIES` changed; True if it did (see ``numba_cache``)."""
+    return numba_cache.refresh_cache(__file__, DEPENDENCIES, directory)
 
 
 refresh_cache()  # before the first kernel is compiled or loaded from the cache

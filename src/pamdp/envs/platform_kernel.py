@@ -30,11 +30,11 @@ of those modules next to the cache and drops the cached kernel when it changes.
 
 from __future__ import annotations
 
-import hashlib
 from pathlib import Path
 
 import numba
 
+from pamdp.envs import numba_cache
 from pamdp.envs.platform import (
     AX_MAX,
     AY_MAX,
@@ -91,28 +91,8 @@ DEPENDENCIES = ("platform.py", "platform_vector.py")
 
 
 def refresh_cache(directory: Path | None = None) -> bool:
-    """Drop this module's cached kernel if the modules whose constants it holds changed; True if it did.
-
-    The digest of :data:`DEPENDENCIES` is kept in ``__pycache__/platform_kernel.deps``. A read-only install
-    is left alone: its files do not change, and an upgrade rewrites this file too, which Numba notices.
-    """
-    here = Path(__file__)
-    cache = directory if directory is not None else here.parent / "__pycache__"
-    digest = hashlib.sha256(b"".join(here.with_name(name).read_bytes() for name in DEPENDENCIES)).hexdigest()
-    stamp = cache / "platform_kernel.deps"
-    try:
-        if stamp.read_text() == digest:
-            return False
-    except OSError:
-        pass
-    try:
-        cache.mkdir(exist_ok=True)
-        for stale in [*cache.glob("platform_kernel.*.nbi"), *cache.glob("platform_kernel.*.nbc")]:
-            stale.unlink()
-        stamp.write_text(digest)
-    except OSError:
-        return False
-    return True
+    """Drop this module's cached kernel if :data:`DEPENDENCIES` changed; True if it did (see ``numba_cache``)."""
+    return numba_cache.refresh_cache(__file__, DEPENDENCIES, directory)
 
 
 refresh_cache()  # before the kernel is compiled or loaded from the cache
