@@ -10,6 +10,7 @@ import gymnasium
 import numpy as np
 import pytest
 import torch
+from numeric import finite_difference
 from torch.distributions import Categorical, Normal
 
 import pamdp
@@ -88,23 +89,6 @@ def _independent_loss(policy, value, obs, a, x, old_logp, adv, returns, cfg):
     return -mean(surrogate) + cfg.vf_coef * mse - cfg.ent_coef_d * mean(entropy_d) - cfg.ent_coef_c * mean(entropy_c)
 
 
-def _finite_difference(f, params, h=1e-6):
-    grads = []
-    for p in params:
-        g = torch.zeros_like(p)
-        flat, gflat = p.data.view(-1), g.view(-1)
-        for i in range(flat.numel()):
-            old = flat[i].item()
-            flat[i] = old + h
-            up = f()
-            flat[i] = old - h
-            down = f()
-            flat[i] = old
-            gflat[i] = (up - down) / (2 * h)
-        grads.append(g)
-    return grads
-
-
 def test_loss_matches_an_independent_computation_and_finite_differences():
     cfg = PAPPOConfig(clip_range=0.2, vf_coef=0.7, ent_coef_d=0.3, ent_coef_c=0.2)
     policy, value, obs, a, x, old_logp, adv, returns = _tiny_problem()
@@ -116,7 +100,7 @@ def test_loss_matches_an_independent_computation_and_finite_differences():
     params = [*policy.parameters(), *value.parameters()]
     loss.backward()
     with torch.no_grad():
-        expected = _finite_difference(
+        expected = finite_difference(
             lambda: _independent_loss(policy, value, obs, a, x, old_logp, adv, returns, cfg).item(), params
         )
     for p, e in zip(params, expected):

@@ -9,6 +9,7 @@ import gymnasium
 import numpy as np
 import pytest
 import torch
+from numeric import finite_difference
 
 import pamdp
 from pamdp import PDQN
@@ -78,24 +79,6 @@ def test_only_p_dqn_q_depends_on_other_actions_parameters():
         assert d_multi[:, j].abs().min() > 1e-6, j  # ...but Q_j does move with x_j
 
 
-def _finite_difference(f, tensors, h=1e-6):
-    """Central differences of the scalar ``f()`` with respect to every entry of ``tensors`` (edited in place)."""
-    out = []
-    for t in tensors:
-        g = torch.zeros_like(t)
-        flat, gflat = t.data.view(-1), g.view(-1)
-        for i in range(flat.numel()):
-            old = flat[i].item()
-            flat[i] = old + h
-            up = f()
-            flat[i] = old - h
-            down = f()
-            flat[i] = old
-            gflat[i] = (up - down) / (2 * h)
-        out.append(g)
-    return out
-
-
 @pytest.mark.parametrize("multi_pass", [False, True])
 def test_actor_gradient_matches_finite_differences_of_sum_of_q(multi_pass):
     torch.manual_seed(2)
@@ -106,7 +89,7 @@ def test_actor_gradient_matches_finite_differences_of_sum_of_q(multi_pass):
     assert all(p.grad is None for p in q_net.parameters())  # Q's weights are not trained by the actor loss
 
     with torch.no_grad():
-        expected = _finite_difference(lambda: q_net(obs, actor(obs)).sum(-1).mean().item(), list(actor.parameters()))
+        expected = finite_difference(lambda: q_net(obs, actor(obs)).sum(-1).mean().item(), list(actor.parameters()))
     for p, g in zip(actor.parameters(), expected):
         torch.testing.assert_close(p.grad, -g, rtol=1e-6, atol=1e-8)  # descent on -mean sum_k Q_k
 
@@ -123,9 +106,9 @@ def test_inverted_actor_gradient_matches_finite_differences():
     with torch.no_grad():
         p = actor(obs)
         assert (p.abs() > 1).any()
-        (dq_dp,) = _finite_difference(lambda: q_net(obs, p).sum().item(), [p])  # d(sum_k Q_k)/dx per sample
+        (dq_dp,) = finite_difference(lambda: q_net(obs, p).sum().item(), [p])  # d(sum_k Q_k)/dx per sample
         g = invert_gradients(dq_dp, p)
-        expected = _finite_difference(lambda: -(g * actor(obs)).sum().item() / len(obs), list(actor.parameters()))
+        expected = finite_difference(lambda: -(g * actor(obs)).sum().item() / len(obs), list(actor.parameters()))
     for param, e in zip(actor.parameters(), expected):
         torch.testing.assert_close(param.grad, e, rtol=1e-6, atol=1e-8)
 
