@@ -1,7 +1,5 @@
 """The batched HFO env's Numba backend (``hfo_kernel.py``) against its NumPy backend, the reference."""
 
-import builtins
-
 import numpy as np
 import pytest
 
@@ -96,20 +94,3 @@ def test_numba_backend_draws_alike_when_player_and_ball_coincide():
     u = np.array([[0.5, 0.0, 0.5, 0.0, 0.0]])
     assert hfo_kernel.placements_coincide(u)
     assert not hfo_kernel.placements_coincide(np.random.default_rng(0).random((1000, 5)))
-
-
-def test_backend_choice_and_errors(monkeypatch):
-    assert HalfFieldOffenseVectorEnv(backend="numpy").backend == "numpy"
-    with pytest.raises(ValueError, match="backend='jax'"):
-        HalfFieldOffenseVectorEnv(backend="jax")
-    real_import = builtins.__import__
-
-    def no_numba(name, *args, **kwargs):
-        if name == "numba" or name.startswith("numba."):
-            raise ImportError("No module named 'numba'")
-        return real_import(name, *args, **kwargs)
-
-    monkeypatch.setattr(builtins, "__import__", no_numba)
-    with pytest.raises(ImportError, match=r"pip install pamdp\[fast\]"):
-        HalfFieldOffenseVectorEnv(backend="numba")
-    assert HalfFieldOffenseVectorEnv(backend="auto").backend == "numpy"

@@ -1,8 +1,5 @@
 """The batched Platform env's Numba backend (``platform_kernel.py``) against its NumPy backend, the reference."""
 
-import builtins
-
-import gymnasium
 import numpy as np
 import pytest
 
@@ -93,22 +90,3 @@ def test_numba_backend_runs_the_numpy_loop_for_other_noise_sources():
 
     envs, _ = _assert_backends_agree(Halved, 16, 10)
     assert envs[1].np_random.rng.bit_generator.state == envs[0].np_random.rng.bit_generator.state
-
-
-def test_backend_choice_and_errors(monkeypatch):
-    assert PlatformVectorEnv(backend="numpy").backend == "numpy"
-    venv = gymnasium.make_vec("pamdp/Platform-v0", num_envs=2, vectorization_mode="vector_entry_point", backend="numpy")
-    assert venv.backend == "numpy"
-    with pytest.raises(ValueError, match="backend='jax'"):
-        PlatformVectorEnv(backend="jax")
-    real_import = builtins.__import__
-
-    def no_numba(name, *args, **kwargs):
-        if name == "numba" or name.startswith("numba."):
-            raise ImportError("No module named 'numba'")
-        return real_import(name, *args, **kwargs)
-
-    monkeypatch.setattr(builtins, "__import__", no_numba)
-    with pytest.raises(ImportError, match=r"backend='numba' needs Numba"):
-        PlatformVectorEnv(backend="numba")
-    assert PlatformVectorEnv(backend="auto").backend == "numpy"
