@@ -31,8 +31,8 @@ import dataclasses
 import numpy as np
 import torch
 
-from pamdp.algos.base import AlgoConfig, Algorithm, setting
-from pamdp.algos.patrpo import Rollout, advantage_batch
+from pamdp.algos.base import AlgoConfig, setting
+from pamdp.algos.patrpo import OnPolicyHybrid, Rollout
 from pamdp.distributions import HybridDistribution, kl_divergence
 from pamdp.policies import ACTIVATIONS, HybridPolicy, ValueNetwork
 
@@ -153,7 +153,7 @@ def ppo_loss(
     return loss, {k: v.detach() for k, v in parts.items()}
 
 
-class PAPPO(Algorithm):
+class PAPPO(OnPolicyHybrid):
     """PPO of the hierarchical policy. See the module docstring for the update and :class:`PAPPOConfig`."""
 
     config_class = PAPPOConfig
@@ -172,30 +172,14 @@ class PAPPO(Algorithm):
     def _optimizers(self):
         return {"adam": self.optimizer}
 
-    def _act(self, obs, deterministic):
-        dist = self.policy(obs)
-        return dist.mode() if deterministic else dist.sample(self.torch_gen)
-
     def _values(self, obs: np.ndarray, t: np.ndarray) -> np.ndarray:
         with torch.no_grad():
             return self.value(self._obs_tensor(obs)).double().numpy()
 
     def _run_epoch(self) -> dict[str, float]:
-        cfg = self.config
-        batch = self.rollout.collect(
-            self.vec_env, self.policy, self.hybrid, cfg.batch_size, self.np_rng, self.torch_gen
-        )
-        data, explained_var = advantage_batch(batch, self._values, cfg.gamma, cfg.gae_lambda, cfg.normalize_advantages)
-        stats = self._update(
-            self._obs_tensor(data["obs"]),
-            torch.as_tensor(data["a"]),
-            torch.as_tensor(data["x"]),
-            torch.as_tensor(data["adv"], dtype=torch.float32),
-            torch.as_tensor(data["returns"], dtype=torch.float32),
-        )
-        stats["train/explained_variance"] = explained_var
-        stats.update(self.rollout.epoch_stats(data["a"], self.hybrid.n_actions))
-        return stats
+        data, explained_var, tensors = self._sample_epoch()
+        stats = self._update(*tensors, torch.as_tensor(data["returns"], dtype=torch.float32))
+        return self._epoch_stats(stats, data, explained_var)
 
     def _update(self, obs, a, x, adv, returns) -> dict[str, float]:
         """``n_epochs`` passes of minibatch Adam steps on the joint loss, stopped early by ``target_kl``."""

@@ -25,7 +25,7 @@ from pamdp.distributions import KL_ESTIMATORS, kl_divergence
 from pamdp.policies import ACTIVATIONS, HybridPolicy, ValueNetwork
 from pamdp.spaces import HybridActionSpace
 
-__all__ = ["PATRPO", "PATRPOConfig", "LinearFeatureBaseline", "Rollout", "advantage_batch", "gae"]
+__all__ = ["PATRPO", "PATRPOConfig", "LinearFeatureBaseline", "OnPolicyHybrid", "Rollout", "advantage_batch", "gae"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -232,6 +232,41 @@ def advantage_batch(
     return data, explained_var
 
 
+class OnPolicyHybrid(Algorithm):
+    """What PATRPO and PAPPO share: pi_d pi_c sampled by a :class:`Rollout` (``self.rollout``), advantages by
+    :func:`advantage_batch` from ``self._values``, and the greedy or sampled action of ``self.policy``. Their
+    configs name ``batch_size``, ``gamma``, ``gae_lambda`` and ``normalize_advantages`` alike."""
+
+    def _act(self, obs, deterministic):
+        dist = self.policy(obs)
+        return dist.mode() if deterministic else dist.sample(self.torch_gen)
+
+    def _values(self, obs: np.ndarray, t: np.ndarray) -> np.ndarray:
+        raise NotImplementedError
+
+    def _sample_epoch(self) -> tuple[dict[str, np.ndarray], float, tuple[torch.Tensor, ...]]:
+        """One epoch's valid samples with their advantages (:func:`advantage_batch`'s ``data`` and explained
+        variance) and the policy update's tensors ``(obs, a, x, adv)``."""
+        cfg = self.config
+        batch = self.rollout.collect(
+            self.vec_env, self.policy, self.hybrid, cfg.batch_size, self.np_rng, self.torch_gen
+        )
+        data, explained_var = advantage_batch(batch, self._values, cfg.gamma, cfg.gae_lambda, cfg.normalize_advantages)
+        tensors = (
+            self._obs_tensor(data["obs"]),
+            torch.as_tensor(data["a"]),
+            torch.as_tensor(data["x"]),
+            torch.as_tensor(data["adv"], dtype=torch.float32),
+        )
+        return data, explained_var, tensors
+
+    def _epoch_stats(self, stats: dict[str, float], data: dict[str, np.ndarray], explained_var: float):
+        """``stats`` with the explained variance, the action frequencies and the finished episodes added."""
+        stats["train/explained_variance"] = explained_var
+        stats.update(self.rollout.epoch_stats(data["a"], self.hybrid.n_actions))
+        return stats
+
+
 class LinearFeatureBaseline:
     """rllab's baseline: ridge regression of returns on ``[clip(s), s^2, t/100, (t/100)^2, (t/100)^3, 1]``."""
 
@@ -260,7 +295,7 @@ class LinearFeatureBaseline:
         return float(np.mean((self.predict(obs, t) - returns) ** 2))
 
 
-class PATRPO(Algorithm):
+class PATRPO(OnPolicyHybrid):
     """Parameterized Actions TRPO. See the module docstring for the update and :class:`PATRPOConfig`."""
 
     config_class = PATRPOConfig
@@ -291,10 +326,6 @@ class PATRPO(Algorithm):
         if self.config.baseline == "linear":
             self.linear_baseline.coef = state["linear_baseline"].numpy()
 
-    def _act(self, obs, deterministic):
-        dist = self.policy(obs)
-        return dist.mode() if deterministic else dist.sample(self.torch_gen)
-
     # -- baseline --------------------------------------------------------------------------------
     def _values(self, obs: np.ndarray, t: np.ndarray) -> np.ndarray:
         if self.config.baseline == "linear":
@@ -321,21 +352,10 @@ class PATRPO(Algorithm):
 
     # -- one epoch -------------------------------------------------------------------------------
     def _run_epoch(self) -> dict[str, float]:
-        cfg = self.config
-        batch = self.rollout.collect(
-            self.vec_env, self.policy, self.hybrid, cfg.batch_size, self.np_rng, self.torch_gen
-        )
-        data, explained_var = advantage_batch(batch, self._values, cfg.gamma, cfg.gae_lambda, cfg.normalize_advantages)
-        stats = self._update_policy(
-            self._obs_tensor(data["obs"]),
-            torch.as_tensor(data["a"]),
-            torch.as_tensor(data["x"]),
-            torch.as_tensor(data["adv"], dtype=torch.float32),
-        )
+        data, explained_var, tensors = self._sample_epoch()
+        stats = self._update_policy(*tensors)
         stats["losses/value_loss"] = self._fit_baseline(data["obs"], data["t"], data["returns"])
-        stats["train/explained_variance"] = explained_var
-        stats.update(self.rollout.epoch_stats(data["a"], self.hybrid.n_actions))
-        return stats
+        return self._epoch_stats(stats, data, explained_var)
 
     def _update_policy(self, obs, a, x, adv) -> dict[str, float]:
         """One natural-gradient step with line search on the surrogate (the paper's PATRPO update)."""
