@@ -28,7 +28,6 @@ from __future__ import annotations
 
 import dataclasses
 
-import numpy as np
 import torch
 
 from pamdp.algos.base import AlgoConfig, setting
@@ -171,10 +170,6 @@ class PAPPO(OnPolicyHybrid):
 
     def _optimizers(self):
         return {"adam": self.optimizer}
-
-    def _values(self, obs: np.ndarray, t: np.ndarray) -> np.ndarray:
-        with torch.no_grad():
-            return self.value(self._obs_tensor(obs)).double().numpy()
 
     def _run_epoch(self) -> dict[str, float]:
         data, explained_var, tensors = self._sample_epoch()

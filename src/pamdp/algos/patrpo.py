@@ -242,7 +242,9 @@ class OnPolicyHybrid(Algorithm):
         return dist.mode() if deterministic else dist.sample(self.torch_gen)
 
     def _values(self, obs: np.ndarray, t: np.ndarray) -> np.ndarray:
-        raise NotImplementedError
+        """The baseline ``V(s)`` of observations at step ``t`` of their episodes: here ``self.value``'s."""
+        with torch.no_grad():
+            return self.value(self._obs_tensor(obs)).double().numpy()
 
     def _sample_epoch(self) -> tuple[dict[str, np.ndarray], float, tuple[torch.Tensor, ...]]:
         """One epoch's valid samples with their advantages (:func:`advantage_batch`'s ``data`` and explained
@@ -330,8 +332,7 @@ class PATRPO(OnPolicyHybrid):
     def _values(self, obs: np.ndarray, t: np.ndarray) -> np.ndarray:
         if self.config.baseline == "linear":
             return self.linear_baseline.predict(obs, t)
-        with torch.no_grad():
-            return self.value(self._obs_tensor(obs)).double().numpy()
+        return super()._values(obs, t)
 
     def _fit_baseline(self, obs: np.ndarray, t: np.ndarray, returns: np.ndarray) -> float:
         cfg = self.config
