@@ -39,6 +39,22 @@ def machine() -> str:
     )
 
 
+NOTES_HEADING = "## Notes (written by hand"
+
+
+def hand_notes(record: Path) -> str:
+    """The hand-written notes section of an existing record (from its heading to the end), or ``""``.
+
+    A rerun rewrites the generated part of the record and keeps these notes, so resuming a benchmark never
+    deletes what was written about it.
+    """
+    if not record.exists():
+        return ""
+    text = record.read_text()
+    start = text.find(NOTES_HEADING)
+    return text[start:].strip() if start >= 0 else ""
+
+
 def run_and_record(experiment_file: str, out_root: str, record: str, workers: int, scale: float, seeds) -> None:
     exp = load_experiment(HERE / experiment_file)
     jobs = [(s, str(exp.run_dir(out_root, s))) for s in exp.specs(seeds, scale)]
@@ -92,6 +108,9 @@ def run_and_record(experiment_file: str, out_root: str, record: str, workers: in
         lines += ["", f"{len(failed)} runs failed:"] + [
             f"- {o.out}: {o.error.strip().splitlines()[-1]}" for o in failed
         ]
+    notes = hand_notes(HERE / record)
+    if notes:
+        lines += ["", notes]
     (HERE / record).write_text("\n".join(lines) + "\n")
     print(json.dumps({"record": str(HERE / record), "wall_minutes": wall / 60}))
 
