@@ -11,27 +11,28 @@
 # and the experiments' directories, to be committed by hand with notes.
 #
 # Costs on the 2-core Intel Xeon of 2026-11-28, per run with another run on the other core (PATRPO's figures
-# predate the Numba Platform backend of 2026-11-29, which takes its ~35 % of env time off an epoch):
-#   1. PASVG(0) tuned (preset G), 5 x 1M (issue 4's target): ~55 min a run          ~5 core-hours
-#   2. step-size (2 x 5) and kl-estimators (3 x 5), PATRPO: ~16 min a run            ~6.5 core-hours
-#   3. the PATRPO arms of platform (5 x ~16 min) and soccer (3 x 5M, ~1 h each)      ~4.5 core-hours
-#   4. MP-DQN, P-DQN and PAPPO tuned, 3 x 5 x 300k (beyond the paper): a few minutes a run ~1.5 core-hours
-#   5. platform's off-policy arms: PASVG(0) paper (5 x ~5 h), PADDPG paper (5 x ~3 h)    ~40 core-hours;
-#      they are also issue 4's paper-preset and issue 5's benchmark runs
-#   6. PADDPG with Hausknecht & Stone's preset on Platform, 1 seed x 300k (issue 5)  ~4 core-hours
+# predate the Numba Platform backend of 2026-11-29, which takes its ~35 % of env time off an epoch). Done and
+# dropped from the queue: PASVG(0) tuned, 5 x 1M (issue 4, benchmarks/pasvg_platform.md).
+#   1. step-size (2 x 5) and kl-estimators (3 x 5), PATRPO: ~16 min a run            ~6.5 core-hours
+#   2. the PATRPO arms of platform (5 x ~16 min) and soccer (3 x 5M, ~1 h each)      ~4.5 core-hours
+#   3. MP-DQN, P-DQN and PAPPO tuned, 3 x 5 x 300k (beyond the paper): a few minutes a run ~1.5 core-hours
+#   4. platform's PADDPG arm, paper preset, 5 x 1M (~3 h a run alone, ~5 h beside another): also issue 5's
+#      benchmark, so it goes before PASVG(0)'s arm to close that issue first    ~25 core-hours
+#   5. PADDPG with Hausknecht & Stone's preset on Platform, 1 seed x 300k (issue 5)  ~4 core-hours
+#   6. platform's PASVG(0) arm, paper preset, 5 x 1M (~5 h a run alone)          ~40 core-hours
 #   7. soccer's PADDPG arm: 3 x 5M at one update per sample is ~15 core-hours a run here, so it runs as far
 #      as the sessions allow (issue 7 asks for "as far as the machine allows")
 set -euo pipefail
 cd "$(dirname "$0")"
 RUNS=${PAMDP_RUNS:-/root/pamdp-runs}
 
-python bench_pasvg_platform.py --workers 2 --out "$RUNS/bench"
 pamdp reproduce step-size --workers 2 --out "$RUNS/repro"
 pamdp reproduce kl-estimators --workers 2 --out "$RUNS/repro"
 pamdp reproduce platform --runs PATRPO --workers 2 --out "$RUNS/repro"
 pamdp reproduce soccer --runs PATRPO --workers 2 --out "$RUNS/repro"
 python bench_later_platform.py --workers 2 --out "$RUNS/bench"
-pamdp reproduce platform --workers 2 --out "$RUNS/repro"
+pamdp reproduce platform --runs PADDPG --workers 2 --out "$RUNS/repro"
 pamdp train paddpg --preset hausknecht_stone --seed 0 --total-steps 300000 --save-replay true \
     --eval-every 5 --no-progress --out "$RUNS/bench/paddpg_hausknecht_stone/seed0"
+pamdp reproduce platform --workers 2 --out "$RUNS/repro"
 pamdp reproduce soccer --workers 2 --out "$RUNS/repro"
