@@ -119,6 +119,11 @@ def test_resume_after_a_killed_worker(tmp_path):
     os.killpg(proc.pid, signal.SIGKILL)  # the runner and its workers
     proc.wait()
     assert ckpt.exists()
+    status = subprocess.run(cmd + ["--status"], capture_output=True, text=True, timeout=60)
+    assert status.returncode == 0, status.stderr
+    row0 = next(line for line in status.stdout.splitlines() if line.startswith("| small delta | 0 |"))
+    assert "| partial" in row0 and "/ 3,000 |" in row0
+    assert "tiny: 0 of 2 runs done" in status.stdout
     done = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr
     log = (out / "tiny" / "small_delta" / "seed0" / "stdout.log").read_text()
@@ -126,6 +131,30 @@ def test_resume_after_a_killed_worker(tmp_path):
     with open(out / "tiny" / "small_delta" / "seed0" / "progress.csv", newline="") as f:
         steps = [float(r["time/total_timesteps"]) for r in csv.DictReader(f)]
     assert steps == sorted(set(steps)) and steps[-1] >= 3000
+    status = subprocess.run(cmd + ["--status"], capture_output=True, text=True, timeout=60)
+    assert "tiny: 2 of 2 runs done, 0 partial, 0 not started" in status.stdout
+    greedy = json.loads((out / "tiny" / "small_delta" / "seed0" / "evaluation.json").read_text())["mean_return"]
+    assert "| small delta | 0 | done | 3,000 |" in status.stdout and f"| {greedy:.3f} |" in status.stdout
+
+
+def test_status_estimates_the_training_left_from_each_runs_own_pace():
+    from pamdp.experiments.status import RunStatus, format_status, remaining_seconds
+
+    def run(label, seed, state, steps, seconds):
+        return RunStatus(label, seed, "", state, steps, 1000, seconds, None, None, None, None)
+
+    statuses = [
+        run("a", 0, "done", 1000, 100.0),  # 0.1 s a sample; finished, nothing left
+        run("a", 1, "partial", 500, 100.0),  # 0.2 s a sample: 500 left -> 100 s
+        run("a", 2, "not started", 0, 0.0),  # label a's median (0.15) x 1000 -> 150 s
+        run("b", 0, "not started", 0, 0.0),  # no b has run: the overall median 0.15 -> 150 s
+    ]
+    left, unknown = remaining_seconds(statuses)
+    assert left == pytest.approx(400.0) and unknown == 0
+    assert remaining_seconds([run("b", 0, "not started", 0, 0.0)]) == (0.0, 1)
+    text = format_status("x", statuses, workers=2)
+    assert "x: 1 of 4 runs done, 1 partial, 2 not started; about 7 min of training to go" in text
+    assert "(~3 min with 2 side by side)" in text
 
 
 @pytest.mark.skipif(not os.path.isdir("/proc/self/fd"), reason="finds the worker through /proc")

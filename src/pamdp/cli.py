@@ -139,6 +139,11 @@ def build_parser() -> argparse.ArgumentParser:
     rp.add_argument("--out", default="results", help="results root (default: %(default)s)")
     rp.add_argument("--backend", choices=["local", "ray"], default="local", help="local processes or a Ray cluster")
     rp.add_argument("--address", default=None, help="Ray cluster address HOST:PORT (with --backend ray)")
+    rp.add_argument(
+        "--status",
+        action="store_true",
+        help="train nothing: list each run's state (done, partial, not started) and the training time still to go",
+    )
 
     pl = sub.add_parser("plot", help="learning curves (PNG, SVG) and a results table from run directories")
     pl.add_argument("dirs", nargs="+", help="directories holding run directories (grouped by parent: one curve each)")
@@ -212,6 +217,11 @@ def cmd_reproduce(args) -> int:
     jobs = [(spec, str(exp.run_dir(args.out, spec))) for spec in exp.specs(seeds, args.scale, labels)]
     for spec, _ in jobs:
         spec.config()  # every setting is checked before the first run starts
+    if args.status:
+        from pamdp.experiments.status import format_status, run_status
+
+        print(format_status(exp.name, [run_status(spec, out) for spec, out in jobs], args.workers), end="")
+        return 0
     print(f"{exp.name}: {exp.description}; {len(jobs)} runs of {jobs[0][0].total_steps:,} steps", file=sys.stderr)
     if args.backend == "ray":
         from pamdp.experiments.ray_backend import run_all_ray

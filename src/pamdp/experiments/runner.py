@@ -24,7 +24,16 @@ from typing import Any
 
 from pamdp.algos import ALGORITHMS
 
-__all__ = ["RunSpec", "default_preset", "train_run", "run_all", "algorithm_class", "ALGORITHMS", "DEFAULT_PRESET"]
+__all__ = [
+    "RunSpec",
+    "default_preset",
+    "train_run",
+    "is_finished",
+    "run_all",
+    "algorithm_class",
+    "ALGORITHMS",
+    "DEFAULT_PRESET",
+]
 
 DEFAULT_PRESET = "tuned"
 
@@ -74,6 +83,26 @@ class RunSpec:
         return cls, preset, cls.config_class.from_dict({**dict(self.settings), "seed": self.seed}, base=base)
 
 
+def is_finished(out: str | Path, spec: RunSpec) -> bool:
+    """Whether ``out`` holds ``spec``'s final model for its whole budget (and its evaluation, if it asks for one).
+
+    :func:`train_run` skips such a run (after checking its recorded settings); ``pamdp reproduce --status``
+    counts it as done.
+    """
+    from pamdp.algos.base import FINAL_MODEL
+
+    out = Path(out)
+    if not (out / FINAL_MODEL).exists() or not (out / "run.json").exists():
+        return False
+    try:
+        recorded = json.loads((out / "run.json").read_text())
+    except (OSError, json.JSONDecodeError):
+        return False
+    if recorded.get("total_steps") != spec.total_steps:
+        return False
+    return spec.eval_episodes <= 0 or (out / "evaluation.json").exists()
+
+
 def train_run(spec: RunSpec, out: str | os.PathLike, progress_bar: bool = True, log=print) -> dict:
     """Train (or resume, or skip) one run in ``out``; returns its evaluation (or ``{}`` without one)."""
     from pamdp.algos.base import CHECKPOINT, FINAL_MODEL
@@ -102,8 +131,7 @@ def train_run(spec: RunSpec, out: str | os.PathLike, progress_bar: bool = True, 
                 f"{out} holds a run with other {', '.join(differ)}; "
                 "resume it with the same settings or use another output directory"
             )
-        done = (out / FINAL_MODEL).exists() and recorded.get("total_steps") == spec.total_steps
-        if done and (eval_file.exists() or spec.eval_episodes == 0):
+        if is_finished(out, spec):
             log(f"{out}: already finished")
             return json.loads(eval_file.read_text()) if eval_file.exists() else {}
         model = cls.load(out / CHECKPOINT if (out / CHECKPOINT).exists() else out / FINAL_MODEL)

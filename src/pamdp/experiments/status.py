@@ -1,0 +1,155 @@
+"""Where an experiment stands, read from its run directories: ``pamdp reproduce NAME --status``.
+
+The paper's experiments take tens of CPU-hours on a laptop and are run over many sittings, each resuming
+where the last one stopped. This reads every run's directory without training anything and reports, per run,
+whether it is finished, partial (it resumes from its checkpoint) or not started, how many samples it has and
+how long it trained, and for the experiment the training time still to go, extrapolated from the time per
+sample its runs have taken so far.
+"""
+
+from __future__ import annotations
+
+import csv
+import dataclasses
+import json
+import math
+import statistics
+import time
+from pathlib import Path
+
+from pamdp.experiments.runner import RunSpec, is_finished
+
+__all__ = ["RunStatus", "run_status", "format_status", "remaining_seconds"]
+
+DONE, PARTIAL, NOT_STARTED = "done", "partial", "not started"
+
+
+@dataclasses.dataclass
+class RunStatus:
+    """One run's state, from its directory."""
+
+    label: str
+    seed: int
+    out: str
+    state: str  # "done", "partial" or "not started"
+    steps: int  # samples trained on so far (from progress.csv)
+    total_steps: int
+    train_seconds: float  # summed epoch times from progress.csv
+    last_return: float | None  # mean training return of the last epoch
+    greedy_return: float | None  # the final greedy evaluation, once done
+    goal_rate: float | None
+    idle_seconds: float | None  # since progress.csv was last written; small while a run is training
+
+    @property
+    def seconds_per_step(self) -> float | None:
+        return self.train_seconds / self.steps if self.steps > 0 and self.train_seconds > 0 else None
+
+
+def _float(value) -> float | None:
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        return None
+    return x if math.isfinite(x) else None
+
+
+def run_status(spec: RunSpec, out: str | Path, now: float | None = None) -> RunStatus:
+    """The state of ``spec``'s run in directory ``out``."""
+    from pamdp.algos.base import CHECKPOINT, FINAL_MODEL
+
+    out = Path(out)
+    steps, seconds, last_return, idle = 0, 0.0, None, None
+    progress = out / "progress.csv"
+    if progress.exists():
+        with open(progress, newline="") as f:
+            rows = list(csv.DictReader(f))
+        for row in rows:
+            seconds += _float(row.get("time/epoch_seconds")) or 0.0
+        if rows:
+            steps = int(_float(rows[-1].get("time/total_timesteps")) or 0)
+            last_return = _float(rows[-1].get("charts/episodic_return"))
+        idle = (time.time() if now is None else now) - progress.stat().st_mtime
+    greedy = goal = None
+    if is_finished(out, spec):
+        state = DONE
+        if (out / "evaluation.json").exists():
+            result = json.loads((out / "evaluation.json").read_text())
+            greedy, goal = _float(result.get("mean_return")), _float(result.get("goal_rate"))
+    elif (out / CHECKPOINT).exists() or (out / FINAL_MODEL).exists() or steps > 0:
+        state = PARTIAL
+    else:
+        state = NOT_STARTED
+    return RunStatus(
+        spec.label, spec.seed, str(out), state, steps, spec.total_steps, seconds, last_return, greedy, goal, idle
+    )
+
+
+def _minutes(seconds: float) -> str:
+    return f"{seconds / 60:.0f} min" if seconds < 5940 else f"{seconds / 3600:.1f} h"
+
+
+def remaining_seconds(statuses: list[RunStatus]) -> tuple[float, int]:
+    """Training time still to go over all unfinished runs, and how many runs that estimate leaves out.
+
+    A run's time per sample is its own if it has trained, else the median of its setting's (its label's)
+    runs, else the median over the experiment; runs with nothing to go by are counted, not guessed.
+    """
+    by_label: dict[str, list[float]] = {}
+    for s in statuses:
+        if s.seconds_per_step is not None:
+            by_label.setdefault(s.label, []).append(s.seconds_per_step)
+    overall = [x for xs in by_label.values() for x in xs]
+    total, unknown = 0.0, 0
+    for s in statuses:
+        if s.state == DONE:
+            continue
+        rate = s.seconds_per_step
+        if rate is None and s.label in by_label:
+            rate = statistics.median(by_label[s.label])
+        if rate is None and overall:
+            rate = statistics.median(overall)
+        if rate is None:
+            unknown += 1
+            continue
+        total += rate * max(s.total_steps - s.steps, 0)
+    return total, unknown
+
+
+def format_status(name: str, statuses: list[RunStatus], workers: int = 1) -> str:
+    """A markdown table of the runs and a summary line with the training time still to go."""
+    goal = any(s.goal_rate is not None for s in statuses)
+    head = "| run | seed | state | samples | trained | last epoch's return | greedy return |" + (
+        " goal rate |" if goal else ""
+    )
+    lines = [head, "|---" * (head.count("|") - 1) + "|"]
+    for s in statuses:
+        share = f"{s.steps:,} / {s.total_steps:,}" if s.state != DONE else f"{s.total_steps:,}"
+        state = s.state
+        if s.state == PARTIAL and s.idle_seconds is not None:  # a run in training writes every epoch
+            state += f" (last epoch {_minutes(s.idle_seconds)} ago)"
+        cells = [
+            s.label,
+            str(s.seed),
+            state,
+            share,
+            _minutes(s.train_seconds) if s.train_seconds else "-",
+            f"{s.last_return:.3f}" if s.last_return is not None else "-",
+            f"{s.greedy_return:.3f}" if s.greedy_return is not None else "-",
+        ]
+        if goal:
+            cells.append(f"{s.goal_rate:.3f}" if s.goal_rate is not None else "-")
+        lines.append("| " + " | ".join(cells) + " |")
+    counts = {k: sum(s.state == k for s in statuses) for k in (DONE, PARTIAL, NOT_STARTED)}
+    left, unknown = remaining_seconds(statuses)
+    summary = f"{name}: {counts[DONE]} of {len(statuses)} runs done, {counts[PARTIAL]} partial, "
+    summary += f"{counts[NOT_STARTED]} not started"
+    if counts[DONE] < len(statuses):
+        if left > 0:
+            workers = max(1, workers)
+            summary += (
+                f"; about {_minutes(left)} of training to go at the runs' own pace so far"
+                f" (~{_minutes(left / workers)} with {workers} side by side)"
+            )
+        if unknown:
+            summary += f"; {unknown} runs with no time per sample to go by yet"
+    return "\n".join(lines) + "\n\n" + summary + "\n"
