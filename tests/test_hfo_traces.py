@@ -71,11 +71,15 @@ def _report(name, results):
     for r in results.values():
         for message in r.messages[:5]:
             print(message)
-    print(f"{name}: {matching}/{compared} = {matching / compared:.2%} of IN_GAME steps within {TOLERANCE}; "
-          f"{endings}/{len(results)} endings match")
+    print(
+        f"{name}: {matching}/{compared} = {matching / compared:.2%} of IN_GAME steps within {TOLERANCE}; "
+        f"{endings}/{len(results)} endings match"
+    )
     for r in results.values():
-        print(f"  episode {r.episode:2d}: {r.matching}/{r.compared} steps, ending "
-              f"{'matches' if r.ending_matches else 'differs'}")
+        print(
+            f"  episode {r.episode:2d}: {r.matching}/{r.compared} steps, ending "
+            f"{'matches' if r.ending_matches else 'differs'}"
+        )
     return matching / compared, endings
 
 
@@ -86,8 +90,9 @@ def test_trace_copy_is_complete(trace):
 
 
 def test_rounding_box():
-    np.testing.assert_allclose(rounding_box(np.array([4.45103, 12.9701, -77.141, -0.1, 0.0])),
-                               [5e-6, 5e-5, 5e-5, 5e-7, 0.0])
+    np.testing.assert_allclose(
+        rounding_box(np.array([4.45103, 12.9701, -77.141, -0.1, 0.0])), [5e-6, 5e-5, 5e-5, 5e-7, 0.0]
+    )
 
 
 def test_one_step_replay_matches_the_server(trace):

@@ -32,8 +32,7 @@ class HybridActionSpace:
     def __post_init__(self):
         if len(self.lows) == 0 or len(self.lows) != len(self.highs):
             raise ValueError(
-                f"lows and highs must be equally long, non-empty sequences; got {len(self.lows)} and "
-                f"{len(self.highs)}"
+                f"lows and highs must be equally long, non-empty sequences; got {len(self.lows)} and {len(self.highs)}"
             )
         for a, (lo, hi) in enumerate(zip(self.lows, self.highs)):
             if lo.shape != hi.shape or lo.ndim != 1:

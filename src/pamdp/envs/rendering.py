@@ -84,9 +84,7 @@ def record_episode(
     Returns the GIF's path and the episode's return.
     """
     if getattr(env, "render_mode", None) != "rgb_array":
-        raise ValueError(
-            f"record_episode needs an env made with render_mode='rgb_array', got {env.render_mode!r}"
-        )
+        raise ValueError(f"record_episode needs an env made with render_mode='rgb_array', got {env.render_mode!r}")
     obs, _ = env.reset(seed=seed)
     if seed is not None:
         env.action_space.seed(seed)
