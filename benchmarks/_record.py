@@ -55,13 +55,27 @@ def hand_notes(record: Path) -> str:
     return text[start:].strip() if start >= 0 else ""
 
 
-def run_and_record(experiment_file: str, out_root: str, record: str, workers: int, scale: float, seeds) -> None:
-    exp = load_experiment(HERE / experiment_file)
-    jobs = [(s, str(exp.run_dir(out_root, s))) for s in exp.specs(seeds, scale)]
+def run_and_record(
+    experiment: str, out_root: str, record: str, workers: int, scale: float, seeds, runs=None, title=None
+) -> None:
+    """Run ``experiment`` (a TOML file next to this script, or a packaged experiment's name such as
+    ``platform``), only its arms labelled ``runs`` if given, and write ``record`` with its figures.
+
+    The runs go where ``pamdp reproduce`` puts them (``OUT/NAME/LABEL/seedN``), so a benchmark made of a
+    packaged experiment's arm shares its runs with ``pamdp reproduce NAME --out OUT``.
+    """
+    exp = load_experiment(HERE / experiment if experiment.endswith(".toml") else experiment)
+    specs = exp.specs(seeds, scale, runs)
+    jobs = [(s, str(exp.run_dir(out_root, s))) for s in specs]
     t0 = time.time()
     outcomes = run_all(jobs, workers=workers)
     wall = time.time() - t0
-    report = write_report([Path(out_root) / exp.name], Path(out_root) / exp.name, exp.description)
+    title = title or exp.description
+    if runs is None:
+        report = write_report([Path(out_root) / exp.name], Path(out_root) / exp.name, title)
+    else:  # the chosen arms alone, reported beside the experiment's own report
+        arms = list(dict.fromkeys(exp.run_dir(out_root, s).parent for s in specs))
+        report = write_report(arms, Path(out_root) / exp.name / f"report-{Path(record).stem}", title)
     figure = HERE / "results" / f"{Path(record).stem}.png"
     figure.parent.mkdir(exist_ok=True)
     shutil.copy(report["png"], figure)
@@ -78,7 +92,7 @@ def run_and_record(experiment_file: str, out_root: str, record: str, workers: in
         ["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, cwd=HERE
     ).stdout.strip()
     lines = [
-        f"# {exp.description}",
+        f"# {title}",
         "",
         f"- command: `python {' '.join(sys.argv)}` (commit {commit})",
         f"- date: {dt.datetime.now().isoformat(timespec='minutes')}",
@@ -115,8 +129,12 @@ def run_and_record(experiment_file: str, out_root: str, record: str, workers: in
     print(json.dumps({"record": str(HERE / record), "wall_minutes": wall / 60}))
 
 
-def main(experiment_file: str, doc: str, workers: int = 2) -> None:
-    """The command line every learning benchmark shares: ``[--workers N] [--scale F] [--seeds 0,1] [--out DIR]``."""
+def main(experiment: str, doc: str, workers: int = 2, runs=None, record=None, title=None) -> None:
+    """The command line every learning benchmark shares: ``[--workers N] [--scale F] [--seeds 0,1] [--out DIR]``.
+
+    ``experiment``, ``runs`` and ``title`` as in :func:`run_and_record`; ``record`` defaults to the
+    experiment file's name with ``.md``.
+    """
     import argparse
 
     p = argparse.ArgumentParser(description=doc, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -126,5 +144,5 @@ def main(experiment_file: str, doc: str, workers: int = 2) -> None:
     p.add_argument("--out", default="results/bench")
     a = p.parse_args()
     seeds = [int(s) for s in a.seeds.split(",")] if a.seeds else None
-    record = Path(experiment_file).with_suffix(".md").name
-    run_and_record(experiment_file, a.out, record, a.workers, a.scale, seeds)
+    record = record or Path(experiment).with_suffix(".md").name
+    run_and_record(experiment, a.out, record, a.workers, a.scale, seeds, runs, title)

@@ -31,7 +31,7 @@ pamdp reproduce kl-estimators --workers 2 --out "$RUNS/repro"
 pamdp reproduce platform --runs PATRPO --workers 2 --out "$RUNS/repro"
 pamdp reproduce soccer --runs PATRPO --workers 2 --out "$RUNS/repro"
 python bench_later_platform.py --workers 2 --out "$RUNS/bench"
-pamdp reproduce platform --runs PADDPG --workers 2 --out "$RUNS/repro"
+python bench_paddpg_platform.py --workers 2 --out "$RUNS/repro"    # = platform --runs PADDPG, + record
 pamdp train paddpg --preset hausknecht_stone --seed 0 --total-steps 300000 --save-replay true \
     --eval-every 5 --no-progress --out "$RUNS/bench/paddpg_hausknecht_stone/seed0"
 pamdp reproduce platform --workers 2 --out "$RUNS/repro"
