@@ -18,7 +18,7 @@
 #   3. MP-DQN, P-DQN and PAPPO tuned, 3 x 5 x 300k (beyond the paper): a few minutes a run ~1.5 core-hours
 #   4. platform's PADDPG arm, paper preset, 5 x 1M (~3 h a run alone, ~5 h beside another): also issue 5's
 #      benchmark, so it goes before PASVG(0)'s arm to close that issue first    ~25 core-hours
-#   5. PADDPG with Hausknecht & Stone's preset on Platform, 1 seed x 300k (issue 5)  ~4 core-hours
+#   5. PADDPG with Hausknecht & Stone's preset on Platform, 1 seed x 300k (issue 5), beside step 4  ~4 core-hours
 #   6. platform's PASVG(0) arm, paper preset, 5 x 1M (~5 h a run alone)          ~40 core-hours
 #   7. soccer's PADDPG arm: 3 x 5M at one update per sample is ~15 core-hours a run here, so it runs as far
 #      as the sessions allow (issue 7 asks for "as far as the machine allows")
@@ -31,8 +31,11 @@ pamdp reproduce kl-estimators --workers 2 --out "$RUNS/repro"
 pamdp reproduce platform --runs PATRPO --workers 2 --out "$RUNS/repro"
 pamdp reproduce soccer --runs PATRPO --workers 2 --out "$RUNS/repro"
 python bench_later_platform.py --workers 2 --out "$RUNS/bench"
+# Issue 5: the H&S run beside the five paper-preset runs (three processes on two cores), so that no core
+# idles at the end of either; the script waits for both and stops if either failed.
+python bench_paddpg_hausknecht_stone.py --workers 1 --out "$RUNS/bench" &
+hs=$!
 python bench_paddpg_platform.py --workers 2 --out "$RUNS/repro"    # = platform --runs PADDPG, + record
-pamdp train paddpg --preset hausknecht_stone --seed 0 --total-steps 300000 --save-replay true \
-    --eval-every 5 --no-progress --out "$RUNS/bench/paddpg_hausknecht_stone/seed0"
+wait "$hs"
 pamdp reproduce platform --workers 2 --out "$RUNS/repro"
 pamdp reproduce soccer --workers 2 --out "$RUNS/repro"
