@@ -212,3 +212,30 @@ def test_greedy_evaluations_get_their_own_figure(tmp_path):
     report = write_report([tmp_path / "exp"], tmp_path / "fig")
     assert report["greedy_png"].exists() and report["greedy_svg"].exists()
     assert "without" not in report["greedy_svg"].read_text() and "with_eval" in report["greedy_svg"].read_text()
+
+
+def test_curves_are_drawn_over_epochs_as_the_paper_unless_epoch_sizes_differ(tmp_path):
+    from pamdp.experiments.plots import aggregate, write_report, x_axis
+
+    def runs(name, steps):
+        run = tmp_path / name / "seed0"
+        run.mkdir(parents=True)
+        rows = "\n".join(f"{s},{0.1 * i}" for i, s in enumerate(steps))
+        (run / "progress.csv").write_text("time/total_timesteps,charts/episodic_return\n" + rows + "\n")
+        return aggregate([run])
+
+    on_policy = runs("a", [10_000, 20_000, 30_000])
+    off_policy = runs("b", [10_008, 20_016, 30_000])  # epochs end on the first whole batch past 10 000
+    small = runs("c", [5_000, 10_000, 15_000])
+    label, xs = x_axis({"a": on_policy, "b": off_policy})
+    assert label == "training epochs (10,000 samples each)"
+    assert xs["a"].tolist() == [1.0, 2.0, 3.0] and xs["b"].tolist() == [1.0, 2.0, 3.0]
+    label, xs = x_axis({"a": on_policy, "c": small})
+    assert label == "environment samples (millions)" and xs["c"].tolist() == [0.005, 0.01, 0.015]
+    assert x_axis({"a": on_policy, "c": small}, "epochs")[0] == "training epochs (5,000 to 10,000 samples each)"
+    with pytest.raises(ValueError, match="x axis 'steps'; expected one of auto, epochs, samples"):
+        x_axis({"a": on_policy}, "steps")
+    svg = write_report([tmp_path / "a", tmp_path / "b"], tmp_path / "fig")["svg"].read_text()
+    assert "training epochs" in svg
+    svg = write_report([tmp_path / "a", tmp_path / "b"], tmp_path / "fig", x="samples")["svg"].read_text()
+    assert "environment samples" in svg

@@ -149,6 +149,13 @@ def build_parser() -> argparse.ArgumentParser:
     pl.add_argument("dirs", nargs="+", help="directories holding run directories (grouped by parent: one curve each)")
     pl.add_argument("--out", default=None, help="where to write curves.png/.svg, curves.csv, results.md")
     pl.add_argument("--title", default="")
+    pl.add_argument(
+        "--x",
+        choices=["auto", "epochs", "samples"],
+        default="auto",
+        help="x axis: training epochs as the paper's figures, samples, or auto: epochs unless the settings' "
+        "epochs differ in size (default: %(default)s)",
+    )
 
     rd = sub.add_parser("render", help="write one episode to a GIF (a trained model, or random actions in an env)")
     rd.add_argument("source", help="run directory, model file, or a registered env id (random actions)")
@@ -242,7 +249,7 @@ def cmd_reproduce(args) -> int:
 def cmd_plot(args) -> int:
     from pamdp.experiments.plots import write_report
 
-    _print_report(write_report(args.dirs, args.out or args.dirs[0], args.title))
+    _print_report(write_report(args.dirs, args.out or args.dirs[0], args.title, args.x))
     return 0
 
 

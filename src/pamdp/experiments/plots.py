@@ -2,7 +2,8 @@
 
 A *group* is the set of seeds of one setting: the run directories (those holding ``progress.csv``) that
 share a parent directory, e.g. ``results/platform/PATRPO/seed0 ... seed4``. Curves show the mean across
-seeds with a shaded standard deviation, per epoch, as the paper's figures do.
+seeds with a shaded standard deviation, per epoch, over training epochs as the paper's figures do (or over
+samples, where the settings' epochs differ in size).
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["find_groups", "aggregate", "plot_curves", "results_table", "write_report"]
+__all__ = ["find_groups", "aggregate", "x_axis", "plot_curves", "results_table", "write_report"]
 
 METRIC = "charts/episodic_return"
 GREEDY_METRIC = "eval/mean_return"  # logged every few epochs by runs with eval_every (``--eval-every``)
@@ -61,26 +62,59 @@ def aggregate(runs: list[Path], metric: str = METRIC) -> dict[str, np.ndarray]:
         }
 
 
+X_AXES = ("auto", "epochs", "samples")
+
+
+def samples_per_epoch(agg: dict[str, np.ndarray]) -> float | None:
+    """The median number of samples per epoch of an aggregate (``None`` with fewer than two epochs)."""
+    steps = agg["steps"]
+    return float(np.median(np.diff(np.concatenate([[0.0], steps])))) if len(steps) >= 2 else None
+
+
+def x_axis(aggs: dict[str, dict[str, np.ndarray]], x: str = "auto") -> tuple[str, dict[str, np.ndarray]]:
+    """The x axis label and each group's x values: training epochs, as the paper's figures, or samples.
+
+    ``auto`` takes epochs when every group's epochs hold the same number of samples (within 1 %: off-policy
+    epochs end on the first whole batch of env steps past their size), else samples, since epochs of
+    different sizes would misalign the curves.
+    """
+    if x not in X_AXES:
+        raise ValueError(f"x axis {x!r}; expected one of {', '.join(X_AXES)}")
+    sizes = [s for s in map(samples_per_epoch, aggs.values()) if s is not None]
+    same = bool(sizes) and max(sizes) <= 1.01 * min(sizes)
+    if x == "samples" or (x == "auto" and not same):
+        return "environment samples (millions)", {k: a["steps"] / 1e6 for k, a in aggs.items()}
+    label = "training epochs"
+    if sizes:
+        size = f"{min(sizes):,.0f}" if same else f"{min(sizes):,.0f} to {max(sizes):,.0f}"
+        label += f" ({size} samples each)"
+    return label, {k: a["epoch"].astype(float) for k, a in aggs.items()}
+
+
 def plot_curves(
-    groups: dict[str, list[Path]], path: str | os.PathLike, title: str = "", metric: str = METRIC
+    groups: dict[str, list[Path]], path: str | os.PathLike, title: str = "", metric: str = METRIC, x: str = "auto"
 ) -> list[Path]:
-    """Mean +- std learning curves of every group, written as ``path`` with ``.png`` and ``.svg`` suffixes."""
+    """Mean +- std learning curves of every group, written as ``path`` with ``.png`` and ``.svg`` suffixes.
+
+    ``x``: ``epochs`` (the paper's axis), ``samples``, or ``auto`` (see :func:`x_axis`).
+    """
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    aggs = {label: aggregate(runs, metric) for label, runs in groups.items()}
+    xlabel, xs = x_axis(aggs, x)
     fig, ax = plt.subplots(figsize=(5.0, 3.4), dpi=110)
     for label, runs in groups.items():
-        agg = aggregate(runs, metric)
+        agg = aggs[label]
         ok = np.isfinite(agg["mean"])  # a metric logged every few epochs only (greedy evaluations)
-        x, mean, std = agg["steps"][ok] / 1e6, agg["mean"][ok], agg["std"][ok]
+        xv, mean, std = xs[label][ok], agg["mean"][ok], agg["std"][ok]
         line = ax.plot(
-            x, mean, label=f"{label} ({len(runs)} seeds)", linewidth=1.4, marker="." if ok.sum() < 40 else None
+            xv, mean, label=f"{label} ({len(runs)} seeds)", linewidth=1.4, marker="." if ok.sum() < 40 else None
         )[0]
-        ax.fill_between(x, mean - std, mean + std, color=line.get_color(), alpha=0.2)
-    # Samples rather than epochs on the x axis: settings may differ in samples per epoch.
-    ax.set_xlabel("environment samples (millions)")
+        ax.fill_between(xv, mean - std, mean + std, color=line.get_color(), alpha=0.2)
+    ax.set_xlabel(xlabel)
     ax.set_ylabel(LABELS.get(metric, metric))
     if title:
         ax.set_title(title)
@@ -121,8 +155,12 @@ def results_table(groups: dict[str, list[Path]]) -> str:
     return "\n".join(lines)
 
 
-def write_report(roots: list[str | os.PathLike], out: str | os.PathLike, title: str = "") -> dict[str, Path]:
+def write_report(
+    roots: list[str | os.PathLike], out: str | os.PathLike, title: str = "", x: str = "auto"
+) -> dict[str, Path]:
     """Curves (PNG, SVG), the per-epoch aggregate (CSV) and the results table (markdown) into ``out``.
+
+    ``x``: the curves' x axis, as in :func:`plot_curves`.
 
     Runs that logged greedy evaluations during training (``eval_every``) also get ``greedy.png`` and
     ``greedy.svg``: the mean +- std across seeds of those evaluations, at the epochs where they were made.
@@ -130,13 +168,13 @@ def write_report(roots: list[str | os.PathLike], out: str | os.PathLike, title: 
     groups = find_groups(roots)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    png, svg = plot_curves(groups, out / "curves", title)
+    png, svg = plot_curves(groups, out / "curves", title, x=x)
     greedy = {
         label: runs for label, runs in groups.items() if np.isfinite(aggregate(runs, GREEDY_METRIC)["mean"]).any()
     }
     extra = {}
     if greedy:
-        extra["greedy_png"], extra["greedy_svg"] = plot_curves(greedy, out / "greedy", title, GREEDY_METRIC)
+        extra["greedy_png"], extra["greedy_svg"] = plot_curves(greedy, out / "greedy", title, GREEDY_METRIC, x)
     csv_path = out / "curves.csv"
     with open(csv_path, "w", newline="") as f:
         writer = csv.writer(f)
