@@ -143,6 +143,9 @@ def format_status(name: str, statuses: list[RunStatus], workers: int = 1) -> str
     left, unknown = remaining_seconds(statuses)
     summary = f"{name}: {counts[DONE]} of {len(statuses)} runs done, {counts[PARTIAL]} partial, "
     summary += f"{counts[NOT_STARTED]} not started"
+    trained = sum(s.train_seconds for s in statuses)
+    if trained > 0:
+        summary += f"; {_minutes(trained)} of training so far"
     if counts[DONE] < len(statuses):
         if left > 0:
             workers = max(1, workers)
