@@ -16,6 +16,8 @@
 #   1. step-size (2 x 5) and kl-estimators (3 x 5), PATRPO: ~16 min a run            ~6.5 core-hours
 #   2. the PATRPO arms of platform (5 x ~16 min) and soccer (3 x 5M, ~1 h each)      ~4.5 core-hours
 #   3. MP-DQN, P-DQN and PAPPO tuned, 3 x 5 x 300k (beyond the paper): a few minutes a run ~1.5 core-hours
+#   3b. SB3's SAC and DQN through pamdp's wrappers, 2 x 3 x 100k (a baseline from a mainstream library)
+#                                                                            ~1.5 core-hours
 #   4. platform's PADDPG arm, paper preset, 5 x 1M (~3 h a run alone, ~5 h beside another): also issue 5's
 #      benchmark, so it goes before PASVG(0)'s arm to close that issue first    ~25 core-hours
 #   5. PADDPG with Hausknecht & Stone's preset on Platform, 1 seed x 300k (issue 5), beside step 4  ~4 core-hours
@@ -31,6 +33,9 @@ pamdp reproduce kl-estimators --workers 2 --out "$RUNS/repro"
 pamdp reproduce platform --runs PATRPO --workers 2 --out "$RUNS/repro"
 pamdp reproduce soccer --runs PATRPO --workers 2 --out "$RUNS/repro"
 python bench_later_platform.py --workers 2 --out "$RUNS/bench"
+# Stable-Baselines3 (not a pamdp dependency) into its own directory, for the mainstream-library baseline
+pip install -q --target "$RUNS/sb3" --no-deps stable-baselines3
+PYTHONPATH="$RUNS/sb3" python bench_mainstream_platform.py --workers 2 --out "$RUNS/bench"
 # Issue 5: the H&S run beside the five paper-preset runs (three processes on two cores), so that no core
 # idles at the end of either; the script waits for both and stops if either failed.
 python bench_paddpg_hausknecht_stone.py --workers 1 --out "$RUNS/bench" &
