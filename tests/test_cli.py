@@ -132,3 +132,58 @@ def test_env_kwargs_reach_the_env(tmp_path):
     model = load_model(out)
     assert model.obs_dim == 58 and model.env_kwargs == {"profile": "hfo2016"}
     assert json.loads((out / "run.json").read_text())["env_kwargs"] == {"profile": "hfo2016"}
+
+
+USER_ENV_MODULE = '''
+import gymnasium
+import numpy as np
+from gymnasium import spaces
+
+
+class Line(gymnasium.Env):
+    """Reach x = 3 on [0, 10]: action 0 steps by dx in [-1, 1], action 1 jumps to a point in [0, 10]."""
+
+    observation_space = spaces.Box(0.0, 10.0, (1,), np.float32)
+    action_space = spaces.Tuple(
+        (spaces.Discrete(2), spaces.Tuple((spaces.Box(-1.0, 1.0, (1,)), spaces.Box(0.0, 10.0, (1,)))))
+    )
+
+    def reset(self, *, seed=None, options=None):
+        super().reset(seed=seed)
+        self.x = float(self.np_random.uniform(0.0, 10.0))
+        return np.array([self.x], np.float32), {}
+
+    def step(self, action):
+        a, params = action
+        p = float(np.asarray(params[a]).item())
+        self.x = float(np.clip(self.x + p if a == 0 else p, 0.0, 10.0))
+        return np.array([self.x], np.float32), -abs(self.x - 3.0), abs(self.x - 3.0) < 0.1, False, {}
+
+
+gymnasium.register("PamdpTestLine-v0", entry_point=Line, max_episode_steps=10)
+'''
+
+
+def test_a_users_env_given_as_module_and_id_is_imported_for_training_and_for_loading(tmp_path, capsys, monkeypatch):
+    (tmp_path / "pamdp_test_user_env.py").write_text(USER_ENV_MODULE)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    out = tmp_path / "run"
+    env = "pamdp_test_user_env:PamdpTestLine-v0"
+    argv = ["train", "patrpo", "--env", env, "--total-steps", "600", "--out", str(out), "--eval-episodes", "5"]
+    assert main([*argv, *TINY]) == 0
+    assert json.loads((out / "run.json").read_text())["env"] == env
+    # A fresh process knows nothing of the module: loading the model imports it again from the stored id.
+    evaluated = subprocess.run(
+        [sys.executable, "-m", "pamdp.cli", "evaluate", str(out), "--episodes", "5", "--json"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env={**os.environ, "PYTHONPATH": str(tmp_path)},
+    )
+    assert evaluated.returncode == 0, evaluated.stderr
+    assert json.loads(evaluated.stdout)["episodes"] == 5
+    capsys.readouterr()
+    assert main(["train", "patrpo", "--env", "no_such_module_xyz:Line-v0", "--out", str(tmp_path / "r2")]) == 2
+    assert "cannot import module 'no_such_module_xyz'" in capsys.readouterr().err
+    assert main(["train", "patrpo", "--env", "NoSuchEnvXyz-v0", "--out", str(tmp_path / "r3")]) == 2
+    assert "env 'NoSuchEnvXyz-v0' is not registered" in capsys.readouterr().err

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import csv
 import dataclasses
+import importlib
 import math
 import os
 import tempfile
@@ -138,6 +139,30 @@ def _coerce(name: str, value: Any, hint: Any) -> Any:
 AUTO_BATCH_MIN = 48
 
 
+def env_spec(env_id: str) -> gymnasium.envs.registration.EnvSpec:
+    """Gymnasium's spec of a registered env id; ``"module:Name-v0"`` first imports ``module`` (which registers
+    the env), as ``gymnasium.make`` does, so that ``pamdp train --env mypackage:MyEnv-v0`` works.
+
+    An id that is not registered, or a module that does not import, is a ``ValueError`` saying so.
+    """
+    module, _, name = env_id.rpartition(":")
+    if module:
+        try:
+            importlib.import_module(module)
+        except ModuleNotFoundError as exc:
+            raise ValueError(
+                f"env {env_id!r}: cannot import module {module!r} ({exc}); expected an importable module "
+                f"that registers {name!r} with gymnasium.register"
+            ) from exc
+    try:
+        return gymnasium.spec(name)
+    except gymnasium.error.Error as exc:
+        raise ValueError(
+            f"env {env_id!r} is not registered ({exc}); expected a Gymnasium id such as pamdp/Platform-v0, "
+            "or module:EnvId-v0 to import the module that registers it"
+        ) from exc
+
+
 def make_vector_env(
     env_id: str, num_envs: int, env_kwargs: dict | None = None, mode: str = "auto"
 ) -> gymnasium.vector.VectorEnv:
@@ -146,7 +171,7 @@ def make_vector_env(
     """
     if mode not in ("auto", "batched", "sync"):
         raise ValueError(f"vector env mode {mode!r}; expected 'auto', 'batched' or 'sync'")
-    spec = gymnasium.spec(env_id)
+    spec = env_spec(env_id)
     batched = spec.vector_entry_point is not None and (
         mode == "batched" or (mode == "auto" and num_envs >= AUTO_BATCH_MIN)
     )
@@ -159,11 +184,12 @@ def make_vector_env(
 def _describe_env(env, env_kwargs: dict | None = None) -> tuple[str | None, dict, spaces.Space, spaces.Space]:
     """``(env_id, env_kwargs, single observation space, single action space)`` of what a user passed."""
     if isinstance(env, str):
-        spec = gymnasium.spec(env)
+        spec = env_spec(env)
         probe = gymnasium.make(env, **(env_kwargs or {}))
         obs_space, act_space = probe.observation_space, probe.action_space
         probe.close()
-        return spec.id, {}, obs_space, act_space
+        # "module:Name-v0" keeps its module, so that a loaded model imports it again to make its env
+        return (env if ":" in env else spec.id), {}, obs_space, act_space
     if isinstance(env, gymnasium.vector.VectorEnv):
         spec = env.spec
         return (
