@@ -14,7 +14,9 @@
 # predate the Numba Platform backend of 2026-11-29, which takes its ~35 % of env time off an epoch). Done and
 # dropped from the queue: PASVG(0) tuned, 5 x 1M (issue 4, benchmarks/pasvg_platform.md).
 #   1. step-size (2 x 5) and kl-estimators (3 x 5), PATRPO: ~16 min a run            ~6.5 core-hours
-#   2. the PATRPO arms of platform (5 x ~16 min) and soccer (3 x 5M, ~1 h each)      ~4.5 core-hours
+#   2. the PATRPO arms of platform (5 x ~12 min) and soccer (3 x 5M): a soccer epoch of 50 000 samples with
+#      {400, 300, 200} networks takes ~95 s of one idle core (the chain-analytic KL's Fisher-vector products
+#      pass pi_c over all 3 actions: 1.4 s each per 10 000 samples), so ~2.6 h a run  ~9 core-hours
 #   3. MP-DQN, P-DQN and PAPPO tuned, 3 x 5 x 300k (beyond the paper): a few minutes a run ~1.5 core-hours
 #   3b. SB3's SAC and DQN through pamdp's wrappers, 2 x 3 x 100k (a baseline from a mainstream library)
 #                                                                            ~1.5 core-hours
