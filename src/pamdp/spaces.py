@@ -88,6 +88,11 @@ class HybridActionSpace:
         return sum(self.param_sizes)
 
     @property
+    def param_offsets(self) -> np.ndarray:
+        """``o_a = m_0 + ... + m_{a-1}``: where action ``a``'s parameters start in the all-parameters vector."""
+        return np.concatenate([[0], np.cumsum(self.param_sizes)[:-1]]).astype(np.int64)
+
+    @property
     def param_mask(self) -> np.ndarray:
         """Boolean ``(K, m)``: entry ``[a, i]`` is true where action ``a`` uses padded parameter ``i``."""
         mask = np.zeros((self.n_actions, self.max_param_size), dtype=bool)

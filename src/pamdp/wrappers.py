@@ -45,7 +45,7 @@ class FlattenHybridAction(gymnasium.ActionWrapper, gymnasium.utils.RecordConstru
         self.hybrid = HybridActionSpace.from_gym(env.action_space)
         k = self.hybrid.n_actions
         self.action_space = spaces.Box(-1.0, 1.0, (k + self.hybrid.total_param_size,), np.float32)
-        self._offsets = k + np.concatenate([[0], np.cumsum(self.hybrid.param_sizes)[:-1]]).astype(int)
+        self._offsets = k + self.hybrid.param_offsets
 
     def hybrid_action(self, action) -> tuple:
         """The wrapped env's action ``(a, (p_0, ..., p_{K-1}))`` for a flat action vector."""

@@ -166,7 +166,7 @@ class ParamActor(nn.Module):
         super().__init__()
         self.net = mlp(obs_dim, hidden_sizes, hybrid.total_param_size, activation, nn.Tanh if squash else None)
         # Where action a's padded parameter i sits in the flat vector: offset_a + i (0 where unused).
-        offsets = np.concatenate([[0], np.cumsum(hybrid.param_sizes)[:-1]]).astype(np.int64)
+        offsets = hybrid.param_offsets
         mask = hybrid.param_mask
         index = np.where(mask, offsets[:, None] + np.arange(hybrid.max_param_size), 0)
         self.register_buffer("param_index", torch.as_tensor(index, dtype=torch.long))
