@@ -8,6 +8,7 @@ ALGORITHMS = {
     "pasvg0": "pamdp.algos.pasvg:PASVG0",
     "paddpg": "pamdp.algos.paddpg:PADDPG",
     "pdqn": "pamdp.algos.pdqn:PDQN",
+    "hyar": "pamdp.algos.hyar:HyAR",
 }
 MODULE_OF = {target.partition(":")[2]: target.partition(":")[0] for target in ALGORITHMS.values()}
 """Class name -> its module, e.g. ``"PATRPO" -> "pamdp.algos.patrpo"``."""

@@ -1,0 +1,446 @@
+"""HyAR-TD3: TD3 in a learned latent space of hybrid actions (Li et al., ICLR 2022, arXiv 2109.05490).
+
+HyAR ("Hybrid Action Representation") turns the parameterized action space into a continuous box that an
+ordinary continuous-control algorithm can act in, and decodes the box back to a hybrid action:
+
+- an **embedding table** ``E`` (``K x embed_dim``) holds one vector ``e_k`` per discrete action;
+- a **conditional VAE** encodes an action's parameters ``x_k`` into ``z`` (``latent_dim`` values), conditioned on
+  the state and ``e_k``: ``q(z | x_k, s, e_k) = N(mu, sigma)``; its decoder maps ``(z, s, e_k)`` back to
+  ``x_k``, and a sub-network stacked on the decoder predicts the state change ``s' - s``, so that latents with
+  similar effects lie close together. Loss: ``|x_k - x~_k|^2 + kl_weight * KL(q || N(0, I)) +
+  dynamics_weight * |s' - s - d~|^2``; the table is trained with the VAE;
+- **decoding** a latent action ``(e, z)``: ``k`` is the table row nearest to ``e`` (Euclidean distance), then
+  ``x_k = decoder(z, s, e_k)``;
+- **TD3** (clipped double Q, target policy smoothing, delayed actor updates) learns an actor ``s -> (e, z)`` and
+  twin critics ``Q(s, e, z)`` on the latent actions;
+- the **latent space constraint**: the actor's Tanh output ``u`` in ``[-1, 1]`` is mapped affinely onto the
+  central ``lsc_percent`` % range of the latents of replayed data, per dimension, recomputed after every round of
+  representation training; outside that range the decoder has seen no data;
+- **representation shift correction**: the representation keeps training during RL, so a replayed latent action
+  may no longer decode to the hybrid action that was executed. Every sampled batch is checked, and the latents
+  that decode to another action, or to parameters more than ``relabel_tolerance`` away, are replaced by the
+  current encoding ``(e_k, mu(x_k, s, e_k))`` of what was executed (``relabel = "invalid"``; ``"all"`` re-encodes
+  every sample, ``"none"`` never does).
+
+Schedule: ``warmup_steps`` samples of uniformly random hybrid actions (the paper: 5000 random episodes; 11 000
+samples are about that many on Platform, whose random episodes last 2.2 steps), then ``warmup_updates`` steps of
+representation training alone, then TD3 with a round of ``vae_updates`` representation steps every
+``vae_interval`` samples.
+
+The paper's appendix (network sizes, learning rates, latent sizes, the percentile, the validity test) was not
+available when this was written: those settings are marked as assumptions in their help. The paper reports
+0.98 +- 0.01 on Platform (5 runs).
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+
+import numpy as np
+import torch
+import torch.nn.functional as F
+from torch import nn
+
+from pamdp.algos.base import AlgoConfig, Algorithm, setting
+from pamdp.algos.offpolicy import OffPolicyLoop, clipped_step, soft_update
+from pamdp.algos.replay import ReplayBuffer
+from pamdp.policies import ACTIVATIONS, mlp
+from pamdp.spaces import HybridActionSpace
+
+__all__ = ["HyAR", "HyARConfig", "ActionRepresentation", "latent_bounds"]
+
+RELABEL = ("invalid", "all", "none")
+
+
+@dataclasses.dataclass(frozen=True)
+class HyARConfig(AlgoConfig):
+    """HyAR-TD3's settings. The defaults are the ``paper`` preset: the paper's schedule, with TD3's published
+    settings (Fujimoto et al. 2018) where the text available here gives none; assumptions are marked."""
+
+    num_envs: int = setting(8, "Copies of the env stepped together; learning per sample is set by updates_per_step.")
+    embed_dim: int = setting(6, "Size of a discrete action's embedding, d1 (assumed: 6).")
+    latent_dim: int = setting(6, "Size of the parameters' latent z, d2 (assumed: 6).")
+    vae_hidden_sizes: tuple[int, ...] = setting((256, 256), "Hidden layers of the VAE's encoder and decoder (assumed).")
+    hidden_sizes: tuple[int, ...] = setting((256, 256), "Hidden layers of the actor and each critic (TD3's: 256-256).")
+    activation: str = setting("relu", "Hidden activation: relu, leaky_relu, tanh or elu.")
+    kl_weight: float = setting(1.0, "Weight of the VAE's KL term (the paper's loss: 1).")
+    dynamics_weight: float = setting(1.0, "Weight of the state-change prediction loss, beta (assumed: 1).")
+    vae_lr: float = setting(1e-4, "Adam learning rate of the embedding table and the VAE (assumed: 1e-4).")
+    vae_batch_size: int = setting(64, "Transitions per representation update (assumed: 64).")
+    warmup_steps: int = setting(
+        11_000, "Samples of uniformly random actions before learning (the paper: 5000 episodes; ~11 000 on Platform)."
+    )
+    warmup_updates: int = setting(5_000, "Representation updates on the warm-up data before TD3 starts (assumed).")
+    vae_interval: int = setting(1_000, "Samples between rounds of representation training during TD3 (assumed).")
+    vae_updates: int = setting(10, "Representation updates per round (assumed).")
+    lsc_percent: float = setting(
+        96.0, "Latent space constraint: the central percentage of replayed latents the actor may reach (assumed: 96)."
+    )
+    lsc_samples: int = setting(5_000, "Replayed transitions encoded to compute the latent bounds.")
+    relabel: str = setting(
+        "invalid", "Representation shift correction: invalid (re-encode stale latents), all (every one) or none."
+    )
+    relabel_tolerance: float = setting(
+        0.1,
+        "A replayed latent is stale if its decoded parameters differ by more than this, in [-1, 1] units (assumed).",
+    )
+    actor_lr: float = setting(3e-4, "Adam learning rate of the actor (TD3: 3e-4).")
+    critic_lr: float = setting(3e-4, "Adam learning rate of the critics (TD3: 3e-4).")
+    grad_clip: float = setting(0.0, "Clip each network's gradient norm to this; 0 turns clipping off (TD3: off).")
+    batch_size: int = setting(128, "Transitions per TD3 update (assumed: 128).")
+    gamma: float = setting(0.99, "Discount factor.")
+    tau: float = setting(0.005, "Soft target-update rate (TD3: 0.005).")
+    exploration_noise: float = setting(0.1, "Std of the Gaussian noise on the actor's [-1, 1] output (TD3: 0.1).")
+    target_noise: float = setting(0.2, "Std of the target policy smoothing noise, [-1, 1] units (TD3: 0.2).")
+    target_noise_clip: float = setting(0.5, "Clip of the target policy smoothing noise (TD3: 0.5).")
+    policy_delay: int = setting(2, "Critic updates per actor and target update (TD3: 2).")
+    buffer_size: int = setting(1_000_000, "Replay capacity.")
+    updates_per_step: float = setting(1.0, "Update-to-data ratio: TD3 updates (critics) per environment sample.")
+    epoch_steps: int = setting(10_000, "Samples per epoch, the unit of logging and checkpoints.")
+    save_replay: bool = setting(
+        True, "Store the replay contents in checkpoints (the representation's training data); else a resume refills it."
+    )
+
+    def __post_init__(self):
+        super().__post_init__()
+        for name in ("hidden_sizes", "vae_hidden_sizes"):
+            sizes = getattr(self, name)
+            self._check(len(sizes) > 0 and all(h > 0 for h in sizes), name, "positive layer sizes")
+        for name in ("embed_dim", "latent_dim", "vae_batch_size", "vae_interval", "lsc_samples", "batch_size"):
+            self._check(getattr(self, name) >= 1, name, "an integer >= 1")
+        for name in ("warmup_updates", "vae_updates"):
+            self._check(getattr(self, name) >= 0, name, "a non-negative integer")
+        self._check(self.warmup_steps >= 1, "warmup_steps", "an integer >= 1 (the representation needs data)")
+        self._check(self.activation in ACTIVATIONS, "activation", f"one of {', '.join(ACTIVATIONS)}")
+        self._check(self.relabel in RELABEL, "relabel", f"one of {', '.join(RELABEL)}")
+        self._check(0 < self.lsc_percent <= 100, "lsc_percent", "a percentage in (0, 100]")
+        self._check(self.relabel_tolerance >= 0, "relabel_tolerance", "a non-negative distance")
+        for name in ("kl_weight", "dynamics_weight", "exploration_noise", "target_noise", "target_noise_clip"):
+            self._check(getattr(self, name) >= 0, name, "a non-negative number")
+        for name in ("vae_lr", "actor_lr", "critic_lr"):
+            self._check(getattr(self, name) > 0, name, "a positive learning rate")
+        self._check(self.grad_clip >= 0, "grad_clip", "a non-negative norm (0: off)")
+        self._check(0 <= self.gamma <= 1, "gamma", "a number in [0, 1]")
+        self._check(0 < self.tau <= 1, "tau", "a number in (0, 1]")
+        self._check(self.policy_delay >= 1, "policy_delay", "an integer >= 1")
+        self._check(self.buffer_size >= self.warmup_steps, "buffer_size", f">= warmup_steps ({self.warmup_steps})")
+        self._check(self.updates_per_step > 0, "updates_per_step", "a positive ratio")
+        self._check(self.epoch_steps >= 1, "epoch_steps", "an integer >= 1")
+
+    @classmethod
+    def presets(cls) -> dict[str, HyARConfig]:
+        # "tuned": smaller networks, 64 batched env copies and a quarter of a TD3 update per sample, for a CPU.
+        return {
+            "paper": cls(),
+            "tuned": cls(
+                num_envs=64,
+                hidden_sizes=(128, 128),
+                vae_hidden_sizes=(128, 128),
+                updates_per_step=0.25,
+                vae_interval=2_000,
+                vae_updates=20,
+                warmup_updates=2_000,
+                buffer_size=200_000,
+            ),
+        }
+
+
+class ActionRepresentation(nn.Module):
+    """The embedding table and the conditional VAE with its state-change head (see the module docstring).
+
+    Parameters ``x`` are padded to ``m = max_a m_a`` in ``[-1, 1]`` units; the unused slots of an action are
+    zero on the way in and masked out of the reconstruction loss.
+    """
+
+    def __init__(
+        self, obs_dim: int, hybrid: HybridActionSpace, embed_dim: int, latent_dim: int, hidden_sizes, activation: str
+    ):
+        super().__init__()
+        self.n_actions, self.param_size, self.obs_dim = hybrid.n_actions, hybrid.max_param_size, obs_dim
+        self.latent_dim = latent_dim
+        self.embedding = nn.Parameter(torch.empty(hybrid.n_actions, embed_dim).uniform_(-1.0, 1.0))
+        self.encoder = mlp(obs_dim + self.param_size + embed_dim, hidden_sizes, 2 * latent_dim, activation)
+        # The decoder's trunk; the parameter head reads it, the state-change head is stacked on top of it.
+        self.decoder = mlp(obs_dim + latent_dim + embed_dim, hidden_sizes[:-1], hidden_sizes[-1], activation)
+        self.act = ACTIVATIONS[activation]()
+        self.param_head = nn.Linear(hidden_sizes[-1], self.param_size)
+        self.dynamics_head = mlp(hidden_sizes[-1], hidden_sizes[-1:], obs_dim, activation)
+        self.register_buffer("mask", torch.as_tensor(hybrid.param_mask, dtype=torch.float32))
+
+    def encode(self, obs: torch.Tensor, a: torch.Tensor, x: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        """Mean and log-std of ``q(z | x, s, e_a)``."""
+        out = self.encoder(torch.cat([obs, x * self.mask[a], self.embedding[a]], dim=-1))
+        mean, log_std = out.split(self.latent_dim, dim=-1)
+        return mean, log_std.clamp(-5.0, 2.0)
+
+    def _trunk(self, obs: torch.Tensor, a: torch.Tensor, z: torch.Tensor) -> torch.Tensor:
+        return self.act(self.decoder(torch.cat([obs, z, self.embedding[a]], dim=-1)))
+
+    def decode_params(self, obs: torch.Tensor, a: torch.Tensor, z: torch.Tensor) -> torch.Tensor:
+        """Action ``a``'s parameters for latent ``z``, in ``[-1, 1]``, zero in the unused slots."""
+        return torch.tanh(self.param_head(self._trunk(obs, a, z))) * self.mask[a]
+
+    def nearest_action(self, e: torch.Tensor) -> torch.Tensor:
+        """The discrete action whose embedding is nearest to ``e`` (Euclidean distance)."""
+        return torch.cdist(e, self.embedding).argmin(-1)
+
+    def decode(self, obs: torch.Tensor, latent: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        """The hybrid action ``(a, x)`` of latent actions ``(e, z)``, concatenated in ``latent``."""
+        e, z = latent.split([self.embedding.shape[1], self.latent_dim], dim=-1)
+        a = self.nearest_action(e)
+        return a, self.decode_params(obs, a, z)
+
+    def latent(self, obs: torch.Tensor, a: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
+        """The current (deterministic) latent action of ``(a, x)``: ``(e_a, mu(x, s, e_a))``."""
+        return torch.cat([self.embedding[a], self.encode(obs, a, x)[0]], dim=-1)
+
+    def loss(self, obs, a, x, next_obs, kl_weight: float, dynamics_weight: float, generator=None):
+        """The representation loss on a batch, and its three terms (reconstruction, KL, state change) as floats."""
+        mean, log_std = self.encode(obs, a, x)
+        std = log_std.exp()
+        eps = torch.randn(mean.shape, generator=generator, dtype=mean.dtype)
+        h = self._trunk(obs, a, mean + std * eps)
+        mask = self.mask[a]
+        recon = ((torch.tanh(self.param_head(h)) - x) ** 2 * mask).sum(-1).mean()
+        kl = (0.5 * (mean**2 + std**2 - 1.0) - log_std).sum(-1).mean()
+        dynamics = ((self.dynamics_head(h) - (next_obs - obs)) ** 2).mean(-1).mean()
+        total = recon + kl_weight * kl + dynamics_weight * dynamics
+        return total, {"recon": float(recon.detach()), "kl": float(kl.detach()), "dynamics": float(dynamics.detach())}
+
+
+def latent_bounds(latents: torch.Tensor, percent: float) -> tuple[torch.Tensor, torch.Tensor]:
+    """Per dimension, the ``(50 -+ percent / 2)``-th percentiles of ``latents`` (N, D): the central ``percent`` %."""
+    q = torch.tensor([0.5 - percent / 200.0, 0.5 + percent / 200.0], dtype=latents.dtype)
+    low, high = torch.quantile(latents, q, dim=0)
+    return low, torch.maximum(high, low + 1e-6)
+
+
+class LatentActor(nn.Module):
+    """``u(s)`` in ``[-1, 1]^(d1 + d2)`` (Tanh), mapped onto the latent box ``[low, high]`` by :meth:`to_latent`."""
+
+    def __init__(self, obs_dim: int, size: int, hidden_sizes, activation: str):
+        super().__init__()
+        self.net = mlp(obs_dim, hidden_sizes, size, activation, nn.Tanh)
+        self.register_buffer("low", -torch.ones(size))
+        self.register_buffer("high", torch.ones(size))
+
+    def forward(self, obs: torch.Tensor) -> torch.Tensor:
+        return self.net(obs)
+
+    def to_latent(self, u: torch.Tensor) -> torch.Tensor:
+        return self.low + (u + 1.0) * 0.5 * (self.high - self.low)
+
+
+class TwinCritic(nn.Module):
+    """TD3's two critics ``Q_1, Q_2(s, e, z)`` on the latent action."""
+
+    def __init__(self, obs_dim: int, size: int, hidden_sizes, activation: str):
+        super().__init__()
+        self.q1 = mlp(obs_dim + size, hidden_sizes, 1, activation)
+        self.q2 = mlp(obs_dim + size, hidden_sizes, 1, activation)
+
+    def forward(self, obs: torch.Tensor, latent: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        inp = torch.cat([obs, latent], dim=-1)
+        return self.q1(inp).squeeze(-1), self.q2(inp).squeeze(-1)
+
+
+class HyAR(Algorithm):
+    """HyAR-TD3 (Li et al. 2022): TD3 in a learned hybrid action representation. See :class:`HyARConfig`."""
+
+    config_class = HyARConfig
+    config: HyARConfig
+
+    def _build(self) -> None:
+        cfg, h = self.config, self.hybrid
+        self.latent_size = cfg.embed_dim + cfg.latent_dim
+        self.rep = ActionRepresentation(
+            self.obs_dim, h, cfg.embed_dim, cfg.latent_dim, cfg.vae_hidden_sizes, cfg.activation
+        )
+        self.actor = LatentActor(self.obs_dim, self.latent_size, cfg.hidden_sizes, cfg.activation)
+        self.critic = TwinCritic(self.obs_dim, self.latent_size, cfg.hidden_sizes, cfg.activation)
+        self.actor_target = copy.deepcopy(self.actor).requires_grad_(False)
+        self.critic_target = copy.deepcopy(self.critic).requires_grad_(False)
+        self.rep_optimizer = torch.optim.Adam(self.rep.parameters(), lr=cfg.vae_lr, fused=True)
+        self.actor_optimizer = torch.optim.Adam(self.actor.net.parameters(), lr=cfg.actor_lr, fused=True)
+        self.critic_optimizer = torch.optim.Adam(self.critic.parameters(), lr=cfg.critic_lr, fused=True)
+        d = self.obs_dim
+        fields = {
+            "obs": ((d,), np.float32),
+            "a": ((), np.int64),
+            "x": ((h.max_param_size,), np.float32),
+            "reward": ((), np.float32),
+            "next_obs": ((d,), np.float32),
+            "terminated": ((), np.bool_),
+            "latent": ((self.latent_size,), np.float32),  # the latent action that was decoded and executed
+        }
+        self.replay = ReplayBuffer(cfg.buffer_size, fields)
+        self.loop = OffPolicyLoop(h, self.replay, cfg.gamma)
+        self.pretrained = False  # the warm-up round of representation training is done
+        self.n_updates = 0  # TD3 updates so far (the policy delay and the representation rounds count them)
+        # The latest values of the losses computed only every few updates, reported with every update so that the
+        # epoch's averages are over one kind of step each.
+        self._latest = {
+            "losses/actor_loss": 0.0,
+            "losses/vae_recon": 0.0,
+            "losses/vae_kl": 0.0,
+            "losses/vae_dynamics": 0.0,
+        }
+
+    def _modules(self):
+        return {
+            "rep": self.rep,
+            "actor": self.actor,
+            "critic": self.critic,
+            "actor_target": self.actor_target,
+            "critic_target": self.critic_target,
+        }
+
+    def _optimizers(self):
+        return {"rep": self.rep_optimizer, "actor": self.actor_optimizer, "critic": self.critic_optimizer}
+
+    def _extra_state(self):
+        return {
+            "loop": self.loop.state_dict(self.config.save_replay),
+            "pretrained": self.pretrained,
+            "n_updates": self.n_updates,
+        }
+
+    def _load_extra_state(self, state):
+        self.loop.load_state_dict(state["loop"])
+        self.pretrained, self.n_updates = bool(state["pretrained"]), int(state["n_updates"])
+        if self.pretrained and len(self.replay) == 0:  # resumed without the replay: warm up again on new data
+            self.pretrained = False
+
+    # -- acting ----------------------------------------------------------------------------------
+    def _act(self, obs, deterministic):
+        u = self.actor(obs)
+        if not deterministic:
+            u = self._noisy(u)
+        return self.rep.decode(obs, self.actor.to_latent(u))
+
+    def _noisy(self, u: torch.Tensor) -> torch.Tensor:
+        noise = self.np_rng.normal(0.0, self.config.exploration_noise, size=u.shape).astype(np.float32)
+        return (u + torch.from_numpy(noise)).clamp(-1.0, 1.0)
+
+    def _explore(self, obs: torch.Tensor, step: int, episode_start: np.ndarray):
+        if step < self.config.warmup_steps:  # uniformly random hybrid actions; latents are filled in after warm-up
+            n, h = len(obs), self.hybrid
+            a = torch.from_numpy(self.np_rng.integers(h.n_actions, size=n))
+            x = self.np_rng.uniform(-1.0, 1.0, size=(n, h.max_param_size)).astype(np.float32)
+            x = torch.from_numpy(x) * self.rep.mask[a]
+            return a, x, {"latent": np.zeros((n, self.latent_size), dtype=np.float32)}
+        latent = self.actor.to_latent(self._noisy(self.actor(obs)))
+        a, x = self.rep.decode(obs, latent)
+        return a, x, {"latent": latent.numpy()}
+
+    # -- learning --------------------------------------------------------------------------------
+    def _run_epoch(self) -> dict[str, float]:
+        cfg = self.config
+        stats = self.loop.run_epoch(
+            self.vec_env,
+            self._explore,
+            self._update,
+            cfg.epoch_steps,
+            self.num_timesteps,
+            cfg.warmup_steps,
+            cfg.updates_per_step,
+            self.np_rng,
+        )
+        stats["train/latent_box_width"] = float((self.actor.high - self.actor.low).mean())
+        return stats
+
+    def train_representation(self, updates: int) -> dict[str, float]:
+        """``updates`` steps of the representation loss on replayed batches, then new latent bounds."""
+        cfg = self.config
+        sums = {"recon": 0.0, "kl": 0.0, "dynamics": 0.0}
+        with torch.enable_grad():
+            for _ in range(updates):
+                b = self.replay.sample(cfg.vae_batch_size, self.np_rng)
+                loss, terms = self.rep.loss(
+                    b["obs"], b["a"], b["x"], b["next_obs"], cfg.kl_weight, cfg.dynamics_weight, self.torch_gen
+                )
+                self.rep_optimizer.zero_grad(set_to_none=True)
+                loss.backward()
+                self.rep_optimizer.step()
+                for k, v in terms.items():
+                    sums[k] += v
+        self.update_bounds()
+        return {f"losses/vae_{k}": v / max(updates, 1) for k, v in sums.items()}
+
+    @torch.no_grad()
+    def update_bounds(self) -> None:
+        """The latent space constraint: the central ``lsc_percent`` % of the latents of replayed actions."""
+        b = self.replay.sample(min(self.config.lsc_samples, len(self.replay)), self.np_rng)
+        low, high = latent_bounds(self.rep.latent(b["obs"], b["a"], b["x"]), self.config.lsc_percent)
+        for actor in (self.actor, self.actor_target):
+            actor.low.copy_(low)
+            actor.high.copy_(high)
+
+    @torch.no_grad()
+    def _reencode_replay(self) -> None:
+        """Write the current latents of every stored action into the replay (the warm-up's random actions)."""
+        n, data = len(self.replay), self.replay.data
+        for start in range(0, n, 4096):
+            s = slice(start, min(n, start + 4096))
+            obs, a, x = (torch.from_numpy(data[k][s]) for k in ("obs", "a", "x"))
+            data["latent"][s] = self.rep.latent(obs, a, x).numpy()
+
+    @torch.no_grad()
+    def relabel(self, b: dict[str, torch.Tensor]) -> tuple[torch.Tensor, float]:
+        """The batch's latent actions after representation shift correction, and the fraction replaced."""
+        mode, latent = self.config.relabel, b["latent"]
+        if mode == "none":
+            return latent, 0.0
+        current = self.rep.latent(b["obs"], b["a"], b["x"])
+        if mode == "all":
+            return current, 1.0
+        a, x = self.rep.decode(b["obs"], latent)
+        stale = (a != b["a"]) | ((x - b["x"] * self.rep.mask[b["a"]]).abs().amax(-1) > self.config.relabel_tolerance)
+        return torch.where(stale[:, None], current, latent), float(stale.float().mean())
+
+    def _update(self) -> dict[str, float]:
+        """One TD3 critic step (on relabelled latents), a delayed actor step, and representation rounds when due."""
+        cfg = self.config
+        if not self.pretrained:
+            self._latest.update(self.train_representation(cfg.warmup_updates))
+            self._reencode_replay()
+            self.pretrained = True
+        self.n_updates += 1
+        interval = max(1, round(cfg.vae_interval * cfg.updates_per_step))
+        if self.n_updates % interval == 0 and cfg.vae_updates > 0:
+            self._latest.update(self.train_representation(cfg.vae_updates))
+
+        b = self.replay.sample(cfg.batch_size, self.np_rng)
+        obs, next_obs = b["obs"], b["next_obs"]
+        latent, relabelled = self.relabel(b)
+        with torch.no_grad():
+            u_next = self.actor_target(next_obs)
+            noise = torch.randn(u_next.shape, generator=self.torch_gen) * cfg.target_noise
+            u_next = (u_next + noise.clamp(-cfg.target_noise_clip, cfg.target_noise_clip)).clamp(-1.0, 1.0)
+            q1_next, q2_next = self.critic_target(next_obs, self.actor_target.to_latent(u_next))
+            y = b["reward"] + cfg.gamma * (~b["terminated"]).float() * torch.minimum(q1_next, q2_next)
+        q1, q2 = self.critic(obs, latent)
+        critic_loss = F.mse_loss(q1, y) + F.mse_loss(q2, y)
+        self.critic_optimizer.zero_grad(set_to_none=True)
+        critic_loss.backward()
+        clipped_step(self.critic_optimizer, self.critic.parameters(), cfg.grad_clip)
+        stats = dict(self._latest)
+        stats.update(
+            {
+                "losses/critic_loss": float(critic_loss.detach()),
+                "train/q_mean": float(q1.detach().mean()),
+                "train/relabelled": relabelled,
+            }
+        )
+        if self.n_updates % cfg.policy_delay == 0:
+            self.critic.requires_grad_(False)  # the actor's loss trains the actor only
+            actor_loss = -self.critic.q1(torch.cat([obs, self.actor.to_latent(self.actor(obs))], -1)).mean()
+            self.actor_optimizer.zero_grad(set_to_none=True)
+            actor_loss.backward()
+            self.critic.requires_grad_(True)
+            clipped_step(self.actor_optimizer, self.actor.net.parameters(), cfg.grad_clip)
+            soft_update(self.critic_target, self.critic, cfg.tau)
+            soft_update(self.actor_target.net, self.actor.net, cfg.tau)
+            stats["losses/actor_loss"] = self._latest["losses/actor_loss"] = float(actor_loss.detach())
+        return stats

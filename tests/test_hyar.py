@@ -1,0 +1,281 @@
+"""HyAR-TD3: decoding by hand, the VAE's loss against closed forms, the latent bounds against NumPy, the
+representation learning to reconstruct, relabelling, TD3's target and policy delay by hand, the warm-up, save/load,
+resuming, a tiny learning run, the CLI."""
+
+import csv
+import dataclasses
+import json
+
+import numpy as np
+import pytest
+import torch
+
+from pamdp import HyAR
+from pamdp.algos.base import load_model
+from pamdp.algos.hyar import ActionRepresentation, HyARConfig, latent_bounds
+from pamdp.cli import main
+from pamdp.spaces import HybridActionSpace
+
+SMALL = HyARConfig(
+    num_envs=4,
+    embed_dim=3,
+    latent_dim=2,
+    hidden_sizes=(16,),
+    vae_hidden_sizes=(16, 16),
+    epoch_steps=200,
+    warmup_steps=150,
+    warmup_updates=20,
+    vae_interval=50,
+    vae_updates=3,
+    batch_size=16,
+    vae_batch_size=16,
+    lsc_samples=100,
+    buffer_size=5_000,
+    updates_per_step=0.25,
+)
+# Three actions with 1, 2 and 1 parameters, padded to 2.
+HYBRID = HybridActionSpace(
+    (np.array([-1.0]), np.array([0.0, 0.0]), np.array([-2.0])), (np.array([1.0]), np.array([1.0, 3.0]), np.array([2.0]))
+)
+
+
+def representation(seed=0, **kw):
+    torch.manual_seed(seed)
+    args = dict(obs_dim=5, hybrid=HYBRID, embed_dim=3, latent_dim=2, hidden_sizes=(16, 16), activation="relu")
+    return ActionRepresentation(**{**args, **kw}).double()
+
+
+def test_decoding_picks_the_nearest_embedding_and_masks_unused_parameters():
+    rep = representation()
+    with torch.no_grad():
+        rep.embedding.copy_(torch.tensor([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, -1.0]]))
+    e = torch.tensor([[0.9, 0.2, 0.0], [0.4, 0.6, 0.0], [0.0, 0.0, -0.1], [0.6, 0.5, 0.1]], dtype=torch.float64)
+    expected = np.linalg.norm(e.numpy()[:, None] - rep.embedding.detach().numpy()[None], axis=-1).argmin(1)
+    np.testing.assert_array_equal(rep.nearest_action(e), expected)
+    obs, z = torch.randn(4, 5, dtype=torch.float64), torch.randn(4, 2, dtype=torch.float64)
+    a, x = rep.decode(obs, torch.cat([e, z], -1))
+    np.testing.assert_array_equal(a, expected)
+    assert torch.all(x.abs() <= 1) and torch.all(x[a != 1, 1] == 0)  # actions 0 and 2 have one parameter
+    torch.testing.assert_close(x, rep.decode_params(obs, a, z))
+
+
+def test_loss_terms_match_closed_forms():
+    rep = representation(1)
+    obs, nxt = torch.randn(32, 5, dtype=torch.float64), torch.randn(32, 5, dtype=torch.float64)
+    a, x = torch.randint(0, 3, (32,)), torch.rand(32, 2, dtype=torch.float64) * 2 - 1
+    x = x * rep.mask[a]
+    total, terms = rep.loss(obs, a, x, nxt, 0.3, 2.0, torch.Generator().manual_seed(5))
+    mean, log_std = rep.encode(obs, a, x)
+    q = torch.distributions.Normal(mean, log_std.exp())
+    kl = torch.distributions.kl_divergence(q, torch.distributions.Normal(0.0, 1.0)).sum(-1).mean()
+    z = mean + log_std.exp() * torch.randn(mean.shape, generator=torch.Generator().manual_seed(5), dtype=mean.dtype)
+    recon = ((rep.decode_params(obs, a, z) - x) ** 2).sum(-1).mean()  # unused slots: both zero
+    h = rep.act(rep.decoder(torch.cat([obs, z, rep.embedding[a]], -1)))
+    dynamics = ((rep.dynamics_head(h) - (nxt - obs)) ** 2).mean()
+    assert terms["kl"] == pytest.approx(kl.item()) and terms["recon"] == pytest.approx(recon.item())
+    assert terms["dynamics"] == pytest.approx(dynamics.item())
+    assert total.item() == pytest.approx((recon + 0.3 * kl + 2.0 * dynamics).item())
+
+
+def test_latent_bounds_are_the_central_percentiles():
+    latents = torch.from_numpy(np.random.default_rng(0).standard_normal((1000, 4)) * [1, 2, 3, 4])
+    low, high = latent_bounds(latents, 90.0)
+    np.testing.assert_allclose(low, np.percentile(latents.numpy(), 5, axis=0))
+    np.testing.assert_allclose(high, np.percentile(latents.numpy(), 95, axis=0))
+    low, high = latent_bounds(latents, 100.0)
+    np.testing.assert_allclose(low, latents.min(0).values)
+    np.testing.assert_allclose(high, latents.max(0).values)
+
+
+def test_representation_learns_to_reconstruct_parameters_from_the_latent():
+    """Trained on uniformly random actions, encoding then decoding gives back the parameters (they are not
+    predictable from the state, so the latent must carry them)."""
+    rep = representation(2).float()
+    opt = torch.optim.Adam(rep.parameters(), lr=3e-3)
+    gen = torch.Generator().manual_seed(0)
+    effect = torch.randn(3, 2, 5, generator=gen)  # the state change is linear in the executed parameters
+
+    def batch(n):
+        obs = torch.randn(n, 5, generator=gen)
+        a = torch.randint(0, 3, (n,), generator=gen)
+        x = (torch.rand(n, 2, generator=gen) * 2 - 1) * rep.mask[a]
+        return obs, a, x, obs + torch.einsum("nm,nmd->nd", x, effect[a])
+
+    for _ in range(600):
+        loss, _ = rep.loss(*batch(64), 0.01, 1.0, gen)
+        opt.zero_grad()
+        loss.backward()
+        opt.step()
+    obs, a, x, _ = batch(2000)
+    with torch.no_grad():
+        a_dec, x_dec = rep.decode(obs, rep.latent(obs, a, x))
+    assert torch.equal(a_dec, a)  # every action's own embedding decodes to it
+    assert (x_dec - x).abs().mean() < 0.1  # uniform parameters: 0.5 mean error if the latent were ignored
+
+
+def model(**kw):
+    return HyAR("pamdp/Platform-v0", dataclasses.replace(SMALL, **kw))
+
+
+def test_warm_up_acts_uniformly_and_its_latents_are_reencoded():
+    m = model(warmup_steps=3000, epoch_steps=2000, buffer_size=6000, num_envs=64, vae_updates=0, updates_per_step=0.05)
+    obs = torch.from_numpy(np.random.default_rng(0).uniform(0, 1, size=(3000, 9)).astype(np.float32))
+    a, x, extras = m._explore(obs, 0, np.zeros(3000, dtype=bool))
+    np.testing.assert_allclose(np.bincount(a.numpy(), minlength=3) / 3000, [1 / 3] * 3, atol=0.04)
+    assert x.min() < -0.95 and x.max() > 0.95 and abs(float(x.mean())) < 0.05
+    m.learn(2000, progress_bar=False)
+    assert not m.pretrained and m.n_updates == 0  # no update before the warm-up ends
+    m.learn(2000, progress_bar=False)
+    assert m.pretrained and m.n_updates > 0
+    n = 3000  # the warm-up transitions: their stored latents were re-encoded after the pre-training
+    d = {k: torch.from_numpy(v[:n]) for k, v in m.replay.data.items()}
+    with torch.no_grad():
+        encoded = m.rep.latent(d["obs"], d["a"], d["x"])
+    torch.testing.assert_close(torch.from_numpy(m.replay.data["latent"][:n]), encoded)  # no round since (vae_updates 0)
+    assert torch.all(m.actor.high > m.actor.low) and torch.equal(m.actor.low, m.actor_target.low)
+
+
+def test_relabelling_replaces_exactly_the_stale_latents():
+    m = model()
+    gen = torch.Generator().manual_seed(0)
+    obs = torch.rand(64, 9, generator=gen)
+    a = torch.randint(0, 3, (64,), generator=gen)
+    x = torch.rand(64, 1, generator=gen) * 2 - 1
+    with torch.no_grad():
+        current = m.rep.latent(obs, a, x)
+        x_current = m.rep.decode(obs, current)[1]
+    # Valid rows store the latent whose decoding is what was executed; stale rows store a far-away latent.
+    stored = current.clone()
+    stored[32:, :3] = m.rep.embedding[(a[32:] + 1) % 3].detach()  # another action's embedding
+    batch = {"obs": obs, "a": a, "x": x_current, "latent": stored}
+    out, fraction = m.relabel(batch)
+    torch.testing.assert_close(out[:32], stored[:32], rtol=0, atol=0)
+    with torch.no_grad():
+        torch.testing.assert_close(out[32:], m.rep.latent(obs, a, x_current)[32:])  # what was executed, encoded now
+    assert fraction == 0.5
+    with torch.no_grad():  # parameters beyond the tolerance are stale too
+        far = dict(batch, x=(x_current + 0.5).clamp(-1, 1))
+    moved = (far["x"] - x_current).abs().amax(-1) > m.config.relabel_tolerance
+    out, fraction = m.relabel(far)
+    assert fraction == pytest.approx(float((moved | (torch.arange(64) >= 32)).float().mean()))
+    m_all, m_none = model(relabel="all"), model(relabel="none")
+    m_all.rep.load_state_dict(m.rep.state_dict())
+    with torch.no_grad():
+        torch.testing.assert_close(m_all.relabel(batch)[0], m.rep.latent(obs, a, x_current))
+    assert m_none.relabel(batch) == (stored, 0.0)
+
+
+def test_td3_critic_loss_by_hand_and_the_policy_delay():
+    m = model(target_noise=0.0, policy_delay=2)
+    m.learn(200, progress_bar=False)  # warm-up done and a few updates
+    gen = torch.Generator().manual_seed(1)
+    b = {
+        "obs": torch.rand(16, 9, generator=gen),
+        "a": torch.randint(0, 3, (16,), generator=gen),
+        "x": torch.rand(16, 1, generator=gen) * 2 - 1,
+        "reward": torch.rand(16, generator=gen),
+        "next_obs": torch.rand(16, 9, generator=gen),
+        "terminated": torch.rand(16, generator=gen) < 0.3,
+        "latent": torch.zeros(16, m.latent_size),
+    }
+    m.replay.sample = lambda n, rng: b
+    m.config = dataclasses.replace(m.config, vae_updates=0)  # no representation round inside these updates
+    m.n_updates = 10  # the next update (11) is odd: critics only
+    with torch.no_grad():
+        latent, _ = m.relabel(b)
+        q1n, q2n = m.critic_target(b["next_obs"], m.actor_target.to_latent(m.actor_target(b["next_obs"])))
+        y = b["reward"] + m.config.gamma * (~b["terminated"]).float() * torch.minimum(q1n, q2n)
+        q1, q2 = m.critic(b["obs"], latent)
+        expected = ((q1 - y) ** 2).mean() + ((q2 - y) ** 2).mean()
+    actor_before = [p.clone() for p in m.actor.parameters()]
+    target_before = [p.clone() for p in m.critic_target.parameters()]
+    stats = m._update()
+    assert stats["losses/critic_loss"] == pytest.approx(expected.item(), rel=1e-5)
+    assert all(torch.equal(p, q) for p, q in zip(actor_before, m.actor.parameters()))
+    assert all(torch.equal(p, q) for p, q in zip(target_before, m.critic_target.parameters()))
+    critic_before = [p.clone() for p in m.critic.parameters()]
+    m.critic_optimizer.step = lambda: None  # isolate the actor's step: the critics must not move with it
+    m._update()  # update 12: the actor and the targets move, the critics' weights get no gradient from it
+    assert not all(torch.equal(p, q) for p, q in zip(actor_before, m.actor.parameters()))
+    assert not all(torch.equal(p, q) for p, q in zip(target_before, m.critic_target.parameters()))
+    assert all(torch.equal(p, q) for p, q in zip(critic_before, m.critic.parameters()))
+
+
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        ({"relabel": "some"}, "relabel = 'some'"),
+        ({"lsc_percent": 0.0}, "lsc_percent = 0.0"),
+        ({"lsc_percent": 101.0}, "lsc_percent = 101.0"),
+        ({"embed_dim": 0}, "embed_dim = 0"),
+        ({"warmup_steps": 0}, "warmup_steps = 0"),
+        ({"policy_delay": 0}, "policy_delay = 0"),
+        ({"tau": 0.0}, "tau = 0.0"),
+        ({"buffer_size": 100}, "buffer_size = 100"),
+        ({"vae_hidden_sizes": ()}, "vae_hidden_sizes = \\(\\)"),
+        ({"kl_weight": -1.0}, "kl_weight = -1.0"),
+    ],
+)
+def test_bad_settings_raise_errors_naming_the_value(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        dataclasses.replace(SMALL, **kwargs)
+
+
+def test_save_load_predict_round_trip(tmp_path):
+    m = model()
+    m.learn(400, progress_bar=False)
+    m.save(tmp_path / "m.pt")
+    saved_rng = m.np_rng.bit_generator.state
+    for loaded in (HyAR.load(tmp_path / "m.pt"), load_model(tmp_path / "m.pt")):
+        m.np_rng.bit_generator.state = saved_rng
+        assert isinstance(loaded, HyAR) and loaded.config == m.config and loaded.pretrained
+        torch.testing.assert_close(loaded.actor.low, m.actor.low)
+        torch.testing.assert_close(loaded.actor.high, m.actor.high)
+        obs = np.random.default_rng(0).uniform(0, 1, size=(32, 9))
+        for deterministic in (True, False):
+            a1, p1 = m.predict(obs, deterministic=deterministic)
+            a2, p2 = loaded.predict(obs, deterministic=deterministic)
+            np.testing.assert_array_equal(a1, a2)
+            for x, y in zip(p1, p2):
+                np.testing.assert_array_equal(x, y)
+    assert m.action_space.contains(m.predict(obs[0]))
+
+
+def test_resume_keeps_the_representation_schedule(tmp_path):
+    m = model()
+    m.learn(400, progress_bar=False, run_dir=tmp_path)
+    resumed = HyAR.load(tmp_path / "checkpoint.pt")
+    assert (resumed.num_timesteps, resumed.n_updates, resumed.pretrained) == (m.num_timesteps, m.n_updates, True)
+    assert len(resumed.replay) == len(m.replay)  # save_replay is on by default: the representation's data
+    stats = []
+    resumed.learn(200, progress_bar=False, run_dir=tmp_path, callback=lambda _, s: stats.append(s))
+    assert stats[0]["train/updates"] > 0 and resumed.pretrained
+    no_replay = model(save_replay=False)
+    no_replay.learn(400, progress_bar=False)
+    no_replay.save(tmp_path / "n.pt")
+    back = HyAR.load(tmp_path / "n.pt")
+    assert len(back.replay) == 0 and not back.pretrained  # it warms the representation up again on new data
+
+
+def test_tiny_learning_run_logs(tmp_path):
+    m = model()
+    m.learn(800, progress_bar=False, run_dir=tmp_path)
+    with open(tmp_path / "progress.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert len(rows) == 4
+    last = rows[-1]
+    for key in ("losses/critic_loss", "losses/actor_loss", "losses/vae_recon", "losses/vae_kl", "train/relabelled"):
+        assert np.isfinite(float(last[key])), key
+    assert 0.0 <= float(last["train/relabelled"]) <= 1.0 and float(last["train/latent_box_width"]) > 0
+
+
+def test_cli_trains_and_evaluates(tmp_path, capsys):
+    out = tmp_path / "run"
+    tiny = ["--hidden-sizes", "16", "--vae-hidden-sizes", "16,16", "--num-envs", "4", "--epoch-steps", "200"]
+    tiny += ["--warmup-steps", "150", "--warmup-updates", "10", "--batch-size", "16", "--buffer-size", "5000"]
+    assert main(["train", "hyar", "--total-steps", "400", "--out", str(out), "--eval-episodes", "20", *tiny]) == 0
+    assert "greedy return over 20 episodes" in capsys.readouterr().out
+    run = json.loads((out / "run.json").read_text())
+    assert run["config"]["warmup_steps"] == 150 and run["preset"] == "tuned"
+    assert main(["evaluate", str(out), "--episodes", "10", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["episodes"] == 10
