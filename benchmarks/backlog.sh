@@ -14,12 +14,15 @@
 # predate the Numba Platform backend of 2026-11-29, which takes its ~35 % of env time off an epoch). Done and
 # dropped from the queue: PASVG(0) tuned, 5 x 1M (issue 4, benchmarks/pasvg_platform.md).
 #   1. step-size (2 x 5) and kl-estimators (3 x 5), PATRPO: ~16 min a run            ~6.5 core-hours
-#   2. the PATRPO arms of platform (5 x ~12 min) and soccer (3 x 5M): a soccer epoch of 50 000 samples with
+#   2. MP-DQN, P-DQN and PAPPO tuned, 3 x 5 x 300k (beyond the paper): ~9 min a run beside another
+#                                                                            ~2.3 core-hours
+#   2b. SB3's SAC and DQN through pamdp's wrappers, 2 x 3 x 100k (a baseline from a mainstream library)
+#                                                                            ~1.5 core-hours
+#       (these two go before soccer's PATRPO arm because they finish within one session and so give recorded
+#       results at its end; a soccer run takes more than a session whatever the order)
+#   3. the PATRPO arm of platform (done) and soccer (3 x 5M): a soccer epoch of 50 000 samples with
 #      {400, 300, 200} networks takes ~95 s of one idle core (the chain-analytic KL's Fisher-vector products
 #      pass pi_c over all 3 actions: 1.4 s each per 10 000 samples), so ~2.6 h a run  ~9 core-hours
-#   3. MP-DQN, P-DQN and PAPPO tuned, 3 x 5 x 300k (beyond the paper): a few minutes a run ~1.5 core-hours
-#   3b. SB3's SAC and DQN through pamdp's wrappers, 2 x 3 x 100k (a baseline from a mainstream library)
-#                                                                            ~1.5 core-hours
 #   4. platform's PADDPG arm, paper preset, 5 x 1M (~3 h a run alone, ~5 h beside another): also issue 5's
 #      benchmark, so it goes before PASVG(0)'s arm to close that issue first    ~25 core-hours
 #   5. PADDPG with Hausknecht & Stone's preset on Platform, 1 seed x 300k (issue 5), beside step 4  ~4 core-hours
@@ -33,11 +36,11 @@ RUNS=${PAMDP_RUNS:-/root/pamdp-runs}
 pamdp reproduce step-size --workers 2 --out "$RUNS/repro"
 pamdp reproduce kl-estimators --workers 2 --out "$RUNS/repro"
 pamdp reproduce platform --runs PATRPO --workers 2 --out "$RUNS/repro"
-pamdp reproduce soccer --runs PATRPO --workers 2 --out "$RUNS/repro"
 python bench_later_platform.py --workers 2 --out "$RUNS/bench"
 # Stable-Baselines3 (not a pamdp dependency) into its own directory, for the mainstream-library baseline
 pip install -q --target "$RUNS/sb3" --no-deps stable-baselines3
 PYTHONPATH="$RUNS/sb3" python bench_mainstream_platform.py --workers 2 --out "$RUNS/bench"
+pamdp reproduce soccer --runs PATRPO --workers 2 --out "$RUNS/repro"
 # Issue 5: the H&S run beside the five paper-preset runs (three processes on two cores), so that no core
 # idles at the end of either; the script waits for both and stops if either failed.
 python bench_paddpg_hausknecht_stone.py --workers 1 --out "$RUNS/bench" &
