@@ -18,13 +18,14 @@ import sys
 import typing
 from pathlib import Path
 
+from pamdp.algos.hyar import HyARConfig
 from pamdp.algos.paddpg import PADDPGConfig
 from pamdp.algos.pappo import PAPPOConfig
 from pamdp.algos.pasvg import PASVG0Config
 from pamdp.algos.patrpo import PATRPOConfig
 from pamdp.algos.pdqn import PDQNConfig
 
-CONFIGS = {c.__name__: c for c in (PATRPOConfig, PAPPOConfig, PASVG0Config, PADDPGConfig, PDQNConfig)}
+CONFIGS = {c.__name__: c for c in (PATRPOConfig, PAPPOConfig, PASVG0Config, PADDPGConfig, PDQNConfig, HyARConfig)}
 DOC = Path(__file__).with_name("algorithms.md")
 BLOCK = re.compile(r"(<!-- settings:(\w+) start -->\n)(.*?)(<!-- settings:\2 end -->)", re.DOTALL)
 
