@@ -269,6 +269,15 @@ def test_tiny_learning_run_logs(tmp_path):
     assert 0.0 <= float(last["train/relabelled"]) <= 1.0 and float(last["train/latent_box_width"]) > 0
 
 
+def test_presets():
+    presets = HyARConfig.presets()
+    assert list(presets) == ["cpu", "paper"] and presets["paper"] == HyARConfig()
+    paper = presets["paper"]
+    assert (paper.policy_delay, paper.target_noise, paper.target_noise_clip, paper.tau) == (2, 0.2, 0.5, 0.005)
+    assert paper.kl_weight == 1.0 and paper.warmup_steps == 11_000  # the paper's loss; ~5000 random Platform episodes
+    assert presets["cpu"].updates_per_step < 1 and presets["cpu"].num_envs >= 48  # batched env copies
+
+
 def test_cli_trains_and_evaluates(tmp_path, capsys):
     out = tmp_path / "run"
     tiny = ["--hidden-sizes", "16", "--vae-hidden-sizes", "16,16", "--num-envs", "4", "--epoch-steps", "200"]
@@ -276,6 +285,6 @@ def test_cli_trains_and_evaluates(tmp_path, capsys):
     assert main(["train", "hyar", "--total-steps", "400", "--out", str(out), "--eval-episodes", "20", *tiny]) == 0
     assert "greedy return over 20 episodes" in capsys.readouterr().out
     run = json.loads((out / "run.json").read_text())
-    assert run["config"]["warmup_steps"] == 150 and run["preset"] == "tuned"
+    assert run["config"]["warmup_steps"] == 150 and run["preset"] == "cpu"
     assert main(["evaluate", str(out), "--episodes", "10", "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["episodes"] == 10
