@@ -9,10 +9,12 @@ import json
 import numpy as np
 import pytest
 import torch
+from numeric import finite_difference
 
 from pamdp import HyAR
 from pamdp.algos.base import load_model
 from pamdp.algos.hyar import ActionRepresentation, HyARConfig, latent_bounds
+from pamdp.algos.paddpg import backprop_actor, invert_gradients
 from pamdp.cli import main
 from pamdp.spaces import HybridActionSpace
 
@@ -135,6 +137,24 @@ def test_warm_up_acts_uniformly_and_its_latents_are_reencoded():
     assert torch.all(m.actor.high > m.actor.low) and torch.equal(m.actor.low, m.actor_target.low)
 
 
+def test_epsilon_draws_embeddings_uniformly_and_anneals():
+    m = model(warmup_steps=1, epsilon_start=1.0, epsilon_end=0.2, epsilon_steps=1000, exploration_noise=0.0)
+    assert (m.epsilon(0), m.epsilon(500), m.epsilon(10**6)) == (1.0, pytest.approx(0.6), pytest.approx(0.2))
+    obs = torch.from_numpy(np.random.default_rng(0).uniform(0, 1, size=(3000, 9)).astype(np.float32))
+    with torch.no_grad():
+        greedy = m.actor.to_latent(m.actor(obs))
+        a, x, extras = m._explore(obs, 1, np.zeros(3000, dtype=bool))  # past the warm-up, epsilon ~1
+    latent = torch.from_numpy(extras["latent"])
+    np.testing.assert_allclose(np.bincount(a.numpy(), minlength=3) / 3000, [1 / 3] * 3, atol=0.04)
+    torch.testing.assert_close(latent[:, :3], m.rep.embedding[a].detach())  # exactly the drawn action's row
+    torch.testing.assert_close(latent[:, 3:], greedy[:, 3:])  # the parameters' latent is the actor's
+    with torch.no_grad():
+        torch.testing.assert_close(x, m.rep.decode(obs, latent)[1])
+        a_late, _, extras = m._explore(obs, 10**6, np.zeros(3000, dtype=bool))  # epsilon 0.2
+    replaced = (torch.from_numpy(extras["latent"])[:, :3] != greedy[:, :3]).any(-1).float().mean()
+    assert float(replaced) == pytest.approx(0.2, abs=0.03)
+
+
 def test_relabelling_replaces_exactly_the_stale_latents():
     m = model()
     gen = torch.Generator().manual_seed(0)
@@ -201,6 +221,37 @@ def test_td3_critic_loss_by_hand_and_the_policy_delay():
     assert all(torch.equal(p, q) for p, q in zip(critic_before, m.critic.parameters()))
 
 
+@pytest.mark.parametrize("bound", ["squash", "invert"])
+def test_actor_gradient_through_the_latent_box_matches_finite_differences(bound):
+    m = model(bound=bound)
+    m.actor.double(), m.critic.double()
+    with torch.no_grad():
+        m.actor.low.copy_(torch.tensor([-0.5, -1.0, 0.0, -2.0, -0.1]))
+        m.actor.high.copy_(torch.tensor([0.5, 2.0, 0.3, 1.0, 0.1]))
+        m.actor.net[-2 if bound == "squash" else -1].weight.mul_(30.0)  # outputs near and past the bounds
+    obs = torch.rand(6, 9, dtype=torch.float64, generator=torch.Generator().manual_seed(0))
+    m.actor.zero_grad()
+    backprop_actor(m.actor, m._q1, obs, "invert" if bound == "invert" else "none")
+    params = list(m.actor.net.parameters())
+    with torch.no_grad():
+        if bound == "squash":  # Tanh outputs: the plain gradient of -mean Q1(s, latent(u(s)))
+            loss = lambda: -m._q1(obs, m.actor(obs)).mean().item()  # noqa: E731
+        else:  # the inverted dQ/du, held fixed, times du/dtheta
+            u = m.actor(obs)
+            assert (u.abs() > 1).any()
+            (dq_du,) = finite_difference(lambda: m._q1(obs, u).sum().item(), [u])
+            g = invert_gradients(dq_du, u)
+            loss = lambda: -(g * m.actor(obs)).sum().item() / len(obs)  # noqa: E731
+        expected = finite_difference(loss, params)
+    for p, e in zip(params, expected):
+        torch.testing.assert_close(p.grad, e, rtol=1e-5, atol=1e-7)
+    m.actor.float()
+    with torch.no_grad():
+        u = m.actor(obs.float()).clamp(-1, 1)
+        a, x = m._act(obs.float(), deterministic=True)  # acting clamps the output into the box, then decodes
+        torch.testing.assert_close(x, m.rep.decode(obs.float(), m.actor.to_latent(u))[1])
+
+
 @pytest.mark.parametrize(
     "kwargs, match",
     [
@@ -214,6 +265,8 @@ def test_td3_critic_loss_by_hand_and_the_policy_delay():
         ({"buffer_size": 100}, "buffer_size = 100"),
         ({"vae_hidden_sizes": ()}, "vae_hidden_sizes = \\(\\)"),
         ({"kl_weight": -1.0}, "kl_weight = -1.0"),
+        ({"epsilon_start": 1.5}, "epsilon_start = 1.5"),
+        ({"bound": "zero"}, "bound = 'zero'"),
     ],
 )
 def test_bad_settings_raise_errors_naming_the_value(kwargs, match):

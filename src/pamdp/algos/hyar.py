@@ -43,7 +43,8 @@ import torch.nn.functional as F
 from torch import nn
 
 from pamdp.algos.base import AlgoConfig, Algorithm, setting
-from pamdp.algos.offpolicy import OffPolicyLoop, clipped_step, soft_update
+from pamdp.algos.offpolicy import OffPolicyLoop, clipped_step, linear_epsilon, soft_update
+from pamdp.algos.paddpg import backprop_actor
 from pamdp.algos.replay import ReplayBuffer
 from pamdp.policies import ACTIVATIONS, mlp
 from pamdp.spaces import HybridActionSpace
@@ -64,6 +65,11 @@ class HyARConfig(AlgoConfig):
     vae_hidden_sizes: tuple[int, ...] = setting((256, 256), "Hidden layers of the VAE's encoder and decoder (assumed).")
     hidden_sizes: tuple[int, ...] = setting((256, 256), "Hidden layers of the actor and each critic (TD3's: 256-256).")
     activation: str = setting("relu", "Hidden activation: relu, leaky_relu, tanh or elu.")
+    bound: str = setting(
+        "squash",
+        "Keeping the actor's output in [-1, 1]: squash (Tanh, the paper) or invert (a linear output and Hausknecht "
+        "& Stone's inverting gradients, which do not stall where Tanh saturates).",
+    )
     kl_weight: float = setting(1.0, "Weight of the VAE's KL term (the paper's loss: 1).")
     dynamics_weight: float = setting(1.0, "Weight of the state-change prediction loss, beta (assumed: 1).")
     vae_lr: float = setting(1e-4, "Adam learning rate of the embedding table and the VAE (assumed: 1e-4).")
@@ -92,6 +98,12 @@ class HyARConfig(AlgoConfig):
     gamma: float = setting(0.99, "Discount factor.")
     tau: float = setting(0.005, "Soft target-update rate (TD3: 0.005).")
     exploration_noise: float = setting(0.1, "Std of the Gaussian noise on the actor's [-1, 1] output (TD3: 0.1).")
+    epsilon_start: float = setting(
+        0.0,
+        "Chance at the start of replacing the actor's embedding by a uniformly drawn action's (not in the paper: 0).",
+    )
+    epsilon_end: float = setting(0.0, "That chance after epsilon_steps samples (falling linearly).")
+    epsilon_steps: int = setting(50_000, "Samples over which the embedding's epsilon falls to epsilon_end.")
     target_noise: float = setting(0.2, "Std of the target policy smoothing noise, [-1, 1] units (TD3: 0.2).")
     target_noise_clip: float = setting(0.5, "Clip of the target policy smoothing noise (TD3: 0.5).")
     policy_delay: int = setting(2, "Critic updates per actor and target update (TD3: 2).")
@@ -113,11 +125,15 @@ class HyARConfig(AlgoConfig):
             self._check(getattr(self, name) >= 0, name, "a non-negative integer")
         self._check(self.warmup_steps >= 1, "warmup_steps", "an integer >= 1 (the representation needs data)")
         self._check(self.activation in ACTIVATIONS, "activation", f"one of {', '.join(ACTIVATIONS)}")
+        self._check(self.bound in ("squash", "invert"), "bound", "'squash' or 'invert'")
         self._check(self.relabel in RELABEL, "relabel", f"one of {', '.join(RELABEL)}")
         self._check(0 < self.lsc_percent <= 100, "lsc_percent", "a percentage in (0, 100]")
         self._check(self.relabel_tolerance >= 0, "relabel_tolerance", "a non-negative distance")
         for name in ("kl_weight", "dynamics_weight", "exploration_noise", "target_noise", "target_noise_clip"):
             self._check(getattr(self, name) >= 0, name, "a non-negative number")
+        self._check(0 <= self.epsilon_start <= 1, "epsilon_start", "a probability")
+        self._check(0 <= self.epsilon_end <= 1, "epsilon_end", "a probability")
+        self._check(self.epsilon_steps >= 1, "epsilon_steps", "an integer >= 1")
         for name in ("vae_lr", "actor_lr", "critic_lr"):
             self._check(getattr(self, name) > 0, name, "a positive learning rate")
         self._check(self.grad_clip >= 0, "grad_clip", "a non-negative norm (0: off)")
@@ -146,6 +162,10 @@ class HyARConfig(AlgoConfig):
                 vae_updates=20,
                 warmup_updates=2_000,
                 buffer_size=200_000,
+                bound="invert",
+                epsilon_start=0.5,
+                epsilon_end=0.05,
+                epsilon_steps=50_000,
             ),
             "paper": cls(),
         }
@@ -222,11 +242,12 @@ def latent_bounds(latents: torch.Tensor, percent: float) -> tuple[torch.Tensor, 
 
 
 class LatentActor(nn.Module):
-    """``u(s)`` in ``[-1, 1]^(d1 + d2)`` (Tanh), mapped onto the latent box ``[low, high]`` by :meth:`to_latent`."""
+    """``u(s)`` in ``[-1, 1]^(d1 + d2)`` (Tanh with ``squash``; else kept there by inverting gradients and clamped
+    when acting), mapped onto the latent box ``[low, high]`` by :meth:`to_latent`."""
 
-    def __init__(self, obs_dim: int, size: int, hidden_sizes, activation: str):
+    def __init__(self, obs_dim: int, size: int, hidden_sizes, activation: str, squash: bool = True):
         super().__init__()
-        self.net = mlp(obs_dim, hidden_sizes, size, activation, nn.Tanh)
+        self.net = mlp(obs_dim, hidden_sizes, size, activation, nn.Tanh if squash else None)
         self.register_buffer("low", -torch.ones(size))
         self.register_buffer("high", torch.ones(size))
 
@@ -262,7 +283,8 @@ class HyAR(Algorithm):
         self.rep = ActionRepresentation(
             self.obs_dim, h, cfg.embed_dim, cfg.latent_dim, cfg.vae_hidden_sizes, cfg.activation
         )
-        self.actor = LatentActor(self.obs_dim, self.latent_size, cfg.hidden_sizes, cfg.activation)
+        squash = cfg.bound == "squash"
+        self.actor = LatentActor(self.obs_dim, self.latent_size, cfg.hidden_sizes, cfg.activation, squash)
         self.critic = TwinCritic(self.obs_dim, self.latent_size, cfg.hidden_sizes, cfg.activation)
         self.actor_target = copy.deepcopy(self.actor).requires_grad_(False)
         self.critic_target = copy.deepcopy(self.critic).requires_grad_(False)
@@ -319,7 +341,7 @@ class HyAR(Algorithm):
 
     # -- acting ----------------------------------------------------------------------------------
     def _act(self, obs, deterministic):
-        u = self.actor(obs)
+        u = self.actor(obs).clamp(-1.0, 1.0)
         if not deterministic:
             u = self._noisy(u)
         return self.rep.decode(obs, self.actor.to_latent(u))
@@ -335,9 +357,20 @@ class HyAR(Algorithm):
             x = self.np_rng.uniform(-1.0, 1.0, size=(n, h.max_param_size)).astype(np.float32)
             x = torch.from_numpy(x) * self.rep.mask[a]
             return a, x, {"latent": np.zeros((n, self.latent_size), dtype=np.float32)}
-        latent = self.actor.to_latent(self._noisy(self.actor(obs)))
+        latent = self.actor.to_latent(self._noisy(self.actor(obs).clamp(-1.0, 1.0)))
+        eps = self.epsilon(step)
+        if eps > 0:  # a uniformly drawn action's embedding in place of the actor's, the parameters' latent kept
+            drawn = torch.from_numpy(self.np_rng.random(len(obs)) < eps)
+            k = torch.from_numpy(self.np_rng.integers(self.hybrid.n_actions, size=len(obs)))
+            e = torch.where(drawn[:, None], self.rep.embedding[k], latent[:, : self.config.embed_dim])
+            latent = torch.cat([e, latent[:, self.config.embed_dim :]], dim=-1)
         a, x = self.rep.decode(obs, latent)
         return a, x, {"latent": latent.numpy()}
+
+    def epsilon(self, step: int) -> float:
+        """The chance of a drawn embedding after ``step`` samples: linear from epsilon_start to epsilon_end."""
+        cfg = self.config
+        return linear_epsilon(step, cfg.epsilon_start, cfg.epsilon_end, cfg.epsilon_steps)
 
     # -- learning --------------------------------------------------------------------------------
     def _run_epoch(self) -> dict[str, float]:
@@ -353,6 +386,7 @@ class HyAR(Algorithm):
             self.np_rng,
         )
         stats["train/latent_box_width"] = float((self.actor.high - self.actor.low).mean())
+        stats["train/epsilon"] = self.epsilon(self.num_timesteps + stats["steps"])
         return stats
 
     def train_representation(self, updates: int) -> dict[str, float]:
@@ -404,6 +438,10 @@ class HyAR(Algorithm):
         stale = (a != b["a"]) | ((x - b["x"] * self.rep.mask[b["a"]]).abs().amax(-1) > self.config.relabel_tolerance)
         return torch.where(stale[:, None], current, latent), float(stale.float().mean())
 
+    def _q1(self, obs: torch.Tensor, u: torch.Tensor) -> torch.Tensor:
+        """The first critic at the actor's output ``u`` (in ``[-1, 1]`` units)."""
+        return self.critic.q1(torch.cat([obs, self.actor.to_latent(u)], dim=-1)).squeeze(-1)
+
     def _update(self) -> dict[str, float]:
         """One TD3 critic step (on relabelled latents), a delayed actor step, and representation rounds when due."""
         cfg = self.config
@@ -420,7 +458,7 @@ class HyAR(Algorithm):
         obs, next_obs = b["obs"], b["next_obs"]
         latent, relabelled = self.relabel(b)
         with torch.no_grad():
-            u_next = self.actor_target(next_obs)
+            u_next = self.actor_target(next_obs).clamp(-1.0, 1.0)
             noise = torch.randn(u_next.shape, generator=self.torch_gen) * cfg.target_noise
             u_next = (u_next + noise.clamp(-cfg.target_noise_clip, cfg.target_noise_clip)).clamp(-1.0, 1.0)
             q1_next, q2_next = self.critic_target(next_obs, self.actor_target.to_latent(u_next))
@@ -439,13 +477,10 @@ class HyAR(Algorithm):
             }
         )
         if self.n_updates % cfg.policy_delay == 0:
-            self.critic.requires_grad_(False)  # the actor's loss trains the actor only
-            actor_loss = -self.critic.q1(torch.cat([obs, self.actor.to_latent(self.actor(obs))], -1)).mean()
             self.actor_optimizer.zero_grad(set_to_none=True)
-            actor_loss.backward()
-            self.critic.requires_grad_(True)
+            _, q_mu = backprop_actor(self.actor, self._q1, obs, "invert" if cfg.bound == "invert" else "none")
             clipped_step(self.actor_optimizer, self.actor.net.parameters(), cfg.grad_clip)
             soft_update(self.critic_target, self.critic, cfg.tau)
             soft_update(self.actor_target.net, self.actor.net, cfg.tau)
-            stats["losses/actor_loss"] = self._latest["losses/actor_loss"] = float(actor_loss.detach())
+            stats["losses/actor_loss"] = self._latest["losses/actor_loss"] = float(-q_mu.mean())
         return stats
