@@ -30,6 +30,11 @@ representation training alone, then TD3 with a round of ``vae_updates`` represen
 The paper's appendix (network sizes, learning rates, latent sizes, the percentile, the validity test) was not
 available when this was written: those settings are marked as assumptions in their help. The paper reports
 0.98 +- 0.01 on Platform (5 runs).
+
+Two options beyond the paper, off in the ``paper`` preset and on in ``cpu``: epsilon-greedy over the embeddings
+(``epsilon_start``, ``epsilon_end``) and inverting gradients instead of the actor's Tanh (``bound = "invert"``).
+Probes on Platform found the Tanh actor stuck in a corner of the latent box, on one action's embedding, while
+its critic preferred another (docs/algorithms.md, "HyAR-TD3").
 """
 
 from __future__ import annotations
