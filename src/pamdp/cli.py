@@ -21,7 +21,14 @@ from pathlib import Path
 from pamdp._memory import keep_freed_memory
 from pamdp.experiments.runner import ALGORITHMS, RunSpec, algorithm_class, default_preset, train_run
 
-DEFAULT_TOTAL_STEPS = {"patrpo": 500_000, "pappo": 300_000, "pasvg0": 1_000_000, "paddpg": 1_000_000, "pdqn": 200_000, "hyar": 200_000}
+DEFAULT_TOTAL_STEPS = {
+    "patrpo": 500_000,
+    "pappo": 300_000,
+    "pasvg0": 1_000_000,
+    "paddpg": 1_000_000,
+    "pdqn": 200_000,
+    "hyar": 200_000,
+}
 ALGO_HELP = {
     "patrpo": "PATRPO: TRPO of the hierarchical policy with the chain-rule KL",
     "pappo": "PAPPO: PPO's clipped surrogate on the hierarchical policy (H-PPO style)",
