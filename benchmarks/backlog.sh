@@ -16,8 +16,9 @@
 #   1. step-size (2 x 5) and kl-estimators (3 x 5), PATRPO: ~16 min a run            ~6.5 core-hours
 #   2. MP-DQN, P-DQN and PAPPO tuned, 3 x 5 x 300k (beyond the paper): ~9 min a run beside another
 #                                                                            ~2.3 core-hours
-#   2b. SB3's SAC and DQN through pamdp's wrappers, 2 x 3 x 100k (a baseline from a mainstream library)
-#                                                                            ~1.5 core-hours
+#   2b. SB3's SAC and DQN through pamdp's wrappers, 2 x 3 x 100k (a baseline from a mainstream library): a SAC
+#       run with SB3's defaults took over 22 min beside another on 2026-11-29 (not resumable mid-run)
+#                                                                            ~2 core-hours
 #       (these two go before soccer's PATRPO arm because they finish within one session and so give recorded
 #       results at its end; a soccer run takes more than a session whatever the order)
 #   3. the PATRPO arm of platform (done) and soccer (3 x 5M): a soccer epoch of 50 000 samples with
