@@ -17,7 +17,7 @@
 #   2. MP-DQN, P-DQN and PAPPO tuned, 3 x 5 x 300k (beyond the paper): ~9 min a run beside another
 #                                                                            ~2.3 core-hours
 #   2b. SB3's SAC and DQN through pamdp's wrappers, 2 x 3 x 100k (a baseline from a mainstream library): a SAC
-#       run with SB3's defaults took over 22 min beside another on 2026-11-29 (not resumable mid-run)
+#       run with SB3's defaults took over 38 min beside another on 2026-11-29 (not resumable mid-run)
 #                                                                            ~2 core-hours
 #       (these two go before soccer's PATRPO arm because they finish within one session and so give recorded
 #       results at its end; a soccer run takes more than a session whatever the order)
