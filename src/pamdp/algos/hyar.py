@@ -187,7 +187,7 @@ class ActionRepresentation(nn.Module):
         self, obs_dim: int, hybrid: HybridActionSpace, embed_dim: int, latent_dim: int, hidden_sizes, activation: str
     ):
         super().__init__()
-        self.n_actions, self.param_size, self.obs_dim = hybrid.n_actions, hybrid.max_param_size, obs_dim
+        self.param_size = hybrid.max_param_size
         self.latent_dim = latent_dim
         self.embedding = nn.Parameter(torch.empty(hybrid.n_actions, embed_dim).uniform_(-1.0, 1.0))
         self.encoder = mlp(obs_dim + self.param_size + embed_dim, hidden_sizes, 2 * latent_dim, activation)
