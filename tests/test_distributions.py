@@ -123,3 +123,32 @@ def test_policy_evaluates_pi_c_for_every_action_in_one_pass():
         onehot = torch.nn.functional.one_hot(torch.full((6,), k), 3).float()
         torch.testing.assert_close(dist.means[:, k], pol.pi_c(torch.cat([obs, onehot], -1)))
     assert torch.all(dist.means.abs() <= 1)
+
+
+@pytest.mark.parametrize("shared_std", [True, False])
+@pytest.mark.parametrize("estimator", ["chain_analytic", "chain_sample"])
+def test_kl_hessian_product_matches_autograd_in_the_distribution_parameters(estimator, shared_std):
+    old = make_dist(7, batch=5, scale=2.0).detach()
+    if not shared_std:  # a per-state log-std
+        old = HybridDistribution(old.logits, old.means, old.log_std + 0.1 * torch.arange(5.0)[:, None, None], MASK)
+    a, _ = old.sample(torch.Generator().manual_seed(1))
+    std0 = old.log_std[0].clone() if shared_std else old.log_std.clone()
+    leaves = [old.logits.clone().requires_grad_(), old.means.clone().requires_grad_(), std0.requires_grad_()]
+    kl = kl_divergence(old, HybridDistribution(*leaves, MASK), estimator, a).mean()
+    grads = torch.autograd.grad(kl, leaves, create_graph=True)
+    g = torch.Generator().manual_seed(2)
+    tangent = [torch.randn(t.shape, dtype=t.dtype, generator=g) for t in leaves]
+    # The Hessian-vector product by double back-propagation of the KL itself, at new = old.
+    expected = torch.autograd.grad(sum((gr * t).sum() for gr, t in zip(grads, tangent)), leaves)
+    got = old.kl_hessian_product(*tangent, estimator, a)
+    for e, r in zip(expected, got):
+        assert r.shape == e.shape
+        torch.testing.assert_close(r, e, atol=1e-12, rtol=1e-9)
+
+
+def test_kl_hessian_product_refuses_the_joint_sample_estimator():
+    d = make_dist(0)
+    with pytest.raises(ValueError, match="joint_sample"):
+        d.kl_hessian_product(d.logits, d.means, d.log_std, "joint_sample")
+    with pytest.raises(ValueError, match="needs the sampled actions"):
+        d.kl_hessian_product(d.logits, d.means, d.log_std, "chain_sample")

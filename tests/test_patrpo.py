@@ -58,6 +58,8 @@ def test_linear_baseline_recovers_a_linear_function():
         ({"hidden_sizes": ()}, "hidden_sizes"),
         ({"gamma": float("nan")}, "gamma = nan"),
         ({"baseline": "zero"}, "baseline = 'zero'"),
+        ({"fvp": "exact"}, "fvp = 'exact'"),
+        ({"fvp": "gauss_newton", "kl_estimator": "joint_sample"}, "fvp = 'gauss_newton'.*joint_sample"),
     ],
 )
 def test_bad_settings_raise_clear_errors(kwargs, match):
@@ -91,6 +93,22 @@ def test_same_seed_gives_identical_first_epochs():
     )
     other.learn(1000, progress_bar=False)
     assert not torch.equal(stats[0], torch.cat([p.detach().flatten() for p in other.policy.parameters()]))
+
+
+@pytest.mark.parametrize("estimator", ["chain_analytic", "chain_sample"])
+def test_gauss_newton_and_double_backprop_take_the_same_step(estimator):
+    """The two Fisher-vector products are the same matrix, so an epoch ends at the same parameters."""
+    params = []
+    for fvp in ("gauss_newton", "double_backprop"):
+        cfg = PATRPOConfig.from_dict({"fvp": fvp, "kl_estimator": estimator, "fvp_subsample": 0.5}, base=SMALL)
+        model = PATRPO("pamdp/Platform-v0", cfg)
+        before = torch.cat([p.detach().flatten() for p in model.policy.parameters()])
+        stats = []
+        model.learn(1000, progress_bar=False, callback=lambda algo, s, out=stats: out.append(s))
+        assert stats[0]["train/line_search_success"] == 1.0
+        params.append(torch.cat([p.detach().flatten() for p in model.policy.parameters()]))
+    step = params[1] - before
+    torch.testing.assert_close(params[0] - before, step, atol=1e-4 * float(step.abs().max()), rtol=0)
 
 
 def test_save_load_predict_round_trip(tmp_path):

@@ -1,11 +1,13 @@
 """TRPO machinery against explicit linear algebra."""
 
 import numpy as np
+import pytest
 import torch
 from torch import nn
 
 from pamdp.algos.trpo import (
     FisherVectorProduct,
+    GaussNewtonFVP,
     backtracking_line_search,
     conjugate_gradient,
     flat_grad,
@@ -13,14 +15,14 @@ from pamdp.algos.trpo import (
     set_flat_params,
 )
 from pamdp.distributions import HybridDistribution, kl_divergence
-from pamdp.policies import HybridPolicy
+from pamdp.policies import HybridPolicy, LinearizedMLP, mlp
 from pamdp.spaces import HybridActionSpace
 
 
-def tiny_policy(seed=0):
+def tiny_policy(seed=0, activation="tanh", hidden_sizes=(4,)):
     hs = HybridActionSpace((np.zeros(2), np.zeros(1)), (np.ones(2), np.ones(1)))
     torch.manual_seed(seed)
-    pol = HybridPolicy(3, hs, hidden_sizes=(4,), activation="tanh").double()
+    pol = HybridPolicy(3, hs, hidden_sizes=hidden_sizes, activation=activation).double()
     # Larger final layers than the default near-zero init, so the Hessian is not trivially tiny.
     for p in pol.parameters():
         p.data.normal_(0, 0.5)
@@ -61,6 +63,36 @@ def test_fisher_vector_product_matches_explicit_hessian():
     torch.testing.assert_close(fvp(v), H @ v + damping * v, atol=1e-10, rtol=1e-8)
     # At the old parameters the KL's Hessian is a Fisher matrix: positive semi-definite.
     assert torch.linalg.eigvalsh(H).min() > -1e-10
+
+
+@pytest.mark.parametrize("activation", ["tanh", "relu", "leaky_relu", "elu"])
+@pytest.mark.parametrize("estimator", ["chain_analytic", "chain_sample"])
+def test_gauss_newton_product_matches_explicit_hessian(estimator, activation):
+    pol = tiny_policy(3, activation, hidden_sizes=(5, 4))
+    named = list(pol.named_parameters())
+    names, params = [n for n, _ in named], [p for _, p in named]
+    g = torch.Generator().manual_seed(0)
+    obs = torch.randn(16, 3, dtype=torch.float64, generator=g)
+    with torch.no_grad():
+        old = pol(obs).detach()
+        a, x = old.sample(g)
+
+    def kl():
+        return kl_divergence(old, pol(obs), estimator, a, x).mean()
+
+    H = explicit_hessian(kl, params)
+    new, jvp = pol.linearize(obs)
+    torch.testing.assert_close(new.logits, pol(obs).logits)
+    fvp = GaussNewtonFVP(
+        (new.logits, new.means, pol.log_std),
+        params,
+        lambda ts: jvp(dict(zip(names, ts))),
+        lambda *t: old.kl_hessian_product(*t, estimator, a),
+        damping=1e-3,
+    )
+    for seed in range(3):
+        v = torch.randn(H.shape[0], dtype=torch.float64, generator=torch.Generator().manual_seed(seed))
+        torch.testing.assert_close(fvp(v), H @ v + 1e-3 * v, atol=1e-10, rtol=1e-8)
 
 
 def test_conjugate_gradient_solves_spd_system():
@@ -140,3 +172,25 @@ def test_hybrid_distribution_dtype_is_preserved():
         torch.zeros(2, 2), torch.zeros(2, 2, 1), torch.zeros(2, 1), torch.ones(2, 1, dtype=torch.bool)
     )
     assert d.entropy().dtype == torch.float32
+
+
+@pytest.mark.parametrize("activation", ["tanh", "relu", "leaky_relu", "elu"])
+def test_linearized_mlp_matches_forward_mode_autodiff(activation):
+    net = mlp(4, (6, 5), 3, activation, nn.Tanh).double()
+    g = torch.Generator().manual_seed(0)
+    inputs = torch.randn(7, 2, 4, dtype=torch.float64, generator=g)  # any leading shape
+    params = dict(net.named_parameters())
+    tangents = {n: torch.randn(p.shape, dtype=p.dtype, generator=g) for n, p in params.items()}
+    lin = LinearizedMLP(net, inputs)
+    out, expected = torch.func.jvp(
+        lambda *w: torch.func.functional_call(net, dict(zip(params, w)), (inputs,)),
+        tuple(p.detach() for p in params.values()),
+        tuple(tangents.values()),
+    )
+    torch.testing.assert_close(lin.outputs, out)
+    torch.testing.assert_close(lin.jvp(list(tangents.values())), expected, atol=1e-12, rtol=1e-10)
+
+
+def test_linearized_mlp_names_a_layer_it_cannot_differentiate():
+    with pytest.raises(TypeError, match="Softplus"):
+        LinearizedMLP(nn.Sequential(nn.Linear(2, 2), nn.Softplus()), torch.zeros(1, 2))

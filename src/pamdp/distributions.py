@@ -104,6 +104,45 @@ class HybridDistribution:
         per_dim = 0.5 * (var_ratio + mean_term - 1.0) - (self.log_std - new.log_std)
         return (per_dim * self.mask).sum(-1)
 
+    def kl_hessian_product(
+        self,
+        d_logits: torch.Tensor,
+        d_means: torch.Tensor,
+        d_log_std: torch.Tensor,
+        estimator: str = "chain_analytic",
+        a: torch.Tensor | None = None,
+    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+        """The Hessian of the batch-mean ``KL(self || new)`` in ``new``'s ``(logits, means, log_std)``, at
+        ``new = self``, times the tangent ``(d_logits, d_means, d_log_std)``: the Fisher information of the
+        estimator in the distribution's own parameters.
+
+        Exact for the closed-form estimators: ``chain_analytic`` weighs action ``a``'s Gaussian by
+        ``pi_d(a | s)``, ``chain_sample`` counts the sampled action ``a``'s only. Per state and parameter the
+        blocks are ``diag(p) - p p^T`` for the logits, ``1 / sigma^2`` for a mean and ``2`` for a log-std, with
+        no cross terms at ``new = self``. ``d_log_std`` may be ``(K, m)`` (shared by the batch) or per state;
+        the result has the tangents' shapes. (``joint_sample`` has no such closed form: its Hessian depends on
+        the sampled parameters, so Fisher-vector products for it go through double back-propagation.)
+        """
+        p = self.probs_d.detach()
+        batch = p.shape[0]
+        if estimator == "chain_analytic":
+            weight = p
+        elif estimator == "chain_sample":
+            if a is None:
+                raise ValueError("the 'chain_sample' KL estimator needs the sampled actions (a)")
+            weight = F.one_hot(a.long(), p.shape[-1]).to(p.dtype)
+        else:
+            raise ValueError(
+                f"no closed-form Fisher for the KL estimator {estimator!r}; expected chain_analytic or chain_sample"
+            )
+        u_logits = p * (d_logits - (p * d_logits).sum(-1, keepdim=True)) / batch
+        w = weight.unsqueeze(-1) * self.mask / batch
+        u_means = w * d_means * torch.exp(-2.0 * self.log_std.detach())
+        u_log_std = 2.0 * w * d_log_std
+        if d_log_std.dim() < u_log_std.dim():  # shared by the batch: its entries collect every state's term
+            u_log_std = u_log_std.sum(0)
+        return u_logits, u_means, u_log_std
+
     def detach(self) -> HybridDistribution:
         return HybridDistribution(self.logits.detach(), self.means.detach(), self.log_std.detach(), self.mask)
 

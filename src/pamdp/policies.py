@@ -8,15 +8,16 @@ is Gaussian with a learned, state-independent log-std per action and parameter.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import torch
+import torch.nn.functional as F
 from torch import nn
 
 from pamdp.distributions import HybridDistribution
 from pamdp.spaces import HybridActionSpace
 
-__all__ = ["ACTIVATIONS", "mlp", "HybridPolicy", "ValueNetwork"]
+__all__ = ["ACTIVATIONS", "mlp", "LinearizedMLP", "HybridPolicy", "ValueNetwork"]
 
 ACTIVATIONS = {"relu": nn.ReLU, "tanh": nn.Tanh, "leaky_relu": nn.LeakyReLU, "elu": nn.ELU}
 
@@ -39,6 +40,61 @@ def mlp(
     if output_activation is not None:
         layers.append(output_activation())
     return nn.Sequential(*layers)
+
+
+def _activation_slope(module: nn.Module, pre: torch.Tensor, out: torch.Tensor) -> torch.Tensor:
+    """The elementwise derivative of an activation layer at pre-activations ``pre`` (outputs ``out``)."""
+    if isinstance(module, nn.ReLU):
+        return (pre > 0).to(pre.dtype)
+    if isinstance(module, nn.LeakyReLU):
+        slope = module.negative_slope
+        return (pre > 0).to(pre.dtype) * (1.0 - slope) + slope
+    if isinstance(module, nn.Tanh):
+        return 1.0 - out * out
+    if isinstance(module, nn.ELU):
+        return torch.where(pre > 0, torch.ones_like(out), out + module.alpha)
+    raise TypeError(f"no derivative known for the layer {module!r}; expected Linear, ReLU, LeakyReLU, Tanh or ELU")
+
+
+class LinearizedMLP:
+    """An :func:`mlp` at one batch of inputs: its outputs (with their autograd graph) and its Jacobian-vector
+    product in the parameters, ``J v``, by forward-mode propagation through the activations cached here.
+
+    ``J v`` costs two matrix products a layer and reuses the forward pass, where ``torch.func.jvp`` would run
+    the forward pass again on every call; a Gauss-Newton Fisher-vector product needs one per CG iteration.
+
+    Args:
+        net: a ``Sequential`` of ``Linear`` layers and elementwise activations (what :func:`mlp` builds).
+        inputs: the network's input, which does not depend on its parameters.
+    """
+
+    def __init__(self, net: nn.Sequential, inputs: torch.Tensor):
+        self.steps: list[tuple[nn.Linear, torch.Tensor] | torch.Tensor] = []  # (layer, its input) or a slope
+        h = inputs
+        for module in net:
+            out = module(h)
+            if isinstance(module, nn.Linear):
+                self.steps.append((module, h.detach()))
+            else:
+                self.steps.append(_activation_slope(module, h.detach(), out.detach()))
+            h = out
+        self.outputs = h
+
+    def jvp(self, tangents: Sequence[torch.Tensor]) -> torch.Tensor:
+        """``J v`` for parameter tangents in the order of ``net.parameters()`` (weight then bias, per layer)."""
+        tangents = iter(tangents)
+        dh: torch.Tensor | None = None  # the tangent of the current hidden layer (the input has none)
+        with torch.no_grad():
+            for step in self.steps:
+                if isinstance(step, tuple):
+                    layer, h = step
+                    d_weight = next(tangents)
+                    d_bias = next(tangents) if layer.bias is not None else None
+                    dz = F.linear(h, d_weight, d_bias)
+                    dh = dz if dh is None else dz + F.linear(dh, layer.weight)
+                else:
+                    dh = step * dh
+        return dh
 
 
 class HybridPolicy(nn.Module):
@@ -84,6 +140,30 @@ class HybridPolicy(nn.Module):
         obs_k = obs.unsqueeze(1).expand(batch, self.n_actions, self.obs_dim)
         means = self.param_means(obs_k, eye.expand(batch, -1, -1))
         return HybridDistribution(self.pi_d(obs), means, self.log_std, self.mask)
+
+    def linearize(
+        self, obs: torch.Tensor
+    ) -> tuple[HybridDistribution, Callable[[dict[str, torch.Tensor]], tuple[torch.Tensor, ...]]]:
+        """The distribution at ``obs`` (as :meth:`forward`) and the Jacobian-vector product of its raw outputs.
+
+        The product takes parameter tangents by name (``dict(self.named_parameters())``'s keys) and returns the
+        tangents of ``(logits (B, K), means (B, K, m), log_std (K, m))``, the distribution's own parameters.
+        """
+        batch = obs.shape[0]
+        eye = torch.eye(self.n_actions, dtype=obs.dtype, device=obs.device)
+        inputs_c = torch.cat(
+            [obs.unsqueeze(1).expand(batch, self.n_actions, self.obs_dim), eye.expand(batch, -1, -1)], -1
+        )
+        lin_d, lin_c = LinearizedMLP(self.pi_d, obs), LinearizedMLP(self.pi_c, inputs_c)
+        names_d = [f"pi_d.{n}" for n, _ in self.pi_d.named_parameters()]
+        names_c = [f"pi_c.{n}" for n, _ in self.pi_c.named_parameters()]
+
+        def jvp(tangents: dict[str, torch.Tensor]) -> tuple[torch.Tensor, ...]:
+            d_logits = lin_d.jvp([tangents[n] for n in names_d])
+            d_means = lin_c.jvp([tangents[n] for n in names_c])
+            return d_logits, d_means, tangents["log_std"]
+
+        return HybridDistribution(lin_d.outputs, lin_c.outputs, self.log_std, self.mask), jvp
 
 
 class ValueNetwork(nn.Module):

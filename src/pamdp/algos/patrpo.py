@@ -20,12 +20,21 @@ import numpy as np
 import torch
 
 from pamdp.algos.base import AlgoConfig, Algorithm, EpisodeTracker, setting
-from pamdp.algos.trpo import FisherVectorProduct, backtracking_line_search, conjugate_gradient, flat_grad
+from pamdp.algos.trpo import (
+    FisherVectorProduct,
+    GaussNewtonFVP,
+    backtracking_line_search,
+    conjugate_gradient,
+    flat_grad,
+)
 from pamdp.distributions import KL_ESTIMATORS, kl_divergence
 from pamdp.policies import ACTIVATIONS, HybridPolicy, ValueNetwork
 from pamdp.spaces import HybridActionSpace
 
 __all__ = ["PATRPO", "PATRPOConfig", "LinearFeatureBaseline", "OnPolicyHybrid", "Rollout", "advantage_batch", "gae"]
+
+
+FVP_METHODS = ("auto", "gauss_newton", "double_backprop")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -56,6 +65,11 @@ class PATRPOConfig(AlgoConfig):
     fvp_subsample: float = setting(
         1.0,
         "Fraction of the batch for Fisher-vector products (0.1-0.2 is a common speed-up; the line search uses all).",
+    )
+    fvp: str = setting(
+        "auto",
+        "How Fisher-vector products are computed: gauss_newton (closed-form KL Hessian, about twice as fast; exact "
+        "for the chain estimators), double_backprop (any estimator), or auto (gauss_newton where it is exact).",
     )
     cg_damping: float = setting(1e-5, "Damping added to the Fisher-vector product; raise it if steps are erratic.")
     backtrack_ratio: float = setting(0.8, "Step shrink factor of the line search.")
@@ -88,6 +102,12 @@ class PATRPOConfig(AlgoConfig):
         self._check(self.kl_estimator in KL_ESTIMATORS, "kl_estimator", f"one of {', '.join(KL_ESTIMATORS)}")
         self._check(self.cg_iters >= 1, "cg_iters", "an integer >= 1")
         self._check(0 < self.fvp_subsample <= 1, "fvp_subsample", "a fraction in (0, 1]")
+        self._check(self.fvp in FVP_METHODS, "fvp", f"one of {', '.join(FVP_METHODS)}")
+        self._check(
+            not (self.fvp == "gauss_newton" and self.kl_estimator == "joint_sample"),
+            "fvp",
+            "auto or double_backprop with kl_estimator='joint_sample' (its Hessian has no closed form)",
+        )
         self._check(self.cg_damping >= 0, "cg_damping", "a non-negative number")
         self._check(0 < self.backtrack_ratio < 1, "backtrack_ratio", "a number in (0, 1)")
         self._check(self.max_backtracks >= 1, "max_backtracks", "an integer >= 1")
@@ -358,6 +378,29 @@ class PATRPO(OnPolicyHybrid):
         stats["losses/value_loss"] = self._fit_baseline(data["obs"], data["t"], data["returns"])
         return self._epoch_stats(stats, data, explained_var)
 
+    def _fisher_vector_product(self, obs, a, x, old) -> Callable[[torch.Tensor], torch.Tensor]:
+        """The damped Fisher-vector product of the KL estimator, on ``fvp_subsample`` of the batch."""
+        cfg = self.config
+        n_fvp = max(1, int(round(cfg.fvp_subsample * len(obs))))
+        if n_fvp < len(obs):
+            sub = torch.randperm(len(obs), generator=self.torch_gen)[:n_fvp]
+            obs, a, x, old = obs[sub], a[sub], x[sub], old[sub]
+        named = [(n, p) for n, p in self.policy.named_parameters() if p.requires_grad]
+        names, params = [n for n, _ in named], [p for _, p in named]
+        method = cfg.fvp
+        if method == "auto":
+            method = "double_backprop" if cfg.kl_estimator == "joint_sample" else "gauss_newton"
+        if method == "double_backprop":
+            kl = kl_divergence(old, self.policy(obs), cfg.kl_estimator, a, x).mean()
+            return FisherVectorProduct(kl, params, cfg.cg_damping)
+        new, jvp = self.policy.linearize(obs)
+
+        def metric(d_logits, d_means, d_log_std):
+            return old.kl_hessian_product(d_logits, d_means, d_log_std, cfg.kl_estimator, a)
+
+        outputs = (new.logits, new.means, self.policy.log_std)
+        return GaussNewtonFVP(outputs, params, lambda ts: jvp(dict(zip(names, ts))), metric, cfg.cg_damping)
+
     def _update_policy(self, obs, a, x, adv) -> dict[str, float]:
         """One natural-gradient step with line search on the surrogate (the paper's PATRPO update)."""
         cfg = self.config
@@ -375,13 +418,7 @@ class PATRPO(OnPolicyHybrid):
             return kl_divergence(old, self.policy(obs), cfg.kl_estimator, a, x).mean()
 
         g = flat_grad(surrogate(), params)
-        n_fvp = max(1, int(round(cfg.fvp_subsample * len(adv))))
-        if n_fvp < len(adv):
-            sub = torch.randperm(len(adv), generator=self.torch_gen)[:n_fvp]
-            kl_sub = kl_divergence(old[sub], self.policy(obs[sub]), cfg.kl_estimator, a[sub], x[sub]).mean()
-        else:
-            kl_sub = kl()
-        fvp = FisherVectorProduct(kl_sub, params, cfg.cg_damping)
+        fvp = self._fisher_vector_product(obs, a, x, old)
         direction = conjugate_gradient(fvp, g, cfg.cg_iters)
         shs = float(direction @ fvp(direction))
         stats = {"train/entropy": float(old.entropy().mean()), "train/grad_norm": float(g.norm())}
