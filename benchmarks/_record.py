@@ -18,6 +18,7 @@ import numpy as np
 from pamdp.experiments import load_experiment
 from pamdp.experiments.plots import write_report
 from pamdp.experiments.runner import is_finished, run_all
+from pamdp.experiments.status import epoch_seconds
 
 HERE = Path(__file__).parent
 
@@ -91,7 +92,7 @@ def run_and_record(
     per_run = {}  # training time of each run from its own log, so that resumed and skipped runs count too
     for o in outcomes:
         with open(Path(o.out) / "progress.csv", newline="") as f:
-            seconds = sum(float(r["time/epoch_seconds"]) for r in csv.DictReader(f))
+            seconds = sum(epoch_seconds(r) for r in csv.DictReader(f))
         per_run.setdefault(o.spec.label, []).append(seconds)
     commit = subprocess.run(
         ["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, cwd=HERE

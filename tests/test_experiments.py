@@ -158,6 +158,37 @@ def test_status_estimates_the_training_left_from_each_runs_own_pace():
     assert "(~3 min with 2 side by side)" in text
 
 
+def test_status_counts_cpu_time_where_an_epoch_logged_it(tmp_path):
+    """A run suspended with SIGSTOP keeps its wall clock going; its CPU time, logged since 2026-11-29, does not."""
+    from pamdp.experiments.status import run_status
+
+    exp = load_experiment(write_experiment(tmp_path / "tiny.toml"))
+    spec = exp.specs(None, 1.0, None)[0]
+    out = tmp_path / "run"
+    out.mkdir()
+    rows = [
+        "time/total_timesteps,time/epoch_seconds,time/epoch_cpu_seconds",
+        "200,100.0,",  # an epoch logged before CPU time was: its wall time counts
+        "400,500.0,40.0",  # suspended for most of its wall time
+    ]
+    (out / "progress.csv").write_text("\n".join(rows) + "\n")
+    status = run_status(spec, out)
+    assert status.steps == 400 and status.train_seconds == pytest.approx(140.0)
+
+
+def test_training_logs_the_cpu_time_of_each_epoch(tmp_path):
+    from pamdp import PATRPO
+    from pamdp.algos.patrpo import PATRPOConfig
+
+    model = PATRPO("pamdp/Platform-v0", PATRPOConfig(hidden_sizes=(8,), batch_size=200, num_envs=4))
+    model.learn(400, progress_bar=False, run_dir=tmp_path)
+    with open(tmp_path / "progress.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert len(rows) == 2
+    for r in rows:  # one torch thread: CPU time is positive and at most the wall time (plus clock granularity)
+        assert 0 < float(r["time/epoch_cpu_seconds"]) <= float(r["time/epoch_seconds"]) + 0.05
+
+
 @pytest.mark.skipif(not os.path.isdir("/proc/self/fd"), reason="finds the worker through /proc")
 def test_a_killed_worker_fails_its_run_alone(tmp_path):
     exp = write_experiment(tmp_path / "tiny.toml")

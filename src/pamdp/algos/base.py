@@ -480,7 +480,7 @@ class Algorithm:
         )
         try:
             while self.num_timesteps < target:
-                t0 = time.perf_counter()
+                t0, cpu0 = time.perf_counter(), time.process_time()
                 stats = self._run_epoch()
                 self.num_timesteps += int(stats.pop("steps"))
                 self.epoch += 1
@@ -490,6 +490,8 @@ class Algorithm:
                         "time/epoch": float(self.epoch),
                         "time/total_timesteps": float(self.num_timesteps),
                         "time/epoch_seconds": elapsed,
+                        # CPU time of this process: unlike the wall clock, it stops while the run is suspended
+                        "time/epoch_cpu_seconds": time.process_time() - cpu0,
                         "charts/SPS": (self.num_timesteps - start_steps) / (time.perf_counter() - start_time),
                     }
                 )

@@ -53,6 +53,13 @@ def _float(value) -> float | None:
     return x if math.isfinite(x) else None
 
 
+def epoch_seconds(row: dict) -> float:
+    """Training seconds of one ``progress.csv`` row: its CPU time where logged (runs since 2026-11-29), which
+    leaves out the time a run spent suspended, else its wall-clock time."""
+    cpu = _float(row.get("time/epoch_cpu_seconds"))
+    return cpu if cpu is not None else (_float(row.get("time/epoch_seconds")) or 0.0)
+
+
 def run_status(spec: RunSpec, out: str | Path, now: float | None = None) -> RunStatus:
     """The state of ``spec``'s run in directory ``out``."""
     from pamdp.algos.base import CHECKPOINT, FINAL_MODEL
@@ -63,8 +70,7 @@ def run_status(spec: RunSpec, out: str | Path, now: float | None = None) -> RunS
     if progress.exists():
         with open(progress, newline="") as f:
             rows = list(csv.DictReader(f))
-        for row in rows:
-            seconds += _float(row.get("time/epoch_seconds")) or 0.0
+        seconds = sum(epoch_seconds(row) for row in rows)
         if rows:
             steps = int(_float(rows[-1].get("time/total_timesteps")) or 0)
             last_return = _float(rows[-1].get("charts/episodic_return"))
