@@ -16,14 +16,17 @@
 #   1. step-size (2 x 5) and kl-estimators (3 x 5), PATRPO: ~16 min a run            ~6.5 core-hours
 #   2. MP-DQN, P-DQN and PAPPO tuned, 3 x 5 x 300k (beyond the paper): ~9 min a run beside another
 #                                                                            ~2.3 core-hours
+#      (done on 2026-11-29 with HyAR-TD3's cpu preset; its "HyAR-TD3 remap" arm, 5 x 300k at ~12 min a run
+#      beside another, was added that day and runs first at the next start)   ~1 core-hour
 #   2b. SB3's SAC and DQN through pamdp's wrappers, 2 x 3 x 100k (a baseline from a mainstream library): a SAC
 #       run with SB3's defaults took over 38 min beside another on 2026-11-29 (not resumable mid-run)
 #                                                                            ~2 core-hours
 #       (these two go before soccer's PATRPO arm because they finish within one session and so give recorded
 #       results at its end; a soccer run takes more than a session whatever the order)
 #   3. the PATRPO arm of platform (done) and soccer (3 x 5M): a soccer epoch of 50 000 samples with
-#      {400, 300, 200} networks takes ~95 s of one idle core (the chain-analytic KL's Fisher-vector products
-#      pass pi_c over all 3 actions: 1.4 s each per 10 000 samples), so ~2.6 h a run  ~9 core-hours
+#      {400, 300, 200} networks took ~95 s of one idle core (the chain-analytic KL's Fisher-vector products
+#      pass pi_c over all 3 actions: 1.4 s each per 10 000 samples), so ~2.6 h a run; the Gauss-Newton
+#      products of 2026-11-29 take about a quarter off (benchmarks/fvp_speed.md)      ~7 core-hours
 #   4. platform's PADDPG arm, paper preset, 5 x 1M (~3 h a run alone, ~5 h beside another): also issue 5's
 #      benchmark, so it goes before PASVG(0)'s arm to close that issue first    ~25 core-hours
 #   5. PADDPG with Hausknecht & Stone's preset on Platform, 1 seed x 300k (issue 5), beside step 4  ~4 core-hours

@@ -137,6 +137,28 @@ def test_warm_up_acts_uniformly_and_its_latents_are_reencoded():
     assert torch.all(m.actor.high > m.actor.low) and torch.equal(m.actor.low, m.actor_target.low)
 
 
+@pytest.mark.parametrize("remap", [True, False])
+def test_lsc_remap_keeps_the_actors_latents_when_the_box_moves(remap):
+    m = model(bound="invert", lsc_remap=remap)
+    m.learn(400, progress_bar=False)
+    assert m.pretrained
+    obs = torch.from_numpy(np.random.default_rng(1).uniform(0, 1, size=(50, 9)).astype(np.float32))
+    with torch.no_grad():
+        before = [actor.to_latent(actor(obs)) for actor in (m.actor, m.actor_target)]
+        box = m.actor.low.clone(), m.actor.high.clone()
+        for p in m.rep.parameters():  # a representation that has moved: its latents, and so the box, change
+            p.mul_(1.5)
+    m.train_representation(0)  # no update; new bounds from the changed representation
+    assert not torch.allclose(m.actor.low, box[0]) and not torch.allclose(m.actor.high, box[1])
+    with torch.no_grad():
+        after = [actor.to_latent(actor(obs)) for actor in (m.actor, m.actor_target)]
+    for b, a in zip(before, after):
+        if remap:
+            torch.testing.assert_close(a, b, atol=1e-5, rtol=1e-5)
+        else:
+            assert (a - b).abs().max() > 1e-2
+
+
 def test_epsilon_draws_embeddings_uniformly_and_anneals():
     m = model(warmup_steps=1, epsilon_start=1.0, epsilon_end=0.2, epsilon_steps=1000, exploration_noise=0.0)
     assert (m.epsilon(0), m.epsilon(500), m.epsilon(10**6)) == (1.0, pytest.approx(0.6), pytest.approx(0.2))
@@ -267,6 +289,7 @@ def test_actor_gradient_through_the_latent_box_matches_finite_differences(bound)
         ({"kl_weight": -1.0}, "kl_weight = -1.0"),
         ({"epsilon_start": 1.5}, "epsilon_start = 1.5"),
         ({"bound": "zero"}, "bound = 'zero'"),
+        ({"lsc_remap": True}, "lsc_remap = True.*squash"),
     ],
 )
 def test_bad_settings_raise_errors_naming_the_value(kwargs, match):

@@ -89,6 +89,11 @@ class HyARConfig(AlgoConfig):
         96.0, "Latent space constraint: the central percentage of replayed latents the actor may reach (assumed: 96)."
     )
     lsc_samples: int = setting(5_000, "Replayed transitions encoded to compute the latent bounds.")
+    lsc_remap: bool = setting(
+        False,
+        "When a representation round moves the latent box, rescale the actor's linear output layer so that its "
+        "latents stay where they were, instead of moving with the box (needs bound='invert'; not in the paper).",
+    )
     relabel: str = setting(
         "invalid", "Representation shift correction: invalid (re-encode stale latents), all (every one) or none."
     )
@@ -134,6 +139,11 @@ class HyARConfig(AlgoConfig):
         self._check(self.relabel in RELABEL, "relabel", f"one of {', '.join(RELABEL)}")
         self._check(0 < self.lsc_percent <= 100, "lsc_percent", "a percentage in (0, 100]")
         self._check(self.relabel_tolerance >= 0, "relabel_tolerance", "a non-negative distance")
+        self._check(
+            not self.lsc_remap or self.bound == "invert",
+            "lsc_remap",
+            "False with bound='squash' (a Tanh output cannot be rescaled exactly)",
+        )
         for name in ("kl_weight", "dynamics_weight", "exploration_noise", "target_noise", "target_noise_clip"):
             self._check(getattr(self, name) >= 0, name, "a non-negative number")
         self._check(0 <= self.epsilon_start <= 1, "epsilon_start", "a probability")
@@ -409,15 +419,27 @@ class HyAR(Algorithm):
                 self.rep_optimizer.step()
                 for k, v in terms.items():
                     sums[k] += v
-        self.update_bounds()
+        self.update_bounds(remap=self.config.lsc_remap and self.pretrained)
         return {f"losses/vae_{k}": v / max(updates, 1) for k, v in sums.items()}
 
     @torch.no_grad()
-    def update_bounds(self) -> None:
-        """The latent space constraint: the central ``lsc_percent`` % of the latents of replayed actions."""
+    def update_bounds(self, remap: bool = False) -> None:
+        """The latent space constraint: the central ``lsc_percent`` % of the latents of replayed actions.
+
+        With ``remap`` the actors' linear output layers are rescaled so that every output maps to the same latent
+        in the new box as in the old: ``u' = u * w / w' + 2 (low - low') / w' + w / w' - 1`` per dimension
+        (``w = high - low``); outputs that land outside ``[-1, 1]`` are pushed back by the inverting gradients.
+        """
         b = self.replay.sample(min(self.config.lsc_samples, len(self.replay)), self.np_rng)
         low, high = latent_bounds(self.rep.latent(b["obs"], b["a"], b["x"]), self.config.lsc_percent)
         for actor in (self.actor, self.actor_target):
+            if remap:
+                width, new_width = actor.high - actor.low, high - low
+                scale = width / new_width
+                shift = 2.0 * (actor.low - low) / new_width + scale - 1.0
+                out = actor.net[-1]
+                out.weight.mul_(scale[:, None])
+                out.bias.mul_(scale).add_(shift)
             actor.low.copy_(low)
             actor.high.copy_(high)
 
