@@ -9,8 +9,9 @@ What a user who cannot use a parameterized-action algorithm would do: SAC on the
 grid (``DiscretizeHybridAction``: each action's parameter on ``--bins`` values), both with SB3's default
 settings, one torch thread per run. Each run ends with a greedy evaluation over 1000 episodes (the same
 count as pamdp's benchmarks). Results per run go to ``DIR/mainstream_platform/ALGO/seedN/result.json``;
-finished runs are skipped when the script runs again (an interrupted run starts over: SB3 keeps no
-mid-run checkpoint here). Writes ``benchmarks/mainstream_platform.md`` with the command, date and machine.
+finished runs are skipped when the script runs again, and an interrupted run resumes from its last checkpoint
+(model and replay buffer every 10 000 steps; the resumed run's random streams differ from an uninterrupted
+one's). Writes ``benchmarks/mainstream_platform.md`` with the command, date and machine.
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ import concurrent.futures as cf
 import datetime as dt
 import json
 import multiprocessing
+import os
 import statistics
 import subprocess
 import sys
@@ -54,20 +56,49 @@ def greedy_return(model, env, episodes: int, seed: int) -> float:
     return total / episodes
 
 
+CHECKPOINT_EVERY = 10_000  # env steps between checkpoints of a run (model, replay buffer, training time)
+
+
 def run(algo: str, seed: int, steps: int, bins: int, out: str) -> dict:
     import torch
     from stable_baselines3 import DQN, SAC
+    from stable_baselines3.common.callbacks import BaseCallback
 
     torch.set_num_threads(1)
-    result_file = Path(out) / "result.json"
+    out = Path(out)
+    result_file = out / "result.json"
     if result_file.exists():
         return json.loads(result_file.read_text())
-    Path(out).mkdir(parents=True, exist_ok=True)
+    out.mkdir(parents=True, exist_ok=True)
     cls = SAC if algo == "SAC" else DQN
-    model = cls("MlpPolicy", make_env(algo, bins), seed=seed, verbose=0)
+    model_file, buffer_file, clock_file = out / "checkpoint.zip", out / "replay.pkl", out / "checkpoint.json"
+    if model_file.exists() and buffer_file.exists() and clock_file.exists():  # resume an interrupted run
+        model = cls.load(model_file, env=make_env(algo, bins))
+        model.load_replay_buffer(buffer_file)
+        trained = json.loads(clock_file.read_text())["train_seconds"]
+    else:
+        model = cls("MlpPolicy", make_env(algo, bins), seed=seed, verbose=0)
+        trained = 0.0
     t0 = time.time()
-    model.learn(steps)
-    seconds = time.time() - t0
+
+    class Checkpoint(BaseCallback):
+        """Every CHECKPOINT_EVERY steps: the model, its replay buffer and the training time, each file replaced
+        atomically, the clock last (a resume needs all three)."""
+
+        def _on_step(self) -> bool:
+            if self.num_timesteps % CHECKPOINT_EVERY == 0 and self.num_timesteps < steps:
+                self.model.save(out / "checkpoint.tmp.zip")
+                os.replace(out / "checkpoint.tmp.zip", model_file)
+                self.model.save_replay_buffer(out / "replay.tmp.pkl")
+                os.replace(out / "replay.tmp.pkl", buffer_file)
+                clock = {"train_seconds": trained + time.time() - t0, "steps": self.num_timesteps}
+                (out / "checkpoint.tmp.json").write_text(json.dumps(clock))
+                os.replace(out / "checkpoint.tmp.json", clock_file)
+            return True
+
+    # Counting on from the checkpoint keeps the schedules (DQN's exploration) where an uninterrupted run has them.
+    model.learn(steps - model.num_timesteps, reset_num_timesteps=False, callback=Checkpoint())
+    seconds = trained + time.time() - t0
     result = {
         "algo": algo,
         "seed": seed,
@@ -77,6 +108,8 @@ def run(algo: str, seed: int, steps: int, bins: int, out: str) -> dict:
         "greedy_return": greedy_return(model, make_env(algo, bins), 1000, 10_000 + seed),
     }
     result_file.write_text(json.dumps(result, indent=2))
+    for f in (model_file, buffer_file, clock_file):  # the replay buffer is large; the result is what stays
+        f.unlink(missing_ok=True)
     return result
 
 
