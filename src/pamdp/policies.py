@@ -133,12 +133,15 @@ class HybridPolicy(nn.Module):
         """``pi_c``'s mean for the (batched) one-hot actions ``onehot`` (any leading shape)."""
         return self.pi_c(torch.cat([obs, onehot], dim=-1))
 
-    def forward(self, obs: torch.Tensor) -> HybridDistribution:
-        """The distribution at ``obs`` ``(B, obs_dim)``, with ``pi_c`` evaluated for every action in one pass."""
+    def _every_action(self, obs: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        """``obs`` ``(B, obs_dim)`` repeated for each action, ``(B, K, obs_dim)``, beside the one-hots ``(B, K, K)``."""
         batch = obs.shape[0]
         eye = torch.eye(self.n_actions, dtype=obs.dtype, device=obs.device)
-        obs_k = obs.unsqueeze(1).expand(batch, self.n_actions, self.obs_dim)
-        means = self.param_means(obs_k, eye.expand(batch, -1, -1))
+        return obs.unsqueeze(1).expand(batch, self.n_actions, self.obs_dim), eye.expand(batch, -1, -1)
+
+    def forward(self, obs: torch.Tensor) -> HybridDistribution:
+        """The distribution at ``obs`` ``(B, obs_dim)``, with ``pi_c`` evaluated for every action in one pass."""
+        means = self.param_means(*self._every_action(obs))
         return HybridDistribution(self.pi_d(obs), means, self.log_std, self.mask)
 
     def linearize(
@@ -149,12 +152,8 @@ class HybridPolicy(nn.Module):
         The product takes parameter tangents by name (``dict(self.named_parameters())``'s keys) and returns the
         tangents of ``(logits (B, K), means (B, K, m), log_std (K, m))``, the distribution's own parameters.
         """
-        batch = obs.shape[0]
-        eye = torch.eye(self.n_actions, dtype=obs.dtype, device=obs.device)
-        inputs_c = torch.cat(
-            [obs.unsqueeze(1).expand(batch, self.n_actions, self.obs_dim), eye.expand(batch, -1, -1)], -1
-        )
-        lin_d, lin_c = LinearizedMLP(self.pi_d, obs), LinearizedMLP(self.pi_c, inputs_c)
+        lin_d = LinearizedMLP(self.pi_d, obs)
+        lin_c = LinearizedMLP(self.pi_c, torch.cat(self._every_action(obs), dim=-1))
         names_d = [f"pi_d.{n}" for n, _ in self.pi_d.named_parameters()]
         names_c = [f"pi_c.{n}" for n, _ in self.pi_c.named_parameters()]
 

@@ -14,6 +14,7 @@ import torch
 __all__ = [
     "flat_params",
     "set_flat_params",
+    "split_flat",
     "flat_grad",
     "FisherVectorProduct",
     "GaussNewtonFVP",
@@ -28,26 +29,37 @@ def flat_params(params: Sequence[torch.Tensor]) -> torch.Tensor:
     return torch.cat([p.detach().reshape(-1) for p in params])
 
 
-def set_flat_params(params: Sequence[torch.Tensor], flat: torch.Tensor) -> None:
-    """Write a flat vector back into the parameters, in place."""
-    offset = 0
-    with torch.no_grad():
-        for p in params:
-            n = p.numel()
-            p.copy_(flat[offset : offset + n].view_as(p))
-            offset += n
+def split_flat(flat: torch.Tensor, params: Sequence[torch.Tensor]) -> list[torch.Tensor]:
+    """A flat vector as views shaped like ``params``, in order (the inverse of :func:`flat_params`)."""
+    views, offset = [], 0
+    for p in params:
+        views.append(flat[offset : offset + p.numel()].view_as(p))
+        offset += p.numel()
     if offset != flat.numel():
         raise ValueError(f"flat vector has {flat.numel()} entries, the parameters {offset}")
+    return views
+
+
+def set_flat_params(params: Sequence[torch.Tensor], flat: torch.Tensor) -> None:
+    """Write a flat vector back into the parameters, in place."""
+    views = split_flat(flat, params)
+    with torch.no_grad():
+        for p, v in zip(params, views):
+            p.copy_(v)
 
 
 def flat_grad(
-    output: torch.Tensor,
+    output: torch.Tensor | Sequence[torch.Tensor],
     params: Sequence[torch.Tensor],
     create_graph: bool = False,
     retain_graph: bool | None = None,
+    grad_outputs: Sequence[torch.Tensor] | None = None,
 ) -> torch.Tensor:
-    """``d output / d params`` as one vector (zeros for parameters the output does not depend on)."""
-    grads = torch.autograd.grad(output, params, create_graph=create_graph, retain_graph=retain_graph, allow_unused=True)
+    """``d output / d params`` as one vector (zeros for parameters the output does not depend on); for several
+    outputs, the vector-Jacobian product with ``grad_outputs``."""
+    grads = torch.autograd.grad(
+        output, params, grad_outputs, create_graph=create_graph, retain_graph=retain_graph, allow_unused=True
+    )
     return torch.cat([(torch.zeros_like(p) if g is None else g).reshape(-1) for g, p in zip(grads, params)])
 
 
@@ -101,14 +113,8 @@ class GaussNewtonFVP:
         self.damping = float(damping)
 
     def __call__(self, v: torch.Tensor) -> torch.Tensor:
-        tangents, offset = [], 0
-        for p in self.params:
-            tangents.append(v[offset : offset + p.numel()].view_as(p))
-            offset += p.numel()
-        cotangents = self.metric(*self.jvp(tangents))
-        grads = torch.autograd.grad(self.outputs, self.params, cotangents, retain_graph=True, allow_unused=True)
-        flat = torch.cat([(torch.zeros_like(p) if g is None else g).reshape(-1) for g, p in zip(grads, self.params)])
-        return flat + self.damping * v
+        cotangents = self.metric(*self.jvp(split_flat(v, self.params)))
+        return flat_grad(self.outputs, self.params, retain_graph=True, grad_outputs=cotangents) + self.damping * v
 
 
 def conjugate_gradient(
