@@ -120,3 +120,38 @@ def test_clipped_step_clips_the_gradient_norm_before_stepping(max_norm, expected
     w.grad = torch.tensor([3.0, 4.0])  # norm 5
     clipped_step(torch.optim.SGD([w], lr=1.0), [w], max_norm)
     assert float(w.detach().norm()) == pytest.approx(expected_norm)
+
+
+def test_epoch_stats_average_each_figure_over_the_updates_that_computed_it():
+    """A figure computed every third update (a delayed actor step) is the mean of those steps, not diluted."""
+    from pamdp.algos.base import make_vector_env
+    from pamdp.algos.offpolicy import OffPolicyLoop
+    from pamdp.spaces import HybridActionSpace
+
+    env = make_vector_env("pamdp/Platform-v0", 4)
+    hybrid = HybridActionSpace.from_gym(env.single_action_space)
+    fields = {
+        "obs": ((env.single_observation_space.shape[0],), np.float32),
+        "a": ((), np.int64),
+        "x": ((hybrid.max_param_size,), np.float32),
+        "reward": ((), np.float32),
+        "next_obs": ((env.single_observation_space.shape[0],), np.float32),
+        "terminated": ((), np.bool_),
+    }
+    loop = OffPolicyLoop(hybrid, ReplayBuffer(1000, fields))
+    calls = []
+
+    def act(obs, step, episode_start):
+        n = len(obs)
+        return torch.zeros(n, dtype=torch.long), torch.zeros(n, hybrid.max_param_size), {}
+
+    def update():
+        calls.append(len(calls))
+        i = calls[-1]
+        return {"every": float(i), **({"third": float(10 * i)} if i % 3 == 0 else {})}
+
+    rng = np.random.default_rng(0)
+    stats = loop.run_epoch(env, act, update, 40, 0, 0, 1.0, rng)
+    assert stats["train/updates"] == len(calls) >= 40
+    assert stats["every"] == pytest.approx(np.mean(calls))
+    assert stats["third"] == pytest.approx(np.mean([10 * i for i in calls if i % 3 == 0]))

@@ -320,14 +320,6 @@ class HyAR(Algorithm):
         self.loop = OffPolicyLoop(h, self.replay, cfg.gamma)
         self.pretrained = False  # the warm-up round of representation training is done
         self.n_updates = 0  # TD3 updates so far (the policy delay and the representation rounds count them)
-        # The latest values of the losses computed only every few updates, reported with every update so that the
-        # epoch's averages are over one kind of step each.
-        self._latest = {
-            "losses/actor_loss": 0.0,
-            "losses/vae_recon": 0.0,
-            "losses/vae_kl": 0.0,
-            "losses/vae_dynamics": 0.0,
-        }
 
     def _modules(self):
         return {
@@ -472,14 +464,15 @@ class HyAR(Algorithm):
     def _update(self) -> dict[str, float]:
         """One TD3 critic step (on relabelled latents), a delayed actor step, and representation rounds when due."""
         cfg = self.config
+        stats: dict[str, float] = {}  # what this update computed; the loop averages each figure over its own steps
         if not self.pretrained:
-            self._latest.update(self.train_representation(cfg.warmup_updates))
+            stats.update(self.train_representation(cfg.warmup_updates))
             self._reencode_replay()
             self.pretrained = True
         self.n_updates += 1
         interval = max(1, round(cfg.vae_interval * cfg.updates_per_step))
         if self.n_updates % interval == 0 and cfg.vae_updates > 0:
-            self._latest.update(self.train_representation(cfg.vae_updates))
+            stats.update(self.train_representation(cfg.vae_updates))
 
         b = self.replay.sample(cfg.batch_size, self.np_rng)
         obs, next_obs = b["obs"], b["next_obs"]
@@ -495,7 +488,6 @@ class HyAR(Algorithm):
         self.critic_optimizer.zero_grad(set_to_none=True)
         critic_loss.backward()
         clipped_step(self.critic_optimizer, self.critic.parameters(), cfg.grad_clip)
-        stats = dict(self._latest)
         stats.update(
             {
                 "losses/critic_loss": float(critic_loss.detach()),
@@ -509,5 +501,5 @@ class HyAR(Algorithm):
             clipped_step(self.actor_optimizer, self.actor.net.parameters(), cfg.grad_clip)
             soft_update(self.critic_target, self.critic, cfg.tau)
             soft_update(self.actor_target.net, self.actor.net, cfg.tau)
-            stats["losses/actor_loss"] = self._latest["losses/actor_loss"] = float(-q_mu.mean())
+            stats["losses/actor_loss"] = float(-q_mu.mean())
         return stats

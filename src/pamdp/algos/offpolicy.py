@@ -38,6 +38,8 @@ __all__ = [
 
 # act(obs (N, d) tensor, global step, episode_start (N,) bool) -> (a (N,), x (N, m) in [-1, 1], extra fields)
 ActFn = Callable[[torch.Tensor, int, np.ndarray], tuple[torch.Tensor, torch.Tensor, dict[str, np.ndarray]]]
+# update() -> the figures it computed; an epoch's stats average each one over the updates that returned it, so a
+# figure computed every few updates (a delayed actor step, a representation round) is the mean of those steps.
 UpdateFn = Callable[[], dict[str, float]]
 
 
@@ -155,6 +157,7 @@ class OffPolicyLoop:
             self._start(env, np_rng)
         counts = np.zeros(self.hybrid.n_actions, dtype=np.int64)
         sums: dict[str, float] = {}
+        reported: dict[str, int] = {}  # per key: the updates that computed it (some run every few updates only)
         n_updates = n_valid = 0
         while n_valid < n_samples:
             obs = np.asarray(self.obs, dtype=np.float32)
@@ -189,11 +192,12 @@ class OffPolicyLoop:
                         self.update_credit -= 1.0
                         for k, v in update().items():
                             sums[k] = sums.get(k, 0.0) + v
+                            reported[k] = reported.get(k, 0) + 1
                         n_updates += 1
             self.episode_start = ~valid
             self.prev_done = done
             self.obs = next_obs
-        stats = {k: v / n_updates for k, v in sums.items()}
+        stats = {k: v / reported[k] for k, v in sums.items()}
         stats["train/updates"] = float(n_updates)
         stats["train/buffer_size"] = float(len(self.buffer))
         stats.update({f"train/action_freq_{k}": float(c) / n_valid for k, c in enumerate(counts)})

@@ -326,7 +326,6 @@ class PASVG0(Algorithm):
             critic_params += list(self.critic2.parameters())
         self.critic_params = critic_params
         self.critic_updates = 0  # for policy_delay
-        self._policy_stats: dict[str, float] = {}
         # fused: one kernel per step instead of a dozen foreach passes, about 3x faster on a CPU.
         self.policy_params = [p for p in self.policy.parameters() if p.requires_grad]
         self.policy_optimizer = torch.optim.Adam(self.policy_params, lr=cfg.policy_lr, fused=True)
@@ -445,13 +444,10 @@ class PASVG0(Algorithm):
         critic_loss.backward()
         clipped_step(self.critic_optimizer, self.critic_params, cfg.grad_clip)
         self.critic_updates += 1
+        stats = {"losses/critic_loss": float(critic_loss.detach()), "train/q_mean": float(q.detach().mean())}
         if self.critic_updates % cfg.policy_delay == 0:
-            self._policy_stats = self._policy_update(obs, b)
-        return {
-            "losses/critic_loss": float(critic_loss.detach()),
-            "train/q_mean": float(q.detach().mean()),
-            **self._policy_stats,
-        }
+            stats.update(self._policy_update(obs, b))
+        return stats
 
     def _policy_update(self, obs: torch.Tensor, b: dict[str, torch.Tensor]) -> dict[str, float]:
         """The value-gradient step of pi_d and pi_c, the entropy weight's step and the soft target updates."""
