@@ -3,7 +3,8 @@
 Each table sits between two marker comments, ``<!-- settings:NAME start -->`` and
 ``<!-- settings:NAME end -->``, where ``NAME`` is a config class below; everything between the markers is
 replaced. A row per ``dataclasses.fields(Config)``: the name, the type, the default, the value in each
-preset that differs from the default (blank where it does not), and the field's ``metadata["help"]``.
+preset that differs from the default (blank where it does not), the field's ``metadata["help"]`` and the values
+its ``metadata["check"]`` accepts.
 
     python docs/gen_settings.py            # rewrite docs/algorithms.md in place
     python docs/gen_settings.py --check    # exit 1 if the tables are out of date (for CI)
@@ -25,6 +26,7 @@ from pamdp.algos.pasvg import PASVG0Config
 from pamdp.algos.patrpo import PATRPOConfig
 from pamdp.algos.pdqn import PDQNConfig
 
+UNCONSTRAINED = {bool: "True or False", int: "any integer", float: "any finite number"}
 CONFIGS = {c.__name__: c for c in (PATRPOConfig, PAPPOConfig, PASVG0Config, PADDPGConfig, PDQNConfig, HyARConfig)}
 DOC = Path(__file__).with_name("algorithms.md")
 BLOCK = re.compile(r"(<!-- settings:(\w+) start -->\n)(.*?)(<!-- settings:\2 end -->)", re.DOTALL)
@@ -51,7 +53,7 @@ def table(config_class) -> str:
     differing = {n: p for n, p in presets.items() if p != default}
     same = [n for n in presets if n not in differing]
     hints = typing.get_type_hints(config_class)
-    head = ["setting", "type", "default", *(f"`{n}`" for n in differing), "meaning"]
+    head = ["setting", "type", "default", *(f"`{n}`" for n in differing), "meaning", "valid"]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for f in dataclasses.fields(config_class):
         base = getattr(default, f.name)
@@ -60,6 +62,8 @@ def table(config_class) -> str:
             v = getattr(p, f.name)
             cells.append(f"`{_value(v)}`" if v != base else "")
         cells.append(f.metadata.get("help", "").replace("|", "\\|"))
+        check = f.metadata.get("check")
+        cells.append(check.expected if check else UNCONSTRAINED.get(hints[f.name], "any"))
         lines.append("| " + " | ".join(cells) + " |")
     if same:
         names = ", ".join(f"`{n}`" for n in same)

@@ -68,13 +68,14 @@ def _add_config_flags(parser: argparse.ArgumentParser, config_class) -> None:
         if f.name == "seed":
             continue
         hint = hints[f.name]
+        check = f.metadata.get("check")
         group.add_argument(
             "--" + f.name.replace("_", "-"),
             dest="cfg_" + f.name,
             type=lambda s, h=hint: _parse_value(s, h),
             default=None,
             metavar=f.name.upper(),
-            help=f.metadata.get("help", ""),
+            help=f.metadata.get("help", "") + (f" Valid: {check.expected}." if check else ""),
         )
 
 

@@ -35,18 +35,66 @@ import pamdp
 from pamdp.algos import MODULE_OF
 from pamdp.spaces import HybridActionSpace
 
-__all__ = ["AlgoConfig", "Algorithm", "setting", "load_model", "make_vector_env", "EpisodeTracker", "Logger"]
+__all__ = [
+    "AlgoConfig",
+    "Algorithm",
+    "setting",
+    "Check",
+    "at_least",
+    "interval",
+    "one_of",
+    "POSITIVE",
+    "NON_NEGATIVE",
+    "LAYERS",
+    "load_model",
+    "make_vector_env",
+    "EpisodeTracker",
+    "Logger",
+]
 
 FINAL_MODEL = "final_model.pt"
 CHECKPOINT = "checkpoint.pt"
 _FORMAT = "pamdp-checkpoint"
 
 
-def setting(default: Any, help: str) -> Any:
-    """A documented dataclass field: the ``help`` text is the field's documentation and its CLI help."""
+@dataclasses.dataclass(frozen=True)
+class Check:
+    """A setting's valid values: ``ok(value)`` says whether a value is one, ``expected`` says which in words
+    (the error message's "expected ..." and the settings tables' "valid" column)."""
+
+    ok: Callable[[Any], bool]
+    expected: str
+
+
+def at_least(n: int) -> Check:
+    return Check(lambda v: v >= n, f"an integer >= {n}")
+
+
+def interval(low: float, high: float, low_open: bool = False, high_open: bool = False) -> Check:
+    """Numbers between ``low`` and ``high``, each end included unless it is open."""
+    text = f"a number in {'(' if low_open else '['}{low}, {high}{')' if high_open else ']'}"
+    return Check(
+        lambda v: (low < v if low_open else low <= v) and (v < high if high_open else v <= high),
+        text,
+    )
+
+
+def one_of(choices) -> Check:
+    choices = tuple(choices)
+    return Check(lambda v: v in choices, "one of " + ", ".join(repr(c) for c in choices))
+
+
+POSITIVE = Check(lambda v: v > 0, "a positive number")
+NON_NEGATIVE = Check(lambda v: v >= 0, "a non-negative number")
+LAYERS = Check(lambda v: len(v) > 0 and all(h > 0 for h in v), "one or more positive layer sizes")
+
+
+def setting(default: Any, help: str, check: Check | None = None) -> Any:
+    """A documented dataclass field: the ``help`` text is the field's documentation and its CLI help; a
+    config rejects a value that fails ``check`` with an error naming the value and ``check.expected``."""
     if isinstance(default, (list, dict)):
         raise TypeError("use tuples for sequence settings, so that configs stay immutable")
-    return dataclasses.field(default=default, metadata={"help": help})
+    return dataclasses.field(default=default, metadata={"help": help, "check": check})
 
 
 @dataclasses.dataclass(frozen=True)
@@ -55,21 +103,26 @@ class AlgoConfig:
 
     seed: int = setting(0, "Seeds the networks' initialisation, action sampling and the environments.")
     num_envs: int = setting(
-        16, "Copies of the environment stepped together (batched when the env has a vector version)."
+        16, "Copies of the environment stepped together (batched when the env has a vector version).", at_least(1)
     )
-    torch_threads: int = setting(1, "Torch intra-op threads; 1 is fastest for these small networks on a laptop CPU.")
+    torch_threads: int = setting(
+        1, "Torch intra-op threads; 1 is fastest for these small networks on a laptop CPU.", at_least(1)
+    )
     vector_mode: str = setting(
-        "auto", "How env copies are stepped: batched, sync (scalar copies in turn) or auto (batched from 48 copies)."
+        "auto",
+        "How env copies are stepped: batched, sync (scalar copies in turn) or auto (batched from 48 copies).",
+        one_of(("auto", "batched", "sync")),
     )
 
     def __post_init__(self):
+        """Each setting against its ``check`` (in declaration order); subclasses add checks across settings."""
         for f in dataclasses.fields(self):
             value = getattr(self, f.name)
             if isinstance(value, float) and not math.isfinite(value):
                 raise ValueError(f"{type(self).__name__}.{f.name} = {value!r}; expected a finite number")
-        self._check(self.num_envs >= 1, "num_envs", "an integer >= 1")
-        self._check(self.torch_threads >= 1, "torch_threads", "an integer >= 1")
-        self._check(self.vector_mode in ("auto", "batched", "sync"), "vector_mode", "'auto', 'batched' or 'sync'")
+            check = f.metadata.get("check")
+            if check is not None:
+                self._check(check.ok(value), f.name, check.expected)
 
     def _check(self, ok: bool, name: str, expected: str) -> None:
         if not ok:

@@ -47,7 +47,17 @@ import torch
 import torch.nn.functional as F
 from torch import nn
 
-from pamdp.algos.base import AlgoConfig, Algorithm, setting
+from pamdp.algos.base import (
+    LAYERS,
+    NON_NEGATIVE,
+    POSITIVE,
+    AlgoConfig,
+    Algorithm,
+    at_least,
+    interval,
+    one_of,
+    setting,
+)
 from pamdp.algos.offpolicy import OffPolicyLoop, clipped_step, linear_epsilon, soft_update
 from pamdp.algos.paddpg import backprop_actor
 from pamdp.algos.replay import ReplayBuffer
@@ -64,100 +74,106 @@ class HyARConfig(AlgoConfig):
     """HyAR-TD3's settings. The defaults are the ``paper`` preset: the paper's schedule, with TD3's published
     settings (Fujimoto et al. 2018) where the text available here gives none; assumptions are marked."""
 
-    num_envs: int = setting(8, "Copies of the env stepped together; learning per sample is set by updates_per_step.")
-    embed_dim: int = setting(6, "Size of a discrete action's embedding, d1 (assumed: 6).")
-    latent_dim: int = setting(6, "Size of the parameters' latent z, d2 (assumed: 6).")
-    vae_hidden_sizes: tuple[int, ...] = setting((256, 256), "Hidden layers of the VAE's encoder and decoder (assumed).")
-    hidden_sizes: tuple[int, ...] = setting((256, 256), "Hidden layers of the actor and each critic (TD3's: 256-256).")
-    activation: str = setting("relu", "Hidden activation: relu, leaky_relu, tanh or elu.")
+    num_envs: int = setting(
+        8, "Copies of the env stepped together; learning per sample is set by updates_per_step.", at_least(1)
+    )
+    embed_dim: int = setting(6, "Size of a discrete action's embedding, d1 (assumed: 6).", at_least(1))
+    latent_dim: int = setting(6, "Size of the parameters' latent z, d2 (assumed: 6).", at_least(1))
+    vae_hidden_sizes: tuple[int, ...] = setting(
+        (256, 256), "Hidden layers of the VAE's encoder and decoder (assumed).", LAYERS
+    )
+    hidden_sizes: tuple[int, ...] = setting(
+        (256, 256), "Hidden layers of the actor and each critic (TD3's: 256-256).", LAYERS
+    )
+    activation: str = setting("relu", "Hidden activation: relu, leaky_relu, tanh or elu.", one_of(ACTIVATIONS))
     bound: str = setting(
         "squash",
         "Keeping the actor's output in [-1, 1]: squash (Tanh, the paper) or invert (a linear output and Hausknecht "
         "& Stone's inverting gradients, which do not stall where Tanh saturates).",
+        one_of(("squash", "invert")),
     )
-    kl_weight: float = setting(1.0, "Weight of the VAE's KL term (the paper's loss: 1).")
-    dynamics_weight: float = setting(1.0, "Weight of the state-change prediction loss, beta (assumed: 1).")
-    vae_lr: float = setting(1e-4, "Adam learning rate of the embedding table and the VAE (assumed: 1e-4).")
-    vae_batch_size: int = setting(64, "Transitions per representation update (assumed: 64).")
+    kl_weight: float = setting(1.0, "Weight of the VAE's KL term (the paper's loss: 1).", NON_NEGATIVE)
+    dynamics_weight: float = setting(
+        1.0, "Weight of the state-change prediction loss, beta (assumed: 1).", NON_NEGATIVE
+    )
+    vae_lr: float = setting(1e-4, "Adam learning rate of the embedding table and the VAE (assumed: 1e-4).", POSITIVE)
+    vae_batch_size: int = setting(64, "Transitions per representation update (assumed: 64).", at_least(1))
     warmup_steps: int = setting(
-        11_000, "Samples of uniformly random actions before learning (the paper: 5000 episodes; ~11 000 on Platform)."
+        11_000,
+        "Samples of uniformly random actions before learning (the paper: 5000 episodes; ~11 000 on Platform).",
+        at_least(1),
     )
-    warmup_updates: int = setting(5_000, "Representation updates on the warm-up data before TD3 starts (assumed).")
-    vae_interval: int = setting(1_000, "Samples between rounds of representation training during TD3 (assumed).")
-    vae_updates: int = setting(10, "Representation updates per round (assumed).")
+    warmup_updates: int = setting(
+        5_000, "Representation updates on the warm-up data before TD3 starts (assumed).", at_least(0)
+    )
+    vae_interval: int = setting(
+        1_000, "Samples between rounds of representation training during TD3 (assumed).", at_least(1)
+    )
+    vae_updates: int = setting(10, "Representation updates per round (assumed).", at_least(0))
     lsc_percent: float = setting(
-        96.0, "Latent space constraint: the central percentage of replayed latents the actor may reach (assumed: 96)."
+        96.0,
+        "Latent space constraint: the central percentage of replayed latents the actor may reach (assumed: 96).",
+        interval(0, 100, low_open=True),
     )
-    lsc_samples: int = setting(5_000, "Replayed transitions encoded to compute the latent bounds.")
+    lsc_samples: int = setting(5_000, "Replayed transitions encoded to compute the latent bounds.", at_least(1))
     lsc_remap: bool = setting(
         False,
         "When a representation round moves the latent box, rescale the actor's linear output layer so that its "
         "latents stay where they were, instead of moving with the box (needs bound='invert'; not in the paper).",
     )
     relabel: str = setting(
-        "invalid", "Representation shift correction: invalid (re-encode stale latents), all (every one) or none."
+        "invalid",
+        "Representation shift correction: invalid (re-encode stale latents), all (every one) or none.",
+        one_of(RELABEL),
     )
     relabel_tolerance: float = setting(
         0.1,
         "A replayed latent is stale if its decoded parameters differ by more than this, in [-1, 1] units (assumed).",
+        NON_NEGATIVE,
     )
-    actor_lr: float = setting(3e-4, "Adam learning rate of the actor (TD3: 3e-4).")
-    critic_lr: float = setting(3e-4, "Adam learning rate of the critics (TD3: 3e-4).")
-    grad_clip: float = setting(0.0, "Clip each network's gradient norm to this; 0 turns clipping off (TD3: off).")
-    batch_size: int = setting(128, "Transitions per TD3 update (assumed: 128).")
-    gamma: float = setting(0.99, "Discount factor.")
-    tau: float = setting(0.005, "Soft target-update rate (TD3: 0.005).")
-    exploration_noise: float = setting(0.1, "Std of the Gaussian noise on the actor's [-1, 1] output (TD3: 0.1).")
+    actor_lr: float = setting(3e-4, "Adam learning rate of the actor (TD3: 3e-4).", POSITIVE)
+    critic_lr: float = setting(3e-4, "Adam learning rate of the critics (TD3: 3e-4).", POSITIVE)
+    grad_clip: float = setting(
+        0.0, "Clip each network's gradient norm to this; 0 turns clipping off (TD3: off).", NON_NEGATIVE
+    )
+    batch_size: int = setting(128, "Transitions per TD3 update (assumed: 128).", at_least(1))
+    gamma: float = setting(0.99, "Discount factor.", interval(0, 1))
+    tau: float = setting(0.005, "Soft target-update rate (TD3: 0.005).", interval(0, 1, low_open=True))
+    exploration_noise: float = setting(
+        0.1, "Std of the Gaussian noise on the actor's [-1, 1] output (TD3: 0.1).", NON_NEGATIVE
+    )
     epsilon_start: float = setting(
         0.0,
         "Chance at the start of replacing the actor's embedding by a uniformly drawn action's (not in the paper: 0).",
+        interval(0, 1),
     )
-    epsilon_end: float = setting(0.0, "That chance after epsilon_steps samples (falling linearly).")
-    epsilon_steps: int = setting(50_000, "Samples over which the embedding's epsilon falls to epsilon_end.")
-    target_noise: float = setting(0.2, "Std of the target policy smoothing noise, [-1, 1] units (TD3: 0.2).")
-    target_noise_clip: float = setting(0.5, "Clip of the target policy smoothing noise (TD3: 0.5).")
-    policy_delay: int = setting(2, "Critic updates per actor and target update (TD3: 2).")
-    buffer_size: int = setting(1_000_000, "Replay capacity.")
-    updates_per_step: float = setting(1.0, "Update-to-data ratio: TD3 updates (critics) per environment sample.")
-    epoch_steps: int = setting(10_000, "Samples per epoch, the unit of logging and checkpoints.")
+    epsilon_end: float = setting(0.0, "That chance after epsilon_steps samples (falling linearly).", interval(0, 1))
+    epsilon_steps: int = setting(
+        50_000, "Samples over which the embedding's epsilon falls to epsilon_end.", at_least(1)
+    )
+    target_noise: float = setting(
+        0.2, "Std of the target policy smoothing noise, [-1, 1] units (TD3: 0.2).", NON_NEGATIVE
+    )
+    target_noise_clip: float = setting(0.5, "Clip of the target policy smoothing noise (TD3: 0.5).", NON_NEGATIVE)
+    policy_delay: int = setting(2, "Critic updates per actor and target update (TD3: 2).", at_least(1))
+    buffer_size: int = setting(1_000_000, "Replay capacity.", at_least(1))
+    updates_per_step: float = setting(
+        1.0, "Update-to-data ratio: TD3 updates (critics) per environment sample.", POSITIVE
+    )
+    epoch_steps: int = setting(10_000, "Samples per epoch, the unit of logging and checkpoints.", at_least(1))
     save_replay: bool = setting(
         True, "Store the replay contents in checkpoints (the representation's training data); else a resume refills it."
     )
 
     def __post_init__(self):
+        """The checks across settings (each setting's own runs in AlgoConfig)."""
         super().__post_init__()
-        for name in ("hidden_sizes", "vae_hidden_sizes"):
-            sizes = getattr(self, name)
-            self._check(len(sizes) > 0 and all(h > 0 for h in sizes), name, "positive layer sizes")
-        for name in ("embed_dim", "latent_dim", "vae_batch_size", "vae_interval", "lsc_samples", "batch_size"):
-            self._check(getattr(self, name) >= 1, name, "an integer >= 1")
-        for name in ("warmup_updates", "vae_updates"):
-            self._check(getattr(self, name) >= 0, name, "a non-negative integer")
-        self._check(self.warmup_steps >= 1, "warmup_steps", "an integer >= 1 (the representation needs data)")
-        self._check(self.activation in ACTIVATIONS, "activation", f"one of {', '.join(ACTIVATIONS)}")
-        self._check(self.bound in ("squash", "invert"), "bound", "'squash' or 'invert'")
-        self._check(self.relabel in RELABEL, "relabel", f"one of {', '.join(RELABEL)}")
-        self._check(0 < self.lsc_percent <= 100, "lsc_percent", "a percentage in (0, 100]")
-        self._check(self.relabel_tolerance >= 0, "relabel_tolerance", "a non-negative distance")
         self._check(
             not self.lsc_remap or self.bound == "invert",
             "lsc_remap",
             "False with bound='squash' (a Tanh output cannot be rescaled exactly)",
         )
-        for name in ("kl_weight", "dynamics_weight", "exploration_noise", "target_noise", "target_noise_clip"):
-            self._check(getattr(self, name) >= 0, name, "a non-negative number")
-        self._check(0 <= self.epsilon_start <= 1, "epsilon_start", "a probability")
-        self._check(0 <= self.epsilon_end <= 1, "epsilon_end", "a probability")
-        self._check(self.epsilon_steps >= 1, "epsilon_steps", "an integer >= 1")
-        for name in ("vae_lr", "actor_lr", "critic_lr"):
-            self._check(getattr(self, name) > 0, name, "a positive learning rate")
-        self._check(self.grad_clip >= 0, "grad_clip", "a non-negative norm (0: off)")
-        self._check(0 <= self.gamma <= 1, "gamma", "a number in [0, 1]")
-        self._check(0 < self.tau <= 1, "tau", "a number in (0, 1]")
-        self._check(self.policy_delay >= 1, "policy_delay", "an integer >= 1")
         self._check(self.buffer_size >= self.warmup_steps, "buffer_size", f">= warmup_steps ({self.warmup_steps})")
-        self._check(self.updates_per_step > 0, "updates_per_step", "a positive ratio")
-        self._check(self.epoch_steps >= 1, "epoch_steps", "an integer >= 1")
 
     @classmethod
     def presets(cls) -> dict[str, HyARConfig]:

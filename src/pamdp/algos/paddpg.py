@@ -33,7 +33,17 @@ import torch
 import torch.nn.functional as F
 from torch import nn
 
-from pamdp.algos.base import AlgoConfig, Algorithm, setting
+from pamdp.algos.base import (
+    LAYERS,
+    NON_NEGATIVE,
+    POSITIVE,
+    AlgoConfig,
+    Algorithm,
+    at_least,
+    interval,
+    one_of,
+    setting,
+)
 from pamdp.algos.offpolicy import OffPolicyLoop, OUNoise, clipped_step, linear_epsilon, mixed_target, soft_update
 from pamdp.algos.replay import ReplayBuffer
 from pamdp.policies import ACTIVATIONS, mlp
@@ -51,62 +61,61 @@ class PADDPGConfig(AlgoConfig):
     ``paper_hfo``; Hausknecht & Stone's own 1024-512-256-128 towers: preset ``hausknecht_stone``)."""
 
     num_envs: int = setting(
-        8, "Copies of the env stepped together; learning per sample is set by updates_per_step, not by this."
+        8,
+        "Copies of the env stepped together; learning per sample is set by updates_per_step, not by this.",
+        at_least(1),
     )
     hidden_sizes: tuple[int, ...] = setting(
-        (400, 300), "Hidden layers of the actor and the critic (paper: {400, 300})."
+        (400, 300), "Hidden layers of the actor and the critic (paper: {400, 300}).", LAYERS
     )
-    activation: str = setting("leaky_relu", "Hidden activation: leaky_relu (slope 0.01, Hausknecht & Stone), relu, ...")
-    bound: str = setting("invert", "Keeping outputs in [-1, 1]: invert (inverting gradients), squash (Tanh) or zero.")
-    actor_lr: float = setting(1e-5, "Adam learning rate of the actor (Hausknecht & Stone: 1e-5).")
-    critic_lr: float = setting(1e-3, "Adam learning rate of the critic (Hausknecht & Stone: 1e-3).")
-    adam_beta1: float = setting(0.95, "Adam's beta1 for both networks (Hausknecht & Stone: 0.95).")
-    grad_clip: float = setting(10.0, "Clip each network's gradient norm to this; 0 turns clipping off (H&S: 10).")
-    batch_size: int = setting(32, "Transitions per gradient update (Hausknecht & Stone: 32).")
-    gamma: float = setting(0.99, "Discount factor.")
-    tau: float = setting(0.001, "Soft target-update rate: target <- tau * online + (1 - tau) * target.")
+    activation: str = setting(
+        "leaky_relu", "Hidden activation: leaky_relu (slope 0.01, Hausknecht & Stone), relu, ...", one_of(ACTIVATIONS)
+    )
+    bound: str = setting(
+        "invert", "Keeping outputs in [-1, 1]: invert (inverting gradients), squash (Tanh) or zero.", one_of(BOUNDS)
+    )
+    actor_lr: float = setting(1e-5, "Adam learning rate of the actor (Hausknecht & Stone: 1e-5).", POSITIVE)
+    critic_lr: float = setting(1e-3, "Adam learning rate of the critic (Hausknecht & Stone: 1e-3).", POSITIVE)
+    adam_beta1: float = setting(
+        0.95, "Adam's beta1 for both networks (Hausknecht & Stone: 0.95).", interval(0, 1, high_open=True)
+    )
+    grad_clip: float = setting(
+        10.0, "Clip each network's gradient norm to this; 0 turns clipping off (H&S: 10).", NON_NEGATIVE
+    )
+    batch_size: int = setting(32, "Transitions per gradient update (Hausknecht & Stone: 32).", at_least(1))
+    gamma: float = setting(0.99, "Discount factor.", interval(0, 1))
+    tau: float = setting(
+        0.001, "Soft target-update rate: target <- tau * online + (1 - tau) * target.", interval(0, 1, low_open=True)
+    )
     beta: float = setting(
-        0.2, "Weight of the Monte-Carlo return in the target (H&S: 0.2 to 0.5); 0 gives DDPG's pure TD target."
+        0.2,
+        "Weight of the Monte-Carlo return in the target (H&S: 0.2 to 0.5); 0 gives DDPG's pure TD target.",
+        interval(0, 1),
     )
-    epsilon_start: float = setting(1.0, "Exploration rate at the start: the chance of a uniformly random output.")
-    epsilon_end: float = setting(0.1, "Exploration rate after the annealing.")
-    epsilon_steps: int = setting(100_000, "Environment samples over which epsilon falls linearly to epsilon_end.")
-    ou_sigma: float = setting(0.0, "Scale of Ornstein-Uhlenbeck noise on the actor's parameters; 0 turns it off.")
-    ou_theta: float = setting(0.15, "Mean reversion of the Ornstein-Uhlenbeck noise (DDPG's 0.15).")
-    buffer_size: int = setting(500_000, "Replay capacity (Hausknecht & Stone: 500 000).")
+    epsilon_start: float = setting(
+        1.0, "Exploration rate at the start: the chance of a uniformly random output.", interval(0, 1)
+    )
+    epsilon_end: float = setting(0.1, "Exploration rate after the annealing.", interval(0, 1))
+    epsilon_steps: int = setting(
+        100_000, "Environment samples over which epsilon falls linearly to epsilon_end.", at_least(1)
+    )
+    ou_sigma: float = setting(
+        0.0, "Scale of Ornstein-Uhlenbeck noise on the actor's parameters; 0 turns it off.", NON_NEGATIVE
+    )
+    ou_theta: float = setting(
+        0.15, "Mean reversion of the Ornstein-Uhlenbeck noise (DDPG's 0.15).", interval(0, 1, low_open=True)
+    )
+    buffer_size: int = setting(500_000, "Replay capacity (Hausknecht & Stone: 500 000).", at_least(1))
     learning_starts: int = setting(
-        10_000, "Samples in the replay buffer before the first update (the seed paper: 10^4)."
+        10_000, "Samples in the replay buffer before the first update (the seed paper: 10^4).", at_least(0)
     )
-    updates_per_step: float = setting(1.0, "Update-to-data ratio: gradient updates per environment sample.")
-    epoch_steps: int = setting(10_000, "Samples per epoch, the unit of logging and checkpoints (paper: 10 000).")
+    updates_per_step: float = setting(1.0, "Update-to-data ratio: gradient updates per environment sample.", POSITIVE)
+    epoch_steps: int = setting(
+        10_000, "Samples per epoch, the unit of logging and checkpoints (paper: 10 000).", at_least(1)
+    )
     save_replay: bool = setting(
         False, "Store the replay contents in checkpoints (large); otherwise a resumed run refills the buffer."
     )
-
-    def __post_init__(self):
-        super().__post_init__()
-        self._check(
-            len(self.hidden_sizes) > 0 and all(h > 0 for h in self.hidden_sizes), "hidden_sizes", "positive layer sizes"
-        )
-        self._check(self.activation in ACTIVATIONS, "activation", f"one of {', '.join(ACTIVATIONS)}")
-        self._check(self.bound in BOUNDS, "bound", f"one of {', '.join(BOUNDS)}")
-        self._check(self.actor_lr > 0, "actor_lr", "a positive learning rate")
-        self._check(self.critic_lr > 0, "critic_lr", "a positive learning rate")
-        self._check(0 <= self.adam_beta1 < 1, "adam_beta1", "a number in [0, 1)")
-        self._check(self.grad_clip >= 0, "grad_clip", "a non-negative norm (0: off)")
-        self._check(self.batch_size >= 1, "batch_size", "an integer >= 1")
-        self._check(0 <= self.gamma <= 1, "gamma", "a number in [0, 1]")
-        self._check(0 < self.tau <= 1, "tau", "a number in (0, 1]")
-        self._check(0 <= self.beta <= 1, "beta", "a number in [0, 1]")
-        self._check(0 <= self.epsilon_start <= 1, "epsilon_start", "a probability")
-        self._check(0 <= self.epsilon_end <= 1, "epsilon_end", "a probability")
-        self._check(self.epsilon_steps >= 1, "epsilon_steps", "an integer >= 1")
-        self._check(self.ou_sigma >= 0, "ou_sigma", "a non-negative scale")
-        self._check(0 < self.ou_theta <= 1, "ou_theta", "a number in (0, 1]")
-        self._check(self.buffer_size >= 1, "buffer_size", "an integer >= 1")
-        self._check(self.learning_starts >= 0, "learning_starts", "a non-negative integer")
-        self._check(self.updates_per_step > 0, "updates_per_step", "a positive ratio")
-        self._check(self.epoch_steps >= 1, "epoch_steps", "an integer >= 1")
 
     @classmethod
     def presets(cls) -> dict[str, PADDPGConfig]:

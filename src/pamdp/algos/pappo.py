@@ -30,7 +30,7 @@ import dataclasses
 
 import torch
 
-from pamdp.algos.base import AlgoConfig, setting
+from pamdp.algos.base import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, at_least, interval, one_of, setting
 from pamdp.algos.patrpo import OnPolicyHybrid, Rollout
 from pamdp.distributions import HybridDistribution, kl_divergence
 from pamdp.policies import ACTIVATIONS, HybridPolicy, ValueNetwork
@@ -47,61 +47,63 @@ class PAPPOConfig(AlgoConfig):
     num_envs: int = setting(
         64,
         "Copies of the env stepped together (batched from 48 on, twice as fast as 32 scalar copies on Platform).",
+        at_least(1),
     )
-    hidden_sizes: tuple[int, ...] = setting((64, 64), "Hidden layers of pi_d and pi_c (each its own network).")
-    activation: str = setting("tanh", "Hidden activation of the policies: tanh (PPO's usual), relu, leaky_relu or elu.")
+    hidden_sizes: tuple[int, ...] = setting((64, 64), "Hidden layers of pi_d and pi_c (each its own network).", LAYERS)
+    activation: str = setting(
+        "tanh", "Hidden activation of the policies: tanh (PPO's usual), relu, leaky_relu or elu.", one_of(ACTIVATIONS)
+    )
     init_log_std: float = setting(0.0, "Initial log-std of the parameter noise, in [-1, 1] units.")
-    batch_size: int = setting(4096, "Samples per epoch, collected with the current policy before its update.")
-    n_epochs: int = setting(10, "Passes over each batch; more reuse per sample, and more drift from pi_old.")
+    batch_size: int = setting(
+        4096, "Samples per epoch, collected with the current policy before its update.", at_least(1)
+    )
+    n_epochs: int = setting(
+        10, "Passes over each batch; more reuse per sample, and more drift from pi_old.", at_least(1)
+    )
     minibatch_size: int = setting(
-        256, "Samples per gradient step (the batch is split into equal minibatches of about this size)."
+        256, "Samples per gradient step (the batch is split into equal minibatches of about this size).", at_least(1)
     )
-    lr: float = setting(3e-4, "Adam learning rate of the policy and the value network (one optimiser, one loss).")
+    lr: float = setting(
+        3e-4, "Adam learning rate of the policy and the value network (one optimiser, one loss).", POSITIVE
+    )
     clip_range: float = setting(
-        0.2, "eps: the ratio pi / pi_old is clipped to [1 - eps, 1 + eps] in the surrogate; 0.1-0.3 is usual."
+        0.2,
+        "eps: the ratio pi / pi_old is clipped to [1 - eps, 1 + eps] in the surrogate; 0.1-0.3 is usual.",
+        interval(0, 1, low_open=True, high_open=True),
     )
-    gamma: float = setting(0.99, "Discount factor.")
-    gae_lambda: float = setting(0.95, "GAE lambda: lower trades bias for less variance in the advantages.")
+    gamma: float = setting(0.99, "Discount factor.", interval(0, 1))
+    gae_lambda: float = setting(
+        0.95, "GAE lambda: lower trades bias for less variance in the advantages.", interval(0, 1)
+    )
     ent_coef_d: float = setting(
         0.01,
         "Weight of pi_d's entropy in the loss: keeps every discrete action tried. Platform needs 0.3; at 0.01-0.1 "
         "pi_d turns deterministic within ~150k samples and the return stays at 0.80-0.90.",
+        NON_NEGATIVE,
     )
     ent_coef_c: float = setting(
         0.0,
         "Weight of the parameter policy's entropy (expected over pi_d) in the loss; it only widens the noise.",
+        NON_NEGATIVE,
     )
-    vf_coef: float = setting(0.5, "Weight of the value loss E[(V(s) - R)^2] in the joint loss.")
-    max_grad_norm: float = setting(0.5, "Clip the joint gradient's norm to this before each Adam step.")
+    vf_coef: float = setting(0.5, "Weight of the value loss E[(V(s) - R)^2] in the joint loss.", POSITIVE)
+    max_grad_norm: float = setting(0.5, "Clip the joint gradient's norm to this before each Adam step.", POSITIVE)
     target_kl: float = setting(
         0.0,
         "Stop an epoch's passes once a minibatch's chain-rule KL(pi_old || pi) exceeds this (0: never; 0.01-0.05).",
+        NON_NEGATIVE,
     )
     normalize_advantages: bool = setting(True, "Standardise advantages within the batch.")
-    vf_hidden_sizes: tuple[int, ...] = setting((64, 64), "Hidden layers of the value network.")
+    vf_hidden_sizes: tuple[int, ...] = setting((64, 64), "Hidden layers of the value network.", LAYERS)
 
     def __post_init__(self):
+        """The checks across settings (each setting's own runs in AlgoConfig)."""
         super().__post_init__()
-        for name in ("hidden_sizes", "vf_hidden_sizes"):
-            sizes = getattr(self, name)
-            self._check(len(sizes) > 0 and all(h > 0 for h in sizes), name, "positive layer sizes")
-        self._check(self.activation in ACTIVATIONS, "activation", f"one of {', '.join(ACTIVATIONS)}")
-        self._check(self.batch_size >= 1, "batch_size", "an integer >= 1")
-        self._check(self.n_epochs >= 1, "n_epochs", "an integer >= 1")
         self._check(
-            1 <= self.minibatch_size <= self.batch_size,
+            self.minibatch_size <= self.batch_size,
             "minibatch_size",
             f"an integer in [1, batch_size={self.batch_size}]",
         )
-        self._check(self.lr > 0, "lr", "a positive learning rate")
-        self._check(0 < self.clip_range < 1, "clip_range", "a number in (0, 1)")
-        self._check(0 <= self.gamma <= 1, "gamma", "a number in [0, 1]")
-        self._check(0 <= self.gae_lambda <= 1, "gae_lambda", "a number in [0, 1]")
-        self._check(self.ent_coef_d >= 0, "ent_coef_d", "a non-negative weight")
-        self._check(self.ent_coef_c >= 0, "ent_coef_c", "a non-negative weight")
-        self._check(self.vf_coef > 0, "vf_coef", "a positive weight")
-        self._check(self.max_grad_norm > 0, "max_grad_norm", "a positive norm")
-        self._check(self.target_kl >= 0, "target_kl", "a non-negative KL (0: no early stop)")
 
     @classmethod
     def presets(cls) -> dict[str, PAPPOConfig]:

@@ -34,7 +34,18 @@ import torch
 import torch.nn.functional as F
 from torch import nn
 
-from pamdp.algos.base import AlgoConfig, Algorithm, setting
+from pamdp.algos.base import (
+    LAYERS,
+    NON_NEGATIVE,
+    POSITIVE,
+    AlgoConfig,
+    Algorithm,
+    Check,
+    at_least,
+    interval,
+    one_of,
+    setting,
+)
 from pamdp.algos.offpolicy import OffPolicyLoop, clipped_step, soft_update
 from pamdp.algos.replay import ReplayBuffer
 from pamdp.policies import ACTIVATIONS, mlp
@@ -50,39 +61,48 @@ class PASVG0Config(AlgoConfig):
     """PASVG(0)'s settings; the defaults are the paper's preset (DDPG's where the paper says nothing)."""
 
     num_envs: int = setting(
-        8, "Copies of the env stepped together; learning per sample is set by updates_per_step, not by this."
+        8,
+        "Copies of the env stepped together; learning per sample is set by updates_per_step, not by this.",
+        at_least(1),
     )
     hidden_sizes: tuple[int, ...] = setting(
-        (400, 300), "Hidden layers of pi_d, pi_c and the critic (paper: {400, 300})."
+        (400, 300), "Hidden layers of pi_d, pi_c and the critic (paper: {400, 300}).", LAYERS
     )
-    activation: str = setting("relu", "Hidden activation: relu (paper), tanh, leaky_relu or elu.")
+    activation: str = setting("relu", "Hidden activation: relu (paper), tanh, leaky_relu or elu.", one_of(ACTIVATIONS))
     temperature: float = setting(
-        1.0, "Gumbel-Softmax temperature t (paper: 1.0, fixed); lower is less biased, higher less noisy."
+        1.0, "Gumbel-Softmax temperature t (paper: 1.0, fixed); lower is less biased, higher less noisy.", POSITIVE
     )
     straight_through: bool = setting(
         True,
         "The critic sees the hard one-hot (straight-through gradient); false: the soft Gumbel-Softmax sample.",
     )
     init_log_std: float = setting(
-        -0.5, "Initial log-std of the parameter noise, added before pi_c's Tanh (so x stays in [-1, 1])."
+        -0.5,
+        "Initial log-std of the parameter noise, added before pi_c's Tanh (so x stays in [-1, 1]).",
+        interval(LOG_STD_MIN, LOG_STD_MAX),
     )
     learn_std: bool = setting(True, "Train the parameter noise's log-std by the value gradient too (SVG); else fixed.")
     entropy_coef: float = setting(
         0.0,
         "Weight of pi_d's entropy in the policy loss (0 in the paper); keeps the discrete choice exploring. "
         "With target_entropy set, the weight's starting value.",
+        NON_NEGATIVE,
     )
     target_entropy: float | None = setting(
         None,
         "If set, the entropy weight is tuned (as in SAC) to hold pi_d's mean entropy at this many nats, "
         "between 0 and ln K; None keeps entropy_coef fixed.",
+        Check(lambda v: v is None or v >= 0, "None or a non-negative entropy in nats"),
     )
-    entropy_lr: float = setting(3e-4, "Adam learning rate of the log entropy weight when target_entropy is set.")
+    entropy_lr: float = setting(
+        3e-4, "Adam learning rate of the log entropy weight when target_entropy is set.", POSITIVE
+    )
     explore_epsilon: float = setting(
         0.0,
         "While collecting, the fraction of steps whose discrete action is drawn uniformly instead of from pi_d "
         "(with pi_c's parameters for it), so that every action keeps appearing in replay; 0 in the paper. "
         "The policy update does not see it: it replays the recorded noise through the current policy.",
+        interval(0, 1),
     )
     discrete_gradient: str = setting(
         "gumbel",
@@ -90,6 +110,7 @@ class PASVG0Config(AlgoConfig):
         "sample; expected takes the exact expectation over the K actions, sum_k pi_d(k|s) Q(s, k, x_k), in the "
         "policy loss and in the TD target (pi_c's parameters for every action from the same recorded eta_x): "
         "no estimator bias and lower variance, at K critic evaluations per state. Not in the paper.",
+        one_of(("gumbel", "expected")),
     )
     twin_critics: bool = setting(
         False,
@@ -97,58 +118,47 @@ class PASVG0Config(AlgoConfig):
         "(TD3's clipped double Q, against overestimation); the policy follows the first. Not in the paper.",
     )
     policy_delay: int = setting(
-        1, "Critic updates per policy update (and soft target update); TD3 uses 2. 1 in the paper."
+        1, "Critic updates per policy update (and soft target update); TD3 uses 2. 1 in the paper.", at_least(1)
     )
-    critic_lr: float = setting(1e-3, "Adam learning rate of the critic (paper: 1e-3).")
-    policy_lr: float = setting(1e-5, "Adam learning rate of pi_d and pi_c (paper: 1e-5, which learns slowly).")
-    batch_size: int = setting(64, "Transitions per gradient update (DDPG's 64; the paper does not say).")
-    gamma: float = setting(0.99, "Discount factor.")
-    tau: float = setting(0.001, "Soft target-update rate (DDPG's 0.001): target <- tau * online + (1 - tau) * target.")
-    grad_clip: float = setting(0.0, "Clip each network's gradient norm to this before a step; 0 turns clipping off.")
+    critic_lr: float = setting(1e-3, "Adam learning rate of the critic (paper: 1e-3).", POSITIVE)
+    policy_lr: float = setting(
+        1e-5, "Adam learning rate of pi_d and pi_c (paper: 1e-5, which learns slowly).", POSITIVE
+    )
+    batch_size: int = setting(64, "Transitions per gradient update (DDPG's 64; the paper does not say).", at_least(1))
+    gamma: float = setting(0.99, "Discount factor.", interval(0, 1))
+    tau: float = setting(
+        0.001,
+        "Soft target-update rate (DDPG's 0.001): target <- tau * online + (1 - tau) * target.",
+        interval(0, 1, low_open=True),
+    )
+    grad_clip: float = setting(
+        0.0, "Clip each network's gradient norm to this before a step; 0 turns clipping off.", NON_NEGATIVE
+    )
     buffer_size: int = setting(
-        10_000_000, "Replay capacity (paper: 10^7); memory grows with the contents, not the capacity."
+        10_000_000, "Replay capacity (paper: 10^7); memory grows with the contents, not the capacity.", at_least(1)
     )
-    learning_starts: int = setting(10_000, "Samples in the replay buffer before the first update (paper: 10^4).")
+    learning_starts: int = setting(
+        10_000, "Samples in the replay buffer before the first update (paper: 10^4).", at_least(0)
+    )
     updates_per_step: float = setting(
-        1.0, "Update-to-data ratio: gradient updates (critic and policy) per environment sample."
+        1.0, "Update-to-data ratio: gradient updates (critic and policy) per environment sample.", POSITIVE
     )
-    epoch_steps: int = setting(10_000, "Samples per epoch, the unit of logging and checkpoints (paper: 10 000).")
+    epoch_steps: int = setting(
+        10_000, "Samples per epoch, the unit of logging and checkpoints (paper: 10 000).", at_least(1)
+    )
     save_replay: bool = setting(
         False, "Store the replay contents in checkpoints (large); otherwise a resumed run refills the buffer."
     )
 
     def __post_init__(self):
+        """The checks across settings (each setting's own runs in AlgoConfig)."""
         super().__post_init__()
-        self._check(
-            len(self.hidden_sizes) > 0 and all(h > 0 for h in self.hidden_sizes), "hidden_sizes", "positive layer sizes"
-        )
-        self._check(self.activation in ACTIVATIONS, "activation", f"one of {', '.join(ACTIVATIONS)}")
-        self._check(self.temperature > 0, "temperature", "a positive number")
-        self._check(
-            LOG_STD_MIN <= self.init_log_std <= LOG_STD_MAX, "init_log_std", f"in [{LOG_STD_MIN}, {LOG_STD_MAX}]"
-        )
-        self._check(self.entropy_coef >= 0, "entropy_coef", "a non-negative number")
         if self.target_entropy is not None:
-            self._check(self.target_entropy >= 0, "target_entropy", "None or a non-negative entropy in nats")
             self._check(self.entropy_coef > 0, "entropy_coef", "a positive starting weight when target_entropy is set")
-        self._check(self.entropy_lr > 0, "entropy_lr", "a positive learning rate")
-        self._check(0 <= self.explore_epsilon <= 1, "explore_epsilon", "a probability in [0, 1]")
-        self._check(self.discrete_gradient in ("gumbel", "expected"), "discrete_gradient", "'gumbel' or 'expected'")
         if self.discrete_gradient == "expected":
             self._check(
                 self.straight_through, "straight_through", "True with discrete_gradient 'expected' (Q sees one-hots)"
             )
-        self._check(self.policy_delay >= 1, "policy_delay", "an integer >= 1")
-        self._check(self.critic_lr > 0, "critic_lr", "a positive learning rate")
-        self._check(self.policy_lr > 0, "policy_lr", "a positive learning rate")
-        self._check(self.batch_size >= 1, "batch_size", "an integer >= 1")
-        self._check(0 <= self.gamma <= 1, "gamma", "a number in [0, 1]")
-        self._check(0 < self.tau <= 1, "tau", "a number in (0, 1]")
-        self._check(self.grad_clip >= 0, "grad_clip", "a non-negative norm (0: off)")
-        self._check(self.buffer_size >= 1, "buffer_size", "an integer >= 1")
-        self._check(self.learning_starts >= 0, "learning_starts", "a non-negative integer")
-        self._check(self.updates_per_step > 0, "updates_per_step", "a positive ratio")
-        self._check(self.epoch_steps >= 1, "epoch_steps", "an integer >= 1")
 
     @classmethod
     def presets(cls) -> dict[str, PASVG0Config]:

@@ -19,7 +19,18 @@ from collections.abc import Callable
 import numpy as np
 import torch
 
-from pamdp.algos.base import AlgoConfig, Algorithm, EpisodeTracker, setting
+from pamdp.algos.base import (
+    LAYERS,
+    NON_NEGATIVE,
+    POSITIVE,
+    AlgoConfig,
+    Algorithm,
+    EpisodeTracker,
+    at_least,
+    interval,
+    one_of,
+    setting,
+)
 from pamdp.algos.trpo import (
     FisherVectorProduct,
     GaussNewtonFVP,
@@ -45,80 +56,76 @@ class PATRPOConfig(AlgoConfig):
     """
 
     num_envs: int = setting(
-        128, "Copies of the env stepped together; PATRPO's samples are on-policy, so more is just faster."
+        128, "Copies of the env stepped together; PATRPO's samples are on-policy, so more is just faster.", at_least(1)
     )
     hidden_sizes: tuple[int, ...] = setting(
-        (200, 100, 50), "Hidden layers of pi_d and pi_c (the paper's {200, 100, 50})."
+        (200, 100, 50), "Hidden layers of pi_d and pi_c (the paper's {200, 100, 50}).", LAYERS
     )
-    activation: str = setting("relu", "Hidden activation of the policies: relu (paper), tanh, leaky_relu or elu.")
+    activation: str = setting(
+        "relu", "Hidden activation of the policies: relu (paper), tanh, leaky_relu or elu.", one_of(ACTIVATIONS)
+    )
     init_log_std: float = setting(0.0, "Initial log-std of the parameter noise, in [-1, 1] units (rllab: std 1).")
-    batch_size: int = setting(10_000, "Samples per epoch (one TRPO update per epoch); the paper uses 10 000.")
+    batch_size: int = setting(
+        10_000, "Samples per epoch (one TRPO update per epoch); the paper uses 10 000.", at_least(1)
+    )
     delta: float = setting(
         0.005,
         "Trust region: the bound on the mean KL(pi_old || pi). Paper: 0.005 (0.01, 0.05 in its step-size figure).",
+        POSITIVE,
     )
     kl_estimator: str = setting(
         "chain_analytic",
         "KL estimator for the constraint: joint_sample, chain_sample or chain_analytic (the paper's preferred).",
+        one_of(KL_ESTIMATORS),
     )
-    cg_iters: int = setting(10, "Conjugate-gradient iterations for the natural-gradient direction.")
+    cg_iters: int = setting(10, "Conjugate-gradient iterations for the natural-gradient direction.", at_least(1))
     fvp_subsample: float = setting(
         1.0,
         "Fraction of the batch for Fisher-vector products (0.1-0.2 is a common speed-up; the line search uses all).",
+        interval(0, 1, low_open=True),
     )
     fvp: str = setting(
         "auto",
         "How Fisher-vector products are computed: gauss_newton (closed-form KL Hessian, 1.4-1.7x faster; exact "
         "for the chain estimators), double_backprop (any estimator), or auto (gauss_newton where it is exact).",
+        one_of(FVP_METHODS),
     )
-    cg_damping: float = setting(1e-5, "Damping added to the Fisher-vector product; raise it if steps are erratic.")
-    backtrack_ratio: float = setting(0.8, "Step shrink factor of the line search.")
-    max_backtracks: int = setting(15, "Line-search tries before the update is abandoned (parameters restored).")
-    gamma: float = setting(0.99, "Discount factor.")
-    gae_lambda: float = setting(1.0, "GAE lambda: 1.0 is rllab's (Monte-Carlo advantages); 0.95-0.99 lowers variance.")
+    cg_damping: float = setting(
+        1e-5, "Damping added to the Fisher-vector product; raise it if steps are erratic.", NON_NEGATIVE
+    )
+    backtrack_ratio: float = setting(
+        0.8, "Step shrink factor of the line search.", interval(0, 1, low_open=True, high_open=True)
+    )
+    max_backtracks: int = setting(
+        15, "Line-search tries before the update is abandoned (parameters restored).", at_least(1)
+    )
+    gamma: float = setting(0.99, "Discount factor.", interval(0, 1))
+    gae_lambda: float = setting(
+        1.0, "GAE lambda: 1.0 is rllab's (Monte-Carlo advantages); 0.95-0.99 lowers variance.", interval(0, 1)
+    )
     entropy_coef: float = setting(
-        0.0, "Weight of the policy entropy added to the surrogate (not in the paper); keeps exploring longer."
+        0.0,
+        "Weight of the policy entropy added to the surrogate (not in the paper); keeps exploring longer.",
+        NON_NEGATIVE,
     )
     normalize_advantages: bool = setting(True, "Standardise advantages within the batch.")
     baseline: str = setting(
         "mlp",
         "Baseline: mlp (a value network, the modern choice) or linear (rllab's linear-feature baseline).",
+        one_of(("mlp", "linear")),
     )
-    vf_hidden_sizes: tuple[int, ...] = setting((64, 64), "Hidden layers of the value network.")
-    vf_lr: float = setting(1e-3, "Adam learning rate of the value network.")
-    vf_epochs: int = setting(5, "Passes over each batch when fitting the value network.")
-    vf_batch_size: int = setting(256, "Minibatch size of the value network's fit.")
+    vf_hidden_sizes: tuple[int, ...] = setting((64, 64), "Hidden layers of the value network.", LAYERS)
+    vf_lr: float = setting(1e-3, "Adam learning rate of the value network.", POSITIVE)
+    vf_epochs: int = setting(5, "Passes over each batch when fitting the value network.", at_least(1))
+    vf_batch_size: int = setting(256, "Minibatch size of the value network's fit.", at_least(1))
 
     def __post_init__(self):
+        """The checks across settings (each setting's own runs in AlgoConfig)."""
         super().__post_init__()
-        self._check(
-            len(self.hidden_sizes) > 0 and all(h > 0 for h in self.hidden_sizes),
-            "hidden_sizes",
-            "positive layer sizes",
-        )
-        self._check(self.activation in ACTIVATIONS, "activation", f"one of {', '.join(ACTIVATIONS)}")
-        self._check(self.batch_size >= 1, "batch_size", "an integer >= 1")
-        self._check(self.delta > 0, "delta", "a positive KL bound")
-        self._check(self.kl_estimator in KL_ESTIMATORS, "kl_estimator", f"one of {', '.join(KL_ESTIMATORS)}")
-        self._check(self.cg_iters >= 1, "cg_iters", "an integer >= 1")
-        self._check(0 < self.fvp_subsample <= 1, "fvp_subsample", "a fraction in (0, 1]")
-        self._check(self.fvp in FVP_METHODS, "fvp", f"one of {', '.join(FVP_METHODS)}")
         self._check(
             not (self.fvp == "gauss_newton" and self.kl_estimator == "joint_sample"),
             "fvp",
             "auto or double_backprop with kl_estimator='joint_sample' (its Hessian has no closed form)",
-        )
-        self._check(self.cg_damping >= 0, "cg_damping", "a non-negative number")
-        self._check(0 < self.backtrack_ratio < 1, "backtrack_ratio", "a number in (0, 1)")
-        self._check(self.max_backtracks >= 1, "max_backtracks", "an integer >= 1")
-        self._check(0 <= self.gamma <= 1, "gamma", "a number in [0, 1]")
-        self._check(0 <= self.gae_lambda <= 1, "gae_lambda", "a number in [0, 1]")
-        self._check(self.entropy_coef >= 0, "entropy_coef", "a non-negative weight")
-        self._check(self.baseline in ("mlp", "linear"), "baseline", "'mlp' or 'linear'")
-        self._check(
-            self.vf_lr > 0 and self.vf_epochs >= 1 and self.vf_batch_size >= 1,
-            "vf_lr",
-            "a positive rate (with vf_epochs, vf_batch_size >= 1)",
         )
 
     @classmethod

@@ -37,7 +37,17 @@ import torch
 import torch.nn.functional as F
 from torch import nn
 
-from pamdp.algos.base import AlgoConfig, Algorithm, setting
+from pamdp.algos.base import (
+    LAYERS,
+    NON_NEGATIVE,
+    POSITIVE,
+    AlgoConfig,
+    Algorithm,
+    at_least,
+    interval,
+    one_of,
+    setting,
+)
 from pamdp.algos.offpolicy import OffPolicyLoop, OUNoise, clipped_step, linear_epsilon, mixed_target, soft_update
 from pamdp.algos.paddpg import BOUNDS, backprop_actor
 from pamdp.algos.replay import ReplayBuffer
@@ -54,34 +64,51 @@ class PDQNConfig(AlgoConfig):
     marked as assumptions in the help."""
 
     num_envs: int = setting(
-        8, "Copies of the env stepped together; learning per sample is set by updates_per_step, not by this."
+        8,
+        "Copies of the env stepped together; learning per sample is set by updates_per_step, not by this.",
+        at_least(1),
     )
     multi_pass: bool = setting(
         False, "MP-DQN: Q_k from a pass that sees only action k's parameters; false: P-DQN's joint input."
     )
     hidden_sizes: tuple[int, ...] = setting(
-        (128,), "Hidden layers of the actor and the Q-network (Bester et al. on Platform: one layer of 128)."
+        (128,), "Hidden layers of the actor and the Q-network (Bester et al. on Platform: one layer of 128).", LAYERS
     )
-    activation: str = setting("relu", "Hidden activation: relu, leaky_relu, tanh or elu.")
+    activation: str = setting("relu", "Hidden activation: relu, leaky_relu, tanh or elu.", one_of(ACTIVATIONS))
     bound: str = setting(
-        "invert", "Keeping parameters in [-1, 1]: invert (inverting gradients, Bester et al.), squash (Tanh) or zero."
+        "invert",
+        "Keeping parameters in [-1, 1]: invert (inverting gradients, Bester et al.), squash (Tanh) or zero.",
+        one_of(BOUNDS),
     )
-    q_lr: float = setting(1e-3, "Adam learning rate of the Q-network (Bester et al.: 1e-3).")
-    actor_lr: float = setting(1e-4, "Adam learning rate of the parameter actor (Bester et al. on Platform: 1e-4).")
-    grad_clip: float = setting(10.0, "Clip each network's gradient norm to this; 0 turns clipping off (assumed: 10).")
-    batch_size: int = setting(128, "Transitions per gradient update (Bester et al.: 128).")
-    gamma: float = setting(0.9, "Discount factor (Bester et al. on Platform: 0.9).")
-    tau_q: float = setting(0.1, "Soft target-update rate of the Q-network (Bester et al.: 0.1).")
-    tau_actor: float = setting(0.001, "Soft target-update rate of the actor (Bester et al.: 0.001).")
+    q_lr: float = setting(1e-3, "Adam learning rate of the Q-network (Bester et al.: 1e-3).", POSITIVE)
+    actor_lr: float = setting(
+        1e-4, "Adam learning rate of the parameter actor (Bester et al. on Platform: 1e-4).", POSITIVE
+    )
+    grad_clip: float = setting(
+        10.0, "Clip each network's gradient norm to this; 0 turns clipping off (assumed: 10).", NON_NEGATIVE
+    )
+    batch_size: int = setting(128, "Transitions per gradient update (Bester et al.: 128).", at_least(1))
+    gamma: float = setting(0.9, "Discount factor (Bester et al. on Platform: 0.9).", interval(0, 1))
+    tau_q: float = setting(
+        0.1, "Soft target-update rate of the Q-network (Bester et al.: 0.1).", interval(0, 1, low_open=True)
+    )
+    tau_actor: float = setting(
+        0.001, "Soft target-update rate of the actor (Bester et al.: 0.001).", interval(0, 1, low_open=True)
+    )
     beta: float = setting(
-        0.0, "Weight of the Monte-Carlo return in the Q target, as PADDPG's; 0 (Platform) is the one-step TD target."
+        0.0,
+        "Weight of the Monte-Carlo return in the Q target, as PADDPG's; 0 (Platform) is the one-step TD target.",
+        interval(0, 1),
     )
-    epsilon_start: float = setting(1.0, "Exploration rate at the start: the chance of a uniformly random action.")
-    epsilon_end: float = setting(0.01, "Exploration rate after the annealing (Bester et al.: 0.01).")
+    epsilon_start: float = setting(
+        1.0, "Exploration rate at the start: the chance of a uniformly random action.", interval(0, 1)
+    )
+    epsilon_end: float = setting(0.01, "Exploration rate after the annealing (Bester et al.: 0.01).", interval(0, 1))
     epsilon_steps: int = setting(
         5_000,
         "Environment samples over which epsilon falls linearly to epsilon_end (Bester et al.: 1000 episodes; "
         "Platform's early episodes last 2 to 5 steps).",
+        at_least(1),
     )
     explore_params: bool = setting(
         False,
@@ -89,43 +116,26 @@ class PDQNConfig(AlgoConfig):
         "keeps the actor's, noise included (assumed for Bester et al.).",
     )
     ou_sigma: float = setting(
-        0.0001, "Scale of Ornstein-Uhlenbeck noise on the parameters, in [-1, 1] units (Bester et al.: 1e-4); 0: off."
+        0.0001,
+        "Scale of Ornstein-Uhlenbeck noise on the parameters, in [-1, 1] units (Bester et al.: 1e-4); 0: off.",
+        NON_NEGATIVE,
     )
-    ou_theta: float = setting(0.15, "Mean reversion of the Ornstein-Uhlenbeck noise; 1 gives i.i.d. Gaussian noise.")
-    buffer_size: int = setting(10_000, "Replay capacity (Bester et al. on Platform: 10 000).")
-    learning_starts: int = setting(500, "Samples in the replay buffer before the first update (assumed: 500).")
+    ou_theta: float = setting(
+        0.15,
+        "Mean reversion of the Ornstein-Uhlenbeck noise; 1 gives i.i.d. Gaussian noise.",
+        interval(0, 1, low_open=True),
+    )
+    buffer_size: int = setting(10_000, "Replay capacity (Bester et al. on Platform: 10 000).", at_least(1))
+    learning_starts: int = setting(
+        500, "Samples in the replay buffer before the first update (assumed: 500).", at_least(0)
+    )
     updates_per_step: float = setting(
-        1.0, "Update-to-data ratio: gradient updates (Q-network and actor) per environment sample."
+        1.0, "Update-to-data ratio: gradient updates (Q-network and actor) per environment sample.", POSITIVE
     )
-    epoch_steps: int = setting(10_000, "Samples per epoch, the unit of logging and checkpoints.")
+    epoch_steps: int = setting(10_000, "Samples per epoch, the unit of logging and checkpoints.", at_least(1))
     save_replay: bool = setting(
         False, "Store the replay contents in checkpoints; otherwise a resumed run refills the buffer."
     )
-
-    def __post_init__(self):
-        super().__post_init__()
-        self._check(
-            len(self.hidden_sizes) > 0 and all(h > 0 for h in self.hidden_sizes), "hidden_sizes", "positive layer sizes"
-        )
-        self._check(self.activation in ACTIVATIONS, "activation", f"one of {', '.join(ACTIVATIONS)}")
-        self._check(self.bound in BOUNDS, "bound", f"one of {', '.join(BOUNDS)}")
-        self._check(self.q_lr > 0, "q_lr", "a positive learning rate")
-        self._check(self.actor_lr > 0, "actor_lr", "a positive learning rate")
-        self._check(self.grad_clip >= 0, "grad_clip", "a non-negative norm (0: off)")
-        self._check(self.batch_size >= 1, "batch_size", "an integer >= 1")
-        self._check(0 <= self.gamma <= 1, "gamma", "a number in [0, 1]")
-        self._check(0 < self.tau_q <= 1, "tau_q", "a number in (0, 1]")
-        self._check(0 < self.tau_actor <= 1, "tau_actor", "a number in (0, 1]")
-        self._check(0 <= self.beta <= 1, "beta", "a number in [0, 1]")
-        self._check(0 <= self.epsilon_start <= 1, "epsilon_start", "a probability")
-        self._check(0 <= self.epsilon_end <= 1, "epsilon_end", "a probability")
-        self._check(self.epsilon_steps >= 1, "epsilon_steps", "an integer >= 1")
-        self._check(self.ou_sigma >= 0, "ou_sigma", "a non-negative scale")
-        self._check(0 < self.ou_theta <= 1, "ou_theta", "a number in (0, 1]")
-        self._check(self.buffer_size >= 1, "buffer_size", "an integer >= 1")
-        self._check(self.learning_starts >= 0, "learning_starts", "a non-negative integer")
-        self._check(self.updates_per_step > 0, "updates_per_step", "a positive ratio")
-        self._check(self.epoch_steps >= 1, "epoch_steps", "an integer >= 1")
 
     @classmethod
     def presets(cls) -> dict[str, PDQNConfig]:
