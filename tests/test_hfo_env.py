@@ -229,6 +229,14 @@ def test_render_and_gif(tmp_path):
     assert (tmp_path / "hfo.gif").stat().st_size > 0 and str(path).endswith("hfo.gif")
 
 
+def test_record_episode_rejects_a_path_that_is_not_a_gif_before_playing(tmp_path):
+    env = HalfFieldOffenseEnv(render_mode="rgb_array")
+    played = []
+    with pytest.raises(ValueError, match=r"'.*episode.mp4'; expected a file name ending in .gif"):
+        record_episode(env, lambda obs: played.append(obs) or scripted_scorer(obs), tmp_path / "episode.mp4")
+    assert played == [] and not (tmp_path / "episode.mp4").exists()
+
+
 def test_scripted_scorer_scores_usually():
     env = HalfFieldOffenseEnv()
     goals = 0

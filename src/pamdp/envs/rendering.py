@@ -58,10 +58,16 @@ class Canvas:
             self.circle(x0 + t * (x1 - x0), y0 + t * (y1 - y0), width / 2.0, color)
 
 
+def _check_gif_path(path: str | os.PathLike) -> None:
+    if not os.fspath(path).lower().endswith(".gif"):
+        raise ValueError(f"animation path {os.fspath(path)!r}; expected a file name ending in .gif")
+
+
 def save_gif(frames: Sequence[np.ndarray], path: str | os.PathLike, fps: float = 20.0) -> str:
     """Write ``(H, W, 3)`` uint8 frames to an animated GIF; returns the path."""
     from PIL import Image
 
+    _check_gif_path(path)
     if len(frames) == 0:
         raise ValueError("save_gif needs at least one frame; got an empty sequence")
     images = [Image.fromarray(np.asarray(f, dtype=np.uint8)) for f in frames]
@@ -85,6 +91,7 @@ def record_episode(
     """
     if getattr(env, "render_mode", None) != "rgb_array":
         raise ValueError(f"record_episode needs an env made with render_mode='rgb_array', got {env.render_mode!r}")
+    _check_gif_path(path)  # before the episode, not after it
     obs, _ = env.reset(seed=seed)
     if seed is not None:
         env.action_space.seed(seed)
