@@ -7,6 +7,7 @@ import torch
 
 import pamdp
 from pamdp import PATRPO
+from pamdp.algos.paddpg import PADDPGConfig
 from pamdp.algos.patrpo import LinearFeatureBaseline, PATRPOConfig, gae
 from pamdp.evaluation import evaluate
 
@@ -73,6 +74,15 @@ def test_config_from_dict_rejects_unknown_and_mistyped():
     with pytest.raises(ValueError, match="'batch_size' = 'many'"):
         PATRPOConfig.from_dict({"batch_size": "many"})
     assert PATRPOConfig.from_dict({"hidden_sizes": [8, 8], "delta": 1}).hidden_sizes == (8, 8)
+
+
+def test_config_may_be_a_dict_of_settings_over_the_defaults():
+    model = PATRPO("pamdp/Platform-v0", {"delta": 0.02, "hidden_sizes": [8]})
+    assert model.config == PATRPOConfig(delta=0.02, hidden_sizes=(8,))
+    with pytest.raises(ValueError, match="unknown PATRPOConfig setting"):
+        PATRPO("pamdp/Platform-v0", {"dleta": 0.02})
+    with pytest.raises(ValueError, match="PATRPO needs a PATRPOConfig or a dict of its settings, got PADDPGConfig"):
+        PATRPO("pamdp/Platform-v0", PADDPGConfig())
 
 
 def test_rejects_non_hybrid_action_space():

@@ -405,10 +405,16 @@ class Algorithm:
         super().__init_subclass__(**kwargs)
         _REGISTRY[cls.__name__] = cls
 
-    def __init__(self, env, config: AlgoConfig | None = None, env_kwargs: dict | None = None):
+    def __init__(self, env, config: AlgoConfig | dict | None = None, env_kwargs: dict | None = None):
+        """``config``: the algorithm's config, or a dict of settings over the defaults (``{"delta": 0.01}``)."""
         config = self.config_class() if config is None else config
+        if isinstance(config, dict):
+            config = self.config_class.from_dict(config)
         if not isinstance(config, self.config_class):
-            raise ValueError(f"{type(self).__name__} needs a {self.config_class.__name__}, got {type(config).__name__}")
+            raise ValueError(
+                f"{type(self).__name__} needs a {self.config_class.__name__} or a dict of its settings, "
+                f"got {type(config).__name__}"
+            )
         self.config = config
         env_id, spec_kwargs, obs_space, act_space = _describe_env(env, env_kwargs)
         self.env_id = env_id
