@@ -263,25 +263,33 @@ def _describe_env(env, env_kwargs: dict | None = None) -> tuple[str | None, dict
 
 
 class EpisodeTracker:
-    """Running return and length per env copy; completed episodes are kept until :meth:`pop`."""
+    """Running return and length per env copy; completed episodes are kept until :meth:`pop`.
+
+    Where the env reports an episode's outcome as ``info["status"]`` (Half Field Offense: ``"GOAL"``,
+    ``"OUT_OF_BOUNDS"``, ...), the goal rate and the mean length of scoring episodes are kept too, the training
+    counterparts of :func:`pamdp.evaluation.evaluate`'s ``goal_rate`` and ``mean_steps_to_goal``.
+    """
 
     def __init__(self, num_envs: int):
         self.returns = np.zeros(num_envs)
         self.lengths = np.zeros(num_envs, dtype=np.int64)
         self.done_returns: list[float] = []
         self.done_lengths: list[int] = []
+        self.done_goals: list[bool] = []  # only for envs that report info["status"]
 
     def reset(self) -> None:
         self.returns[:] = 0.0
         self.lengths[:] = 0
 
-    def step(self, rewards: np.ndarray, dones: np.ndarray, valid: np.ndarray) -> None:
+    def step(self, rewards: np.ndarray, dones: np.ndarray, valid: np.ndarray, info: dict | None = None) -> None:
         """Add one vector step; ``valid`` is false for the autoreset steps of Gymnasium's vector envs."""
         self.returns += np.where(valid, rewards, 0.0)
         self.lengths += valid
         ended = dones & valid
         self.done_returns += self.returns[ended].tolist()
         self.done_lengths += self.lengths[ended].tolist()
+        if info is not None and "status" in info and ended.any():
+            self.done_goals += [str(s) == "GOAL" for s in np.asarray(info["status"], dtype=object)[ended]]
         self.returns[ended] = 0.0
         self.lengths[ended] = 0
 
@@ -294,7 +302,12 @@ class EpisodeTracker:
             "charts/episodic_length": float(np.mean(self.done_lengths)),
             "charts/episodes": float(len(self.done_returns)),
         }
-        self.done_returns, self.done_lengths = [], []
+        if self.done_goals:
+            goals = np.array(self.done_goals)
+            stats["charts/goal_rate"] = float(goals.mean())
+            if goals.any():
+                stats["charts/steps_to_goal"] = float(np.mean(np.array(self.done_lengths)[goals]))
+        self.done_returns, self.done_lengths, self.done_goals = [], [], []
         return stats
 
 

@@ -164,10 +164,10 @@ class OffPolicyLoop:
             with torch.no_grad():
                 a, x, extras = act(torch.from_numpy(obs), start_step + n_valid, self.episode_start)
             a, x = a.numpy(), x.numpy()
-            next_obs, reward, terminated, truncated, _ = self.env.step(self.hybrid.to_env_batch(a, x))
+            next_obs, reward, terminated, truncated, info = self.env.step(self.hybrid.to_env_batch(a, x))
             valid = ~self.prev_done
             done = (terminated | truncated) & valid
-            self.tracker.step(np.asarray(reward, dtype=np.float64), done, valid)
+            self.tracker.step(np.asarray(reward, dtype=np.float64), done, valid, info)
             if valid.any():
                 row = {
                     "obs": obs[valid],

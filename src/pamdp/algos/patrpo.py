@@ -206,13 +206,13 @@ class Rollout:
         while n_valid < n_samples:
             with torch.no_grad():
                 a, x = policy(torch.as_tensor(np.asarray(obs, dtype=np.float32))).sample(torch_gen)
-            next_obs, reward, terminated, truncated, _ = env.step(hybrid.to_env_batch(a.numpy(), x.numpy()))
+            next_obs, reward, terminated, truncated, info = env.step(hybrid.to_env_batch(a.numpy(), x.numpy()))
             valid = ~prev_done
             done = (terminated | truncated) & valid
             row = (obs, a.numpy(), x.numpy(), reward, terminated & valid, done, valid, next_obs, t_ep)
             for k, v in zip(self.KEYS, row):
                 rows[k].append(np.array(v))
-            self.tracker.step(np.asarray(reward, dtype=np.float64), done, valid)
+            self.tracker.step(np.asarray(reward, dtype=np.float64), done, valid, info)
             n_valid += int(valid.sum())
             t_ep = np.where(valid, t_ep + 1, 0)
             prev_done, obs = done, next_obs
