@@ -187,3 +187,12 @@ def test_a_users_env_given_as_module_and_id_is_imported_for_training_and_for_loa
     assert "cannot import module 'no_such_module_xyz'" in capsys.readouterr().err
     assert main(["train", "patrpo", "--env", "NoSuchEnvXyz-v0", "--out", str(tmp_path / "r3")]) == 2
     assert "env 'NoSuchEnvXyz-v0' is not registered" in capsys.readouterr().err
+
+
+def test_version_is_the_installed_distributions(capsys):
+    from importlib.metadata import version
+
+    with pytest.raises(SystemExit) as exit_info:
+        main(["--version"])
+    assert exit_info.value.code == 0
+    assert capsys.readouterr().out.strip() == f"pamdp {version('pamdp')}"

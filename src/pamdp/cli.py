@@ -18,6 +18,7 @@ import sys
 import typing
 from pathlib import Path
 
+from pamdp import __version__
 from pamdp._memory import keep_freed_memory
 from pamdp.experiments.runner import ALGORITHMS, RunSpec, algorithm_class, default_preset, train_run
 
@@ -92,6 +93,7 @@ def _read_config_file(path: str) -> dict:
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="pamdp", description="Reinforcement learning in parameterized action spaces.")
+    parser.add_argument("--version", action="version", version=f"pamdp {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
 
     train = sub.add_parser("train", help="train an algorithm (default: on Platform) and evaluate it")
