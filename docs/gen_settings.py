@@ -4,7 +4,7 @@ Each table sits between two marker comments, ``<!-- settings:NAME start -->`` an
 ``<!-- settings:NAME end -->``, where ``NAME`` is a config class below; everything between the markers is
 replaced. A row per ``dataclasses.fields(Config)``: the name, the type, the default, the value in each
 preset that differs from the default (blank where it does not), the field's ``metadata["help"]`` and the values
-its ``metadata["check"]`` accepts.
+its check accepts (``Config.check_of(name)``).
 
     python docs/gen_settings.py            # rewrite docs/algorithms.md in place
     python docs/gen_settings.py --check    # exit 1 if the tables are out of date (for CI)
@@ -57,12 +57,13 @@ def table(config_class) -> str:
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for f in dataclasses.fields(config_class):
         base = getattr(default, f.name)
-        cells = [f"`{f.name}`", f"`{_type(hints[f.name])}`", f"`{_value(base)}`"]
+        type_cell = _type(hints[f.name]).replace("|", "\\|")  # float | None: not a cell boundary
+        cells = [f"`{f.name}`", f"`{type_cell}`", f"`{_value(base)}`"]
         for p in differing.values():
             v = getattr(p, f.name)
             cells.append(f"`{_value(v)}`" if v != base else "")
         cells.append(f.metadata.get("help", "").replace("|", "\\|"))
-        check = f.metadata.get("check")
+        check = config_class.check_of(f.name)
         cells.append(check.expected if check else UNCONSTRAINED.get(hints[f.name], "any"))
         lines.append("| " + " | ".join(cells) + " |")
     if same:

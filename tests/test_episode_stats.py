@@ -95,3 +95,13 @@ def test_patrpo_logs_the_goal_rate_on_soccer_only():
             2000, progress_bar=False, callback=lambda algo, stats, seen=seen: seen.append(stats)
         )
         assert ("charts/goal_rate" in seen[-1]) == expected, env_id
+
+
+def test_goal_figures_count_only_the_episodes_whose_end_reported_a_status():
+    tracker = EpisodeTracker(1)
+    tracker.step(np.array([0.0]), np.array([True]), np.array([True]))  # no status: not counted for goals
+    tracker.step(np.array([0.0]), np.array([False]), np.array([True]), {"status": ["IN_GAME"]})
+    tracker.step(np.array([1.0]), np.array([True]), np.array([True]), {"status": ["GOAL"]})
+    stats = tracker.pop()
+    assert stats["charts/episodes"] == 2
+    assert stats["charts/goal_rate"] == 1.0 and stats["charts/steps_to_goal"] == 2.0

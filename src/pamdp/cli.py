@@ -69,7 +69,7 @@ def _add_config_flags(parser: argparse.ArgumentParser, config_class) -> None:
         if f.name == "seed":
             continue
         hint = hints[f.name]
-        check = f.metadata.get("check")
+        check = config_class.check_of(f.name)
         group.add_argument(
             "--" + f.name.replace("_", "-"),
             dest="cfg_" + f.name,

@@ -101,7 +101,7 @@ def setting(default: Any, help: str, check: Check | None = None) -> Any:
 class AlgoConfig:
     """Settings every algorithm has. Subclasses add their own and a ``presets()`` table."""
 
-    seed: int = setting(0, "Seeds the networks' initialisation, action sampling and the environments.")
+    seed: int = setting(0, "Seeds the networks' initialisation, action sampling and the environments.", at_least(0))
     num_envs: int = setting(
         16, "Copies of the environment stepped together (batched when the env has a vector version).", at_least(1)
     )
@@ -120,9 +120,19 @@ class AlgoConfig:
             value = getattr(self, f.name)
             if isinstance(value, float) and not math.isfinite(value):
                 raise ValueError(f"{type(self).__name__}.{f.name} = {value!r}; expected a finite number")
-            check = f.metadata.get("check")
+            check = self.check_of(f.name)
             if check is not None:
                 self._check(check.ok(value), f.name, check.expected)
+
+    @classmethod
+    def check_of(cls, name: str) -> Check | None:
+        """The check of setting ``name``: its own, or, for a setting a subclass declares again (a new default)
+        without one, the nearest base class's."""
+        for klass in cls.__mro__:
+            f = getattr(klass, "__dataclass_fields__", {}).get(name)
+            if f is not None and f.metadata.get("check") is not None:
+                return f.metadata["check"]
+        return None
 
     def _check(self, ok: bool, name: str, expected: str) -> None:
         if not ok:
@@ -267,7 +277,8 @@ class EpisodeTracker:
 
     Where the env reports an episode's outcome as ``info["status"]`` (Half Field Offense: ``"GOAL"``,
     ``"OUT_OF_BOUNDS"``, ...), the goal rate and the mean length of scoring episodes are kept too, the training
-    counterparts of :func:`pamdp.evaluation.evaluate`'s ``goal_rate`` and ``mean_steps_to_goal``.
+    counterparts of :func:`pamdp.evaluation.evaluate`'s ``goal_rate`` and ``mean_steps_to_goal``, logged as
+    ``charts/goal_rate`` and ``charts/steps_to_goal`` (over the episodes whose end came with a status).
     """
 
     def __init__(self, num_envs: int):
@@ -275,7 +286,7 @@ class EpisodeTracker:
         self.lengths = np.zeros(num_envs, dtype=np.int64)
         self.done_returns: list[float] = []
         self.done_lengths: list[int] = []
-        self.done_goals: list[bool] = []  # only for envs that report info["status"]
+        self.done_goals: list[bool | None] = []  # per ended episode; None where the env reported no status
 
     def reset(self) -> None:
         self.returns[:] = 0.0
@@ -288,8 +299,11 @@ class EpisodeTracker:
         ended = dones & valid
         self.done_returns += self.returns[ended].tolist()
         self.done_lengths += self.lengths[ended].tolist()
-        if info is not None and "status" in info and ended.any():
-            self.done_goals += [str(s) == "GOAL" for s in np.asarray(info["status"], dtype=object)[ended]]
+        if ended.any():
+            if info is not None and "status" in info:
+                self.done_goals += [str(s) == "GOAL" for s in np.asarray(info["status"], dtype=object)[ended]]
+            else:
+                self.done_goals += [None] * int(ended.sum())
         self.returns[ended] = 0.0
         self.lengths[ended] = 0
 
@@ -302,11 +316,12 @@ class EpisodeTracker:
             "charts/episodic_length": float(np.mean(self.done_lengths)),
             "charts/episodes": float(len(self.done_returns)),
         }
-        if self.done_goals:
-            goals = np.array(self.done_goals)
-            stats["charts/goal_rate"] = float(goals.mean())
-            if goals.any():
-                stats["charts/steps_to_goal"] = float(np.mean(np.array(self.done_lengths)[goals]))
+        known = [(n, g) for n, g in zip(self.done_lengths, self.done_goals) if g is not None]
+        if known:
+            stats["charts/goal_rate"] = float(np.mean([g for _, g in known]))
+            scoring = [n for n, g in known if g]
+            if scoring:
+                stats["charts/steps_to_goal"] = float(np.mean(scoring))
         self.done_returns, self.done_lengths, self.done_goals = [], [], []
         return stats
 

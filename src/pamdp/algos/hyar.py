@@ -53,6 +53,7 @@ from pamdp.algos.base import (
     POSITIVE,
     AlgoConfig,
     Algorithm,
+    Check,
     at_least,
     interval,
     one_of,
@@ -156,7 +157,11 @@ class HyARConfig(AlgoConfig):
     )
     target_noise_clip: float = setting(0.5, "Clip of the target policy smoothing noise (TD3: 0.5).", NON_NEGATIVE)
     policy_delay: int = setting(2, "Critic updates per actor and target update (TD3: 2).", at_least(1))
-    buffer_size: int = setting(1_000_000, "Replay capacity.", at_least(1))
+    buffer_size: int = setting(
+        1_000_000,
+        "Replay capacity.",
+        Check(lambda v: v >= 1, "an integer >= warmup_steps"),  # the rest: __post_init__
+    )
     updates_per_step: float = setting(
         1.0, "Update-to-data ratio: TD3 updates (critics) per environment sample.", POSITIVE
     )
@@ -486,8 +491,8 @@ class HyAR(Algorithm):
             self._reencode_replay()
             self.pretrained = True
         self.n_updates += 1
-        interval = max(1, round(cfg.vae_interval * cfg.updates_per_step))
-        if self.n_updates % interval == 0 and cfg.vae_updates > 0:
+        every = max(1, round(cfg.vae_interval * cfg.updates_per_step))
+        if self.n_updates % every == 0 and cfg.vae_updates > 0:
             stats.update(self.train_representation(cfg.vae_updates))
 
         b = self.replay.sample(cfg.batch_size, self.np_rng)

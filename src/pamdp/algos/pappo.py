@@ -30,7 +30,7 @@ import dataclasses
 
 import torch
 
-from pamdp.algos.base import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, at_least, interval, one_of, setting
+from pamdp.algos.base import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
 from pamdp.algos.patrpo import OnPolicyHybrid, Rollout
 from pamdp.distributions import HybridDistribution, kl_divergence
 from pamdp.policies import ACTIVATIONS, HybridPolicy, ValueNetwork
@@ -61,7 +61,9 @@ class PAPPOConfig(AlgoConfig):
         10, "Passes over each batch; more reuse per sample, and more drift from pi_old.", at_least(1)
     )
     minibatch_size: int = setting(
-        256, "Samples per gradient step (the batch is split into equal minibatches of about this size).", at_least(1)
+        256,
+        "Samples per gradient step (the batch is split into equal minibatches of about this size).",
+        Check(lambda v: v >= 1, "an integer in [1, batch_size]"),  # the upper end: __post_init__
     )
     lr: float = setting(
         3e-4, "Adam learning rate of the policy and the value network (one optimiser, one loss).", POSITIVE
