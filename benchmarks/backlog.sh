@@ -38,24 +38,37 @@ set -euo pipefail
 cd "$(dirname "$0")"
 RUNS=${PAMDP_RUNS:-/root/pamdp-runs}
 
-pamdp reproduce step-size --workers 2 --out "$RUNS/repro"
-pamdp reproduce kl-estimators --workers 2 --out "$RUNS/repro"
-pamdp reproduce platform --runs PATRPO --workers 2 --out "$RUNS/repro"
-python bench_later_platform.py --workers 2 --out "$RUNS/bench"
-# Stable-Baselines3 (not a pamdp dependency) into its own directory, for the mainstream-library baseline
-pip install -q --target "$RUNS/sb3" --no-deps stable-baselines3
-PYTHONPATH="$RUNS/sb3" python bench_mainstream_platform.py --workers 2 --out "$RUNS/bench"
-# Soccer's PATRPO seeds 0 and 1 on both cores; seed 2 then runs beside platform's PADDPG arm (three processes on
-# two cores), so that no core idles while an arm is down to its last run. The side queue goes on with the H&S run
-# and then the rest of soccer (its PADDPG arm) at the lowest priority: it takes only the cycles the platform arms
-# leave, because those close issues 5 and 7 and soccer is to run "as far as the machine allows".
-pamdp reproduce soccer --runs PATRPO --seeds 0,1 --workers 2 --out "$RUNS/repro"
-(
-    pamdp reproduce soccer --runs PATRPO --seeds 2 --workers 1 --out "$RUNS/repro"
-    python bench_paddpg_hausknecht_stone.py --workers 1 --out "$RUNS/bench"    # issue 5
-    nice -n 19 pamdp reproduce soccer --workers 2 --out "$RUNS/repro"
-) &
-side=$!
-python bench_paddpg_platform.py --workers 2 --out "$RUNS/repro"    # = platform --runs PADDPG, + record (issue 5)
-pamdp reproduce platform --workers 2 --out "$RUNS/repro"          # its PASVG(0) arm, then the figure (issue 7)
-wait "$side"
+# All in one function, which bash reads whole before running any of it: editing this file while it runs
+# changes nothing in the running copy.
+main() {
+    pamdp reproduce step-size --workers 2 --out "$RUNS/repro"
+    pamdp reproduce kl-estimators --workers 2 --out "$RUNS/repro"
+    pamdp reproduce platform --runs PATRPO --workers 2 --out "$RUNS/repro"
+    python bench_later_platform.py --workers 2 --out "$RUNS/bench"
+    # Stable-Baselines3 (not a pamdp dependency) into its own directory, for the mainstream-library baseline
+    pip install -q --target "$RUNS/sb3" --no-deps stable-baselines3
+    PYTHONPATH="$RUNS/sb3" python bench_mainstream_platform.py --workers 2 --out "$RUNS/bench"
+    # Soccer's PATRPO seeds 0 and 1 on both cores; seed 2 then runs beside platform's PADDPG arm (three processes on
+    # two cores), so that no core idles while an arm is down to its last run. The side queue goes on with the H&S run
+    # and then the rest of soccer (its PADDPG arm) at the lowest priority: it takes only the cycles the platform arms
+    # leave, because those close issues 5 and 7 and soccer is to run "as far as the machine allows".
+    pamdp reproduce soccer --runs PATRPO --seeds 0,1 --workers 2 --out "$RUNS/repro"
+    set -m  # the side queue gets its own process group, so that it can be stopped as a whole
+    (
+        pamdp reproduce soccer --runs PATRPO --seeds 2 --workers 1 --out "$RUNS/repro"
+        python bench_paddpg_hausknecht_stone.py --workers 1 --out "$RUNS/bench"    # issue 5
+        nice -n 19 pamdp reproduce soccer --workers 2 --out "$RUNS/repro"
+    ) &
+    side=$!
+    set +m
+    # If the main queue fails (set -e) the side queue must not run on alone: a new start of this script would
+    # then train the same runs in two processes at once.
+    trap 'kill -TERM -- "-$side" 2>/dev/null || true' EXIT
+    python bench_paddpg_platform.py --workers 2 --out "$RUNS/repro"    # = platform --runs PADDPG, + record (issue 5)
+    pamdp reproduce platform --workers 2 --out "$RUNS/repro"          # its PASVG(0) arm, then the figure (issue 7)
+    wait "$side"
+    trap - EXIT
+}
+
+main "$@"
+exit

@@ -41,8 +41,8 @@ CASES = [
 HIDDEN, BATCH, OBS, OUT = (400, 300), 32, 9, 6  # PADDPG's paper preset on Platform: 3 scores + 3 parameters
 
 
-def stacked_update_time(members: int, updates: int, repeats: int) -> list[float]:
-    """Seconds per stacked update of ``members`` PADDPG-sized learners, one figure per repeat."""
+def stacked_update(members: int):
+    """A warmed-up stacked update of ``members`` PADDPG-sized learners, as a callable."""
     import torch
     import torch.nn.functional as F
 
@@ -98,17 +98,11 @@ def stacked_update_time(members: int, updates: int, repeats: int) -> list[float]
 
     for _ in range(30):
         update()
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        for _ in range(updates):
-            update()
-        times.append((time.perf_counter() - start) / updates)
-    return times
+    return update
 
 
-def library_update_time(updates: int, repeats: int) -> list[float]:
-    """Seconds per ``PADDPG._update`` (paper preset, Platform), one figure per repeat."""
+def library_update():
+    """The library's ``PADDPG._update`` (paper preset, Platform), warmed up, as a callable."""
     import dataclasses
 
     import torch
@@ -121,30 +115,40 @@ def library_update_time(updates: int, repeats: int) -> list[float]:
     model.learn(2000, progress_bar=False)
     for _ in range(30):
         model._update()
+    return model._update
+
+
+def worker(core: int, members: int, updates: int, repeats: int) -> None:
+    """Pinned to the ``core``-th allowed CPU: build and warm up, say so, then time once the parent says go."""
+    os.sched_setaffinity(0, {sorted(os.sched_getaffinity(0))[core]})
+    update = library_update() if members == 0 else stacked_update(members)
+    print("ready", flush=True)
+    sys.stdin.readline()  # every worker of the case starts timing together
     times = []
     for _ in range(repeats):
         start = time.perf_counter()
         for _ in range(updates):
-            model._update()
+            update()
         times.append((time.perf_counter() - start) / updates)
-    return times
-
-
-def worker(core: int, members: int, updates: int, repeats: int) -> None:
-    os.sched_setaffinity(0, {core})
-    times = library_update_time(updates, repeats) if members == 0 else stacked_update_time(members, updates, repeats)
-    print(json.dumps({"members": members, "times": times}))
+    print(json.dumps({"members": members, "times": times}), flush=True)
 
 
 def run_case(counts: list[int], updates: int, repeats: int) -> list[dict]:
     procs = [
         subprocess.Popen(
             [sys.executable, __file__, "--worker", str(core), str(m), str(updates), str(repeats)],
+            stdin=subprocess.PIPE,
             stdout=subprocess.PIPE,
             text=True,
         )
         for core, m in enumerate(counts)
     ]
+    for proc in procs:  # all built and warmed up
+        if proc.stdout.readline().strip() != "ready":
+            raise SystemExit(f"a worker failed before timing (exit code {proc.wait()})")
+    for proc in procs:
+        proc.stdin.write("go\n")
+        proc.stdin.flush()
     results = []
     for proc in procs:
         out, _ = proc.communicate()
@@ -178,7 +182,7 @@ def main() -> None:
         print(f"{label}: {rate:.0f} member-updates/s", file=sys.stderr)
     base = next(rate for label, counts, _, rate in rows if counts == [1, 1])
     sys.path.insert(0, str(HERE))
-    from _record import machine
+    from _record import hand_notes, machine
 
     lines = [
         "# Seed batching: several seeds' networks stacked in one process (PADDPG-sized updates)",
@@ -186,7 +190,7 @@ def main() -> None:
         f"- command: `python benchmarks/bench_seed_batching.py --updates {args.updates} --repeats {args.repeats}"
         + (f" --out {args.out}`" if args.out else "`"),
         f"- date: {dt.datetime.now().isoformat(timespec='seconds')}",
-        f"- machine: {machine()}; load average at the start {load:.1f}",
+        f"- load average at the start: {load:.1f}; machine: {machine()}",
         f"- networks {HIDDEN[0]}-{HIDDEN[1]} (actor {OBS} -> {OUT}, critic {OBS + OUT} -> 1), batch {BATCH} per "
         f"seed, one torch thread per process, each process pinned to its own core; medians of {args.repeats} "
         f"repeats of {args.updates} updates",
@@ -204,7 +208,8 @@ def main() -> None:
     text = "\n".join(lines) + "\n"
     print(text)
     if args.out:
-        Path(args.out).write_text(text)
+        notes = hand_notes(Path(args.out))  # a rerun keeps what was written about the last one
+        Path(args.out).write_text(text + (f"\n{notes}\n" if notes else ""))
 
 
 if __name__ == "__main__":
