@@ -267,7 +267,7 @@ def cmd_plot(args) -> int:
 def _print_report(report: dict) -> None:
     """The results table on stdout, the figures' paths on stderr."""
     print(report["table"].read_text())
-    figures = [report[k] for k in ("png", "svg", "greedy_png", "greedy_svg") if k in report]
+    figures = [v for k, v in report.items() if k.endswith(("png", "svg"))]
     print(f"figures: {', '.join(map(str, figures))}", file=sys.stderr)
 
 

@@ -20,7 +20,17 @@ __all__ = ["find_groups", "aggregate", "x_axis", "plot_curves", "results_table",
 
 METRIC = "charts/episodic_return"
 GREEDY_METRIC = "eval/mean_return"  # logged every few epochs by runs with eval_every (``--eval-every``)
-LABELS = {METRIC: "average return", GREEDY_METRIC: "greedy return (100 episodes)"}
+GOAL_METRIC = "charts/goal_rate"  # logged by runs on envs that report each episode's outcome (soccer)
+LABELS = {
+    METRIC: "average return",
+    GREEDY_METRIC: "greedy return (100 episodes)",
+    GOAL_METRIC: "goal rate (training episodes)",
+}
+# Figures beside the curves, for the runs that logged their metric: (name, metric, report keys)
+EXTRA_FIGURES = (
+    ("greedy", GREEDY_METRIC, ("greedy_png", "greedy_svg")),
+    ("goal_rate", GOAL_METRIC, ("goal_png", "goal_svg")),
+)
 
 
 def find_groups(roots: list[str | os.PathLike]) -> dict[str, list[Path]]:
@@ -163,18 +173,19 @@ def write_report(
     ``x``: the curves' x axis, as in :func:`plot_curves`.
 
     Runs that logged greedy evaluations during training (``eval_every``) also get ``greedy.png`` and
-    ``greedy.svg``: the mean +- std across seeds of those evaluations, at the epochs where they were made.
+    ``greedy.svg``: the mean +- std across seeds of those evaluations, at the epochs where they were made. Runs on
+    an env that reports episode outcomes (soccer) get ``goal_rate.png`` and ``goal_rate.svg``: the training goal
+    rate per epoch (epochs logged before a run recorded it are left out).
     """
     groups = find_groups(roots)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     png, svg = plot_curves(groups, out / "curves", title, x=x)
-    greedy = {
-        label: runs for label, runs in groups.items() if np.isfinite(aggregate(runs, GREEDY_METRIC)["mean"]).any()
-    }
     extra = {}
-    if greedy:
-        extra["greedy_png"], extra["greedy_svg"] = plot_curves(greedy, out / "greedy", title, GREEDY_METRIC, x)
+    for name, metric, (png_key, svg_key) in EXTRA_FIGURES:
+        logged = {label: runs for label, runs in groups.items() if np.isfinite(aggregate(runs, metric)["mean"]).any()}
+        if logged:
+            extra[png_key], extra[svg_key] = plot_curves(logged, out / name, title, metric, x)
     csv_path = out / "curves.csv"
     with open(csv_path, "w", newline="") as f:
         writer = csv.writer(f)
