@@ -109,8 +109,8 @@ def test_line_search_accepts_improving_step_within_bound():
     result = backtracking_line_search(
         [w],
         torch.tensor([2.0], dtype=torch.float64),
-        surrogate=lambda: -(w - 1.0).pow(2).sum(),
-        kl=lambda: w.pow(2).sum(),
+        evaluate=lambda: (-(w - 1.0).pow(2).sum(), w.pow(2).sum()),
+        before=-1.0,
         max_kl=1.5,
         backtrack_ratio=0.5,
         max_backtracks=10,
@@ -125,8 +125,8 @@ def test_line_search_rejects_and_restores():
     result = backtracking_line_search(
         [w],
         torch.tensor([1.0], dtype=torch.float64),
-        surrogate=lambda: w.sum(),
-        kl=lambda: 100 * w.pow(2).sum(),
+        evaluate=lambda: (w.sum(), 100 * w.pow(2).sum()),
+        before=0.5,
         max_kl=1.0,
         backtrack_ratio=0.5,
         max_backtracks=3,
@@ -159,7 +159,7 @@ def test_natural_step_improves_the_surrogate_within_the_trust_region():
     d = conjugate_gradient(fvp, grad, 10)
     delta = 0.01
     step = torch.sqrt(2 * delta / (d @ fvp(d))) * d
-    result = backtracking_line_search(params, step, surrogate, kl, delta)
+    result = backtracking_line_search(params, step, lambda: (surrogate(), kl()), before, delta)
     assert result.success
     assert float(surrogate().detach()) > before
     assert float(kl().detach()) <= delta

@@ -416,15 +416,18 @@ class PATRPO(OnPolicyHybrid):
             old = self.policy(obs).detach()
             old_logp = old.log_prob(a, x)
 
-        def surrogate() -> torch.Tensor:
-            new = self.policy(obs)
+        def surrogate(new) -> torch.Tensor:
             gain = (torch.exp(new.log_prob(a, x) - old_logp) * adv).mean()
             return gain + cfg.entropy_coef * new.entropy().mean() if cfg.entropy_coef else gain
 
-        def kl() -> torch.Tensor:
-            return kl_divergence(old, self.policy(obs), cfg.kl_estimator, a, x).mean()
+        tried = []  # the line search's last policy distribution: the accepted one's, for the KL after the step
 
-        g = flat_grad(surrogate(), params)
+        def evaluate() -> tuple[torch.Tensor, torch.Tensor]:  # one forward pass for both of a step's figures
+            tried[:] = [self.policy(obs)]
+            return surrogate(tried[0]), kl_divergence(old, tried[0], cfg.kl_estimator, a, x).mean()
+
+        objective = surrogate(self.policy(obs))
+        g = flat_grad(objective, params)
         fvp = self._fisher_vector_product(obs, a, x, old)
         direction = conjugate_gradient(fvp, g, cfg.cg_iters)
         shs = float(direction @ fvp(direction))
@@ -441,10 +444,11 @@ class PATRPO(OnPolicyHybrid):
             return stats
         full_step = np.sqrt(2.0 * cfg.delta / shs) * direction
         result = backtracking_line_search(
-            params, full_step, surrogate, kl, cfg.delta, cfg.backtrack_ratio, cfg.max_backtracks
+            params, full_step, evaluate, float(objective.detach()), cfg.delta, cfg.backtrack_ratio, cfg.max_backtracks
         )
         with torch.no_grad():
-            kl_after = float(kl_divergence(old, self.policy(obs), "chain_analytic").mean())
+            after = tried[0] if result.success else old  # a rejected step restores the old parameters
+            kl_after = float(kl_divergence(old, after, "chain_analytic").mean())
         stats.update(
             {
                 "train/line_search_success": float(result.success),

@@ -161,8 +161,8 @@ class LineSearchResult:
 def backtracking_line_search(
     params: Sequence[torch.Tensor],
     full_step: torch.Tensor,
-    surrogate: Callable[[], torch.Tensor],
-    kl: Callable[[], torch.Tensor],
+    evaluate: Callable[[], tuple[torch.Tensor | float, torch.Tensor | float]],
+    before: float,
     max_kl: float,
     backtrack_ratio: float = 0.8,
     max_backtracks: int = 15,
@@ -170,15 +170,16 @@ def backtracking_line_search(
     """Try ``theta + ratio^k * full_step`` for ``k = 0, 1, ...``; keep the first that improves the surrogate
     and keeps the KL within ``max_kl`` (rllab's rule), else restore ``theta``.
 
-    ``surrogate`` and ``kl`` evaluate the objective (to maximise) and the KL at the current parameters.
+    ``evaluate()`` gives the objective (to maximise) and the KL at the current parameters, so that both can come
+    from one forward pass; ``before`` is the objective at ``theta`` (the caller has it from the gradient).
     """
     params = list(params)
     theta = flat_params(params)
     with torch.no_grad():
-        before = float(surrogate())
         for k in range(max_backtracks):
             set_flat_params(params, theta + backtrack_ratio**k * full_step)
-            gain, kl_value = float(surrogate()) - before, float(kl())
+            objective, kl_value = (float(v) for v in evaluate())
+            gain = objective - before
             if gain > 0 and kl_value <= max_kl:
                 return LineSearchResult(True, k, gain, kl_value)
         set_flat_params(params, theta)
