@@ -65,6 +65,40 @@ def test_bad_values_give_clear_errors(tmp_path, capsys):
     assert "no pamdp model" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (["reproduce", "step-size", "--seeds", "0,x", "--status"], "--seeds: '0,x'; expected comma-separated seeds"),
+        (["reproduce", "step-size", "--seeds", "-1", "--status"], "--seeds: '-1'; expected comma-separated seeds"),
+        (["reproduce", "step-size", "--workers", "0", "--status"], "--workers: '0'; expected an integer >= 1"),
+        (["train", "patrpo", "--env-kwargs", "{bad"], "--env-kwargs: '{bad' is not valid JSON"),
+        (["train", "patrpo", "--env-kwargs", "[1]"], "--env-kwargs: '[1]'; expected a JSON object"),
+    ],
+)
+def test_bad_arguments_are_refused_before_anything_runs(argv, message, capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        main(argv)
+    assert exit_info.value.code == 2 and message in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    "name, text, message",
+    [
+        ("missing.toml", None, "config file '{path}': No such file or directory; expected a TOML or JSON file"),
+        ("bad.toml", "delta = \n", "config file '{path}' is not valid TOML"),
+        ("bad.json", "{", "config file '{path}' is not valid JSON"),
+        ("list.json", "[1, 2]", "config file '{path}' holds a list; expected a table of settings"),
+    ],
+)
+def test_bad_config_files_give_errors_naming_them(name, text, message, tmp_path, capsys):
+    path = tmp_path / name
+    if text is not None:
+        path.write_text(text)
+    assert main(["train", "patrpo", "--config", str(path), "--out", str(tmp_path / "run")]) == 2
+    assert message.format(path=path) in capsys.readouterr().err
+    assert not (tmp_path / "run").exists()
+
+
 def test_killed_run_resumes_from_its_checkpoint(tmp_path):
     out = tmp_path / "run"
     cmd = [

@@ -62,6 +62,36 @@ def _parse_value(text: str, hint):
         raise argparse.ArgumentTypeError(f"{text!r} is not a valid {hint.__name__}") from exc
 
 
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{text!r}; expected an integer >= 1")
+    return value
+
+
+def _seed_list(text: str) -> list[int]:
+    try:
+        seeds = [int(s) for s in text.split(",")]
+    except ValueError:
+        seeds = [-1]
+    if any(s < 0 for s in seeds):
+        raise argparse.ArgumentTypeError(f"{text!r}; expected comma-separated seeds >= 0, such as 0,1,2")
+    return seeds
+
+
+def _json_object(text: str) -> dict:
+    try:
+        value = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise argparse.ArgumentTypeError(f"{text!r} is not valid JSON ({exc.msg}); expected an object") from exc
+    if not isinstance(value, dict):
+        raise argparse.ArgumentTypeError(f"{text!r}; expected a JSON object such as '{{\"deterministic\": true}}'")
+    return value
+
+
 def _add_config_flags(parser: argparse.ArgumentParser, config_class) -> None:
     group = parser.add_argument_group(f"{config_class.__name__} settings (override the preset)")
     hints = config_class.field_types()
@@ -81,14 +111,22 @@ def _add_config_flags(parser: argparse.ArgumentParser, config_class) -> None:
 
 
 def _read_config_file(path: str) -> dict:
-    text = Path(path).read_text()
-    if path.endswith(".json"):
-        return json.loads(text)
+    try:
+        text = Path(path).read_text()
+    except OSError as exc:
+        raise ValueError(f"config file {path!r}: {exc.strerror}; expected a TOML or JSON file of settings") from exc
     try:
         import tomllib
     except ModuleNotFoundError:  # Python 3.10
         import tomli as tomllib
-    return tomllib.loads(text)
+    kind = "JSON" if path.endswith(".json") else "TOML"
+    try:
+        values = json.loads(text) if kind == "JSON" else tomllib.loads(text)
+    except (json.JSONDecodeError, tomllib.TOMLDecodeError) as exc:
+        raise ValueError(f"config file {path!r} is not valid {kind}: {exc}") from exc
+    if not isinstance(values, dict):
+        raise ValueError(f"config file {path!r} holds a {type(values).__name__}; expected a table of settings")
+    return values
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -104,7 +142,7 @@ def build_parser() -> argparse.ArgumentParser:
             continue
         p = algos.add_parser(name, help=ALGO_HELP.get(name, name))
         p.add_argument("--env", default="pamdp/Platform-v0", help="registered env id (default: %(default)s)")
-        p.add_argument("--env-kwargs", type=json.loads, default=None, help="JSON object of env constructor arguments")
+        p.add_argument("--env-kwargs", type=_json_object, default=None, help="JSON object of env constructor arguments")
         p.add_argument("--seed", type=int, default=None, help="random seed (default: the config file's, else 0)")
         p.add_argument(
             "--total-steps",
@@ -143,10 +181,12 @@ def build_parser() -> argparse.ArgumentParser:
 
     rp = sub.add_parser("reproduce", help="run one of the paper's experiments (all settings and seeds) and plot it")
     rp.add_argument("name", help="platform, step-size, kl-estimators, soccer, or an experiment TOML file")
-    rp.add_argument("--seeds", default=None, help="comma-separated seeds (default: the experiment's)")
+    rp.add_argument("--seeds", type=_seed_list, default=None, help="comma-separated seeds (default: the experiment's)")
     rp.add_argument("--runs", default=None, help="comma-separated run labels to run (default: all), e.g. --runs PATRPO")
     rp.add_argument("--scale", type=float, default=1.0, help="multiply the step budget, e.g. 0.1 for a quick look")
-    rp.add_argument("--workers", type=int, default=1, help="runs side by side in processes (one torch thread each)")
+    rp.add_argument(
+        "--workers", type=_positive_int, default=1, help="runs side by side in processes (one torch thread each)"
+    )
     rp.add_argument("--out", default="results", help="results root (default: %(default)s)")
     rp.add_argument("--backend", choices=["local", "ray"], default="local", help="local processes or a Ray cluster")
     rp.add_argument("--address", default=None, help="Ray cluster address HOST:PORT (with --backend ray)")
@@ -230,7 +270,7 @@ def cmd_reproduce(args) -> int:
     from pamdp.experiments.plots import write_report
 
     exp = load_experiment(args.name)
-    seeds = [int(s) for s in args.seeds.split(",")] if args.seeds else None
+    seeds = args.seeds
     labels = [label.strip() for label in args.runs.split(",")] if args.runs is not None else None
     jobs = [(spec, str(exp.run_dir(args.out, spec))) for spec in exp.specs(seeds, args.scale, labels)]
     for spec, _ in jobs:
