@@ -156,6 +156,20 @@ def test_load_errors_are_clear(tmp_path):
         PATRPO.load(tmp_path / "other.pt")
 
 
+def test_predict_and_save_refuse_bad_input_clearly(tmp_path):
+    model = PATRPO("pamdp/Platform-v0", SMALL)
+    with pytest.raises(ValueError, match=r"observation of shape \(5,\); expected \(9,\) or \(N, 9\)"):
+        model.predict(np.zeros(5))
+    obs = np.zeros((3, 9))
+    obs[1, 4] = np.nan
+    with pytest.raises(ValueError, match=r"non-finite value nan at index \[1, 4\]"):
+        model.predict(obs)
+    (tmp_path / "model.pt").mkdir()
+    with pytest.raises(ValueError, match="it is a directory; expected a file path"):
+        model.save(tmp_path / "model.pt")
+    assert list((tmp_path / "model.pt").iterdir()) == [] and len(list(tmp_path.iterdir())) == 1
+
+
 def test_loading_never_executes_code(tmp_path):
     class Evil:
         def __reduce__(self):

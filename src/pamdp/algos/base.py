@@ -371,6 +371,8 @@ class Logger:
 def atomic_save(payload: dict, path: str | os.PathLike) -> None:
     """``torch.save`` to a temporary file beside ``path``, fsync, then rename over it."""
     path = Path(path)
+    if path.is_dir():
+        raise ValueError(f"cannot save to {path}: it is a directory; expected a file path such as {path / 'model.pt'}")
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
@@ -516,6 +518,11 @@ class Algorithm:
         single = obs.ndim == 1
         if obs.shape[-1] != self.obs_dim or obs.ndim not in (1, 2):
             raise ValueError(f"observation of shape {obs.shape}; expected ({self.obs_dim},) or (N, {self.obs_dim})")
+        if not np.isfinite(obs).all():
+            where = np.argwhere(~np.isfinite(obs))[0].tolist()
+            raise ValueError(
+                f"observation with a non-finite value {obs[tuple(where)]} at index {where}; expected numbers"
+            )
         with torch.no_grad():
             a, x = self._act(torch.as_tensor(obs.reshape(-1, self.obs_dim)), deterministic)
         a, x = a.numpy(), x.numpy()
