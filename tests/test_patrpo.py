@@ -1,5 +1,8 @@
 """PATRPO: advantages by hand, reproducibility, save/load, errors, and a short learning run."""
 
+import os
+import stat
+
 import gymnasium
 import numpy as np
 import pytest
@@ -168,6 +171,16 @@ def test_predict_and_save_refuse_bad_input_clearly(tmp_path):
     with pytest.raises(ValueError, match="it is a directory; expected a file path"):
         model.save(tmp_path / "model.pt")
     assert list((tmp_path / "model.pt").iterdir()) == [] and len(list(tmp_path.iterdir())) == 1
+
+
+def test_saved_files_get_the_permissions_open_would_give(tmp_path):
+    model = PATRPO("pamdp/Platform-v0", SMALL)
+    old = os.umask(0o027)
+    try:
+        model.save(tmp_path / "model.pt")
+    finally:
+        os.umask(old)
+    assert stat.S_IMODE((tmp_path / "model.pt").stat().st_mode) == 0o640
 
 
 def test_loading_never_executes_code(tmp_path):

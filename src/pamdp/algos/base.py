@@ -368,6 +368,12 @@ class Logger:
 
 
 # -- checkpoints --------------------------------------------------------------------------------------
+def _umask() -> int:
+    mask = os.umask(0)  # the only way to read it is to set it
+    os.umask(mask)
+    return mask
+
+
 def atomic_save(payload: dict, path: str | os.PathLike) -> None:
     """``torch.save`` to a temporary file beside ``path``, fsync, then rename over it."""
     path = Path(path)
@@ -376,6 +382,7 @@ def atomic_save(payload: dict, path: str | os.PathLike) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
+        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp's file is private (0600); the model gets what open() would give
         with os.fdopen(fd, "wb") as f:
             torch.save(payload, f)
             f.flush()
