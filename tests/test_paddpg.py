@@ -10,6 +10,7 @@ from torch import nn
 
 import pamdp
 from pamdp import PADDPG
+from pamdp.algos.base import load_model
 from pamdp.algos.paddpg import Actor, PADDPGConfig, invert_gradients, zero_gradients
 from pamdp.cli import main
 from pamdp.spaces import HybridActionSpace
@@ -226,10 +227,12 @@ def test_critic_loss_falls_on_a_fixed_batch():
 def test_cli_trains_resumes_and_evaluates(tmp_path, capsys, algo):
     out = tmp_path / "run"
     tiny = ["--hidden-sizes", "16", "--num-envs", "4", "--epoch-steps", "200", "--learning-starts", "100"]
-    tiny += ["--batch-size", "16", "--buffer-size", "5000", "--no-progress"]
+    tiny += ["--batch-size", "16", "--buffer-size", "5000", "--save-replay", "true", "--no-progress"]
     assert main(["train", algo, "--total-steps", "200", "--out", str(out), "--eval-episodes", "20", *tiny]) == 0
     for name in ("run.json", "progress.csv", "checkpoint.pt", "final_model.pt", "evaluation.json"):
         assert (out / name).exists(), name
+    # the checkpoint keeps the replay buffer for resuming; the final model, for acting, does not
+    assert len(load_model(out / "checkpoint.pt").replay) > 0 and len(load_model(out / "final_model.pt").replay) == 0
     assert "greedy return over 20 episodes" in capsys.readouterr().out
     assert json.loads((out / "run.json").read_text())["config"]["hidden_sizes"] == [16]
     assert main(["train", algo, "--total-steps", "400", "--out", str(out), "--eval-episodes", "0", *tiny]) == 0

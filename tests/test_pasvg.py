@@ -270,6 +270,10 @@ def test_save_load_predict_round_trip(tmp_path, save_replay):
         np.testing.assert_array_equal(loaded.replay.data["eta_a"][:200], model.replay.data["eta_a"][:200])
     loaded.learn(200, progress_bar=False)  # resumes: refills (or keeps) the buffer and goes on
     assert loaded.num_timesteps >= 400
+    model.save(tmp_path / "acting.pt", replay=False)  # what a run directory's final_model.pt holds
+    assert len(PASVG0.load(tmp_path / "acting.pt").replay) == 0
+    if save_replay:
+        assert (tmp_path / "acting.pt").stat().st_size < (tmp_path / "m.pt").stat().st_size
 
 
 def test_explore_epsilon_draws_uniform_actions_with_their_own_parameters():

@@ -490,7 +490,8 @@ class Algorithm:
     def _optimizers(self) -> dict[str, torch.optim.Optimizer]:
         return {}
 
-    def _extra_state(self) -> dict:
+    def _extra_state(self, replay: bool) -> dict:
+        """What a checkpoint holds besides modules and optimisers; ``replay``: the replay buffer's contents too."""
         return {}
 
     def _load_extra_state(self, state: dict) -> None:
@@ -622,8 +623,13 @@ class Algorithm:
             stats["eval/goal_rate"] = result["goal_rate"]
         return stats
 
-    def save(self, path: str | os.PathLike) -> None:
-        """Write weights, optimiser states, settings, counters and RNG states to one file, atomically."""
+    def save(self, path: str | os.PathLike, replay: bool | None = None) -> None:
+        """Write weights, optimiser states, settings, counters and RNG states to one file, atomically.
+
+        ``replay``: whether an off-policy algorithm's replay buffer goes in too (large); ``None`` follows the
+        ``save_replay`` setting. A resumed run needs it to go on exactly; a model for acting does not.
+        """
+        replay = bool(getattr(self.config, "save_replay", False)) if replay is None else replay
         payload = {
             "format": _FORMAT,
             "pamdp_version": pamdp.__version__,
@@ -636,7 +642,7 @@ class Algorithm:
             "rng": {"numpy": self.np_rng.bit_generator.state, "torch": self.torch_gen.get_state()},
             "modules": {k: m.state_dict() for k, m in self._modules().items()},
             "optimizers": {k: o.state_dict() for k, o in self._optimizers().items()},
-            "extra": self._extra_state(),
+            "extra": self._extra_state(replay),
         }
         atomic_save(payload, path)
 

@@ -354,9 +354,9 @@ class HyAR(Algorithm):
     def _optimizers(self):
         return {"rep": self.rep_optimizer, "actor": self.actor_optimizer, "critic": self.critic_optimizer}
 
-    def _extra_state(self):
+    def _extra_state(self, replay):
         return {
-            "loop": self.loop.state_dict(self.config.save_replay),
+            "loop": self.loop.state_dict(replay),
             "pretrained": self.pretrained,
             "n_updates": self.n_updates,
         }

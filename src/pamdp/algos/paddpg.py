@@ -246,8 +246,8 @@ class PADDPG(Algorithm):
     def _optimizers(self):
         return {"actor": self.actor_optimizer, "critic": self.critic_optimizer}
 
-    def _extra_state(self):
-        return {"loop": self.loop.state_dict(self.config.save_replay)}
+    def _extra_state(self, replay):
+        return {"loop": self.loop.state_dict(replay)}
 
     def _load_extra_state(self, state):
         self.loop.load_state_dict(state["loop"])

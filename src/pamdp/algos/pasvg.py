@@ -383,8 +383,8 @@ class PASVG0(Algorithm):
             optimizers["entropy_weight"] = self.entropy_optimizer
         return optimizers
 
-    def _extra_state(self):
-        return {"loop": self.loop.state_dict(self.config.save_replay), "critic_updates": self.critic_updates}
+    def _extra_state(self, replay):
+        return {"loop": self.loop.state_dict(replay), "critic_updates": self.critic_updates}
 
     def _load_extra_state(self, state):
         self.loop.load_state_dict(state["loop"])

@@ -346,7 +346,7 @@ class PATRPO(OnPolicyHybrid):
     def _optimizers(self):
         return {"value": self.vf_optimizer} if self.config.baseline == "mlp" else {}
 
-    def _extra_state(self):
+    def _extra_state(self, replay):
         if self.config.baseline == "linear":
             return {"linear_baseline": torch.as_tensor(self.linear_baseline.coef)}
         return {}

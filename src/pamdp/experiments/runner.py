@@ -147,7 +147,7 @@ def train_run(spec: RunSpec, out: str | os.PathLike, progress_bar: bool = True, 
         run_dir=out,
         eval_every=spec.eval_every,
     )
-    model.save(out / FINAL_MODEL)
+    model.save(out / FINAL_MODEL, replay=False)  # for acting; checkpoint.pt keeps the buffer for resuming
     log(f"trained {model.num_timesteps:,} steps in {time.time() - start:.0f} s; model in {out / FINAL_MODEL}")
     if spec.eval_episodes <= 0:
         return {}
