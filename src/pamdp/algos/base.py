@@ -23,7 +23,7 @@ import types
 import typing
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import gymnasium
 import numpy as np
@@ -34,6 +34,9 @@ from gymnasium.vector import AutoresetMode
 import pamdp
 from pamdp.algos import MODULE_OF
 from pamdp.spaces import HybridActionSpace
+
+if TYPE_CHECKING:
+    from typing_extensions import Self  # typing.Self from Python 3.11
 
 __all__ = [
     "AlgoConfig",
@@ -139,12 +142,12 @@ class AlgoConfig:
             raise ValueError(f"{type(self).__name__}.{name} = {getattr(self, name)!r}; expected {expected}")
 
     @classmethod
-    def presets(cls) -> dict[str, AlgoConfig]:
+    def presets(cls) -> dict[str, Self]:
         """Named settings, e.g. ``"paper"``; the first one is the default."""
         return {"default": cls()}
 
     @classmethod
-    def preset(cls, name: str) -> AlgoConfig:
+    def preset(cls, name: str) -> Self:
         table = cls.presets()
         if name not in table:
             raise ValueError(f"unknown preset {name!r} for {cls.__name__}; expected one of {', '.join(table)}")
@@ -160,7 +163,7 @@ class AlgoConfig:
         return typing.get_type_hints(cls)
 
     @classmethod
-    def from_dict(cls, values: dict[str, Any], base: AlgoConfig | None = None) -> AlgoConfig:
+    def from_dict(cls, values: dict[str, Any], base: Self | None = None) -> Self:
         """Settings from plain data (a config file, a checkpoint), over ``base`` (default: the defaults).
 
         Unknown names and values of the wrong type raise a ``ValueError`` naming them.
@@ -545,7 +548,7 @@ class Algorithm:
         checkpoint_every: int = 1,
         eval_every: int = 0,
         eval_episodes: int = 100,
-    ) -> Algorithm:
+    ) -> Self:
         """Train for ``total_timesteps`` more environment steps, in whole epochs.
 
         Args:
@@ -647,7 +650,7 @@ class Algorithm:
         atomic_save(payload, path)
 
     @classmethod
-    def load(cls, path: str | os.PathLike, env=None) -> Algorithm:
+    def load(cls, path: str | os.PathLike, env=None) -> Self:
         """Load a model saved by :meth:`save`, or the final model of a run directory written by ``pamdp train``.
 
         ``env`` (an id, env or vector env) replaces the env recorded in the file.
@@ -658,7 +661,7 @@ class Algorithm:
         return cls._from_payload(payload, env)
 
     @classmethod
-    def _from_payload(cls, payload: dict, env=None) -> Algorithm:
+    def _from_payload(cls, payload: dict, env=None) -> Self:
         config = cls.config_class.from_dict(payload["config"])
         if env is None:
             if payload["env_id"] is None:

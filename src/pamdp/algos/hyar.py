@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+from typing import TYPE_CHECKING
 
 import numpy as np
 import torch
@@ -64,6 +65,9 @@ from pamdp.algos.paddpg import backprop_actor
 from pamdp.algos.replay import ReplayBuffer
 from pamdp.policies import ACTIVATIONS, mlp
 from pamdp.spaces import HybridActionSpace
+
+if TYPE_CHECKING:
+    from typing_extensions import Self
 
 __all__ = ["HyAR", "HyARConfig", "ActionRepresentation", "latent_bounds"]
 
@@ -181,7 +185,7 @@ class HyARConfig(AlgoConfig):
         self._check(self.buffer_size >= self.warmup_steps, "buffer_size", f">= warmup_steps ({self.warmup_steps})")
 
     @classmethod
-    def presets(cls) -> dict[str, HyARConfig]:
+    def presets(cls) -> dict[str, Self]:
         # "cpu" (the command line's default): smaller networks, 64 batched env copies and a quarter of a TD3 update
         # per sample, for a laptop CPU, with a small KL weight and small latents (a 1-D parameter in 6 latent
         # dimensions left 5 for the critic to learn to ignore). It is sized, not tuned: see docs/algorithms.md.

@@ -27,6 +27,7 @@ from __future__ import annotations
 import copy
 import dataclasses
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 import numpy as np
 import torch
@@ -48,6 +49,9 @@ from pamdp.algos.offpolicy import OffPolicyLoop, OUNoise, clipped_step, linear_e
 from pamdp.algos.replay import ReplayBuffer
 from pamdp.policies import ACTIVATIONS, mlp
 from pamdp.spaces import HybridActionSpace
+
+if TYPE_CHECKING:
+    from typing_extensions import Self
 
 __all__ = ["PADDPG", "PADDPGConfig", "invert_gradients", "zero_gradients", "backprop_actor", "BOUNDS"]
 
@@ -118,7 +122,7 @@ class PADDPGConfig(AlgoConfig):
     )
 
     @classmethod
-    def presets(cls) -> dict[str, PADDPGConfig]:
+    def presets(cls) -> dict[str, Self]:
         return {
             "paper": cls(),
             "paper_hfo": cls(hidden_sizes=(400, 300, 200)),

@@ -27,6 +27,7 @@ clip bounds the change of the whole hierarchical policy, as PATRPO's KL does.
 from __future__ import annotations
 
 import dataclasses
+from typing import TYPE_CHECKING
 
 import torch
 
@@ -34,6 +35,9 @@ from pamdp.algos.base import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, Check, 
 from pamdp.algos.patrpo import OnPolicyHybrid, Rollout
 from pamdp.distributions import HybridDistribution, kl_divergence
 from pamdp.policies import ACTIVATIONS, HybridPolicy, ValueNetwork
+
+if TYPE_CHECKING:
+    from typing_extensions import Self
 
 __all__ = ["PAPPO", "PAPPOConfig", "clipped_surrogate", "ppo_loss"]
 
@@ -108,7 +112,7 @@ class PAPPOConfig(AlgoConfig):
         )
 
     @classmethod
-    def presets(cls) -> dict[str, PAPPOConfig]:
+    def presets(cls) -> dict[str, Self]:
         # "tuned": single runs of 300k samples on Platform (this project's shared 2-core machine; probes, not a
         # benchmark). The defaults and six variations (target_kl 0.02; ent_coef_d 0.05 or 0.1; init_log_std -1 or
         # -0.5; ent_coef_c 0.01 with gae_lambda 0.97; relu {200, 100, 50}) settled within 150k samples at greedy

@@ -28,6 +28,7 @@ from __future__ import annotations
 import copy
 import dataclasses
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 import torch
@@ -50,6 +51,9 @@ from pamdp.algos.offpolicy import OffPolicyLoop, clipped_step, soft_update
 from pamdp.algos.replay import ReplayBuffer
 from pamdp.policies import ACTIVATIONS, mlp
 from pamdp.spaces import HybridActionSpace
+
+if TYPE_CHECKING:
+    from typing_extensions import Self
 
 __all__ = ["PASVG0", "PASVG0Config", "GumbelHybridPolicy", "expected_q", "gumbel_noise", "gumbel_softmax_sample"]
 
@@ -161,7 +165,7 @@ class PASVG0Config(AlgoConfig):
             )
 
     @classmethod
-    def presets(cls) -> dict[str, PASVG0Config]:
+    def presets(cls) -> dict[str, Self]:
         return {
             "paper": cls(),
             # Small networks, 64 batched env copies and a quarter of an update per sample (1M samples in about

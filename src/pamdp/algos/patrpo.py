@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 import numpy as np
 import torch
@@ -41,6 +42,9 @@ from pamdp.algos.trpo import (
 from pamdp.distributions import KL_ESTIMATORS, kl_divergence
 from pamdp.policies import ACTIVATIONS, HybridPolicy, ValueNetwork
 from pamdp.spaces import HybridActionSpace
+
+if TYPE_CHECKING:
+    from typing_extensions import Self
 
 __all__ = ["PATRPO", "PATRPOConfig", "LinearFeatureBaseline", "OnPolicyHybrid", "Rollout", "advantage_batch", "gae"]
 
@@ -129,7 +133,7 @@ class PATRPOConfig(AlgoConfig):
         )
 
     @classmethod
-    def presets(cls) -> dict[str, PATRPOConfig]:
+    def presets(cls) -> dict[str, Self]:
         return {
             "paper": cls(),
             "tuned": cls(

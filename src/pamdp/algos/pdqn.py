@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+from typing import TYPE_CHECKING
 
 import numpy as np
 import torch
@@ -53,6 +54,9 @@ from pamdp.algos.paddpg import BOUNDS, backprop_actor
 from pamdp.algos.replay import ReplayBuffer
 from pamdp.policies import ACTIVATIONS, mlp
 from pamdp.spaces import HybridActionSpace
+
+if TYPE_CHECKING:
+    from typing_extensions import Self
 
 __all__ = ["PDQN", "PDQNConfig", "ParamActor", "QNetwork", "param_blocks"]
 
@@ -138,7 +142,7 @@ class PDQNConfig(AlgoConfig):
     )
 
     @classmethod
-    def presets(cls) -> dict[str, PDQNConfig]:
+    def presets(cls) -> dict[str, Self]:
         # "paper": Bester et al.'s text as recalled here (not re-read; never their code); grad_clip, learning_starts,
         # explore_params and the conversion of 1000 episodes to 5 000 samples are assumptions (see the help).
         # "tuned": the same learning rates and targets with a smaller Q-network and batch, 64 batched env copies
