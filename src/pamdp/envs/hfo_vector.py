@@ -246,6 +246,38 @@ class HalfFieldOffenseVectorEnv(gymnasium.vector.VectorEnv):
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 10, "autoreset_mode": AutoresetMode.NEXT_STEP}
 
+    # Per-game arrays of shape (N,), made by _allocate in loops (declared here for readers and type checkers).
+    # The physical state, rows of self._state: positions, velocities, body angle and stamina.
+    px: np.ndarray
+    bx: np.ndarray
+    py: np.ndarray
+    by: np.ndarray
+    pvx: np.ndarray
+    bvx: np.ndarray
+    pvy: np.ndarray
+    bvy: np.ndarray
+    body: np.ndarray
+    stamina: np.ndarray
+    # Ball position a cycle ago and the stamina model's effort, recovery and capacity.
+    prev_bx: np.ndarray
+    prev_by: np.ndarray
+    effort: np.ndarray
+    recovery: np.ndarray
+    capacity: np.ndarray
+    # Flags: the agent holds the ball, kicked it, its action was legal, collisions, the kickable bonus paid.
+    holder: np.ndarray
+    kicked: np.ndarray
+    last_action_ok: np.ndarray
+    collided_ball: np.ndarray
+    collided_post: np.ndarray
+    bonus_paid: np.ndarray
+    # Scratch arrays handed to the Numba kernels (kick draws, placements).
+    _kick_heading: np.ndarray
+    _kick_length: np.ndarray
+    _kick_angle: np.ndarray
+    _overlap_angle: np.ndarray
+    _place_angle: np.ndarray
+
     def __init__(
         self,
         num_envs: int = 1,
