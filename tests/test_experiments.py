@@ -147,15 +147,16 @@ def test_status_estimates_the_training_left_from_each_runs_own_pace():
         run("a", 0, "done", 1000, 100.0),  # 0.1 s a sample; finished, nothing left
         run("a", 1, "partial", 500, 100.0),  # 0.2 s a sample: 500 left -> 100 s
         run("a", 2, "not started", 0, 0.0),  # label a's median (0.15) x 1000 -> 150 s
-        run("b", 0, "not started", 0, 0.0),  # no b has run: the overall median 0.15 -> 150 s
+        run("b", 0, "not started", 0, 0.0),  # no b has run: a's pace says nothing of b's; counted, not guessed
+        run("b", 1, "not started", 0, 0.0),
     ]
     left, unknown = remaining_seconds(statuses)
-    assert left == pytest.approx(400.0) and unknown == 0
-    assert remaining_seconds([run("b", 0, "not started", 0, 0.0)]) == (0.0, 1)
+    assert left == pytest.approx(250.0) and unknown == {"b": 2}
     text = format_status("x", statuses, workers=2)
-    assert "x: 1 of 4 runs done, 1 partial, 2 not started; 3 min of training so far;" in text
-    assert "; about 7 min of training to go" in text
-    assert "(~3 min with 2 side by side)" in text
+    assert "x: 1 of 5 runs done, 1 partial, 3 not started; 3 min of training so far;" in text
+    assert "; about 4 min of training to go" in text
+    assert "(~2 min with 2 side by side)" in text
+    assert "; not counted, as none of their runs has trained yet: b (2 runs)" in text
 
 
 def test_status_counts_cpu_time_where_an_epoch_logged_it(tmp_path):

@@ -94,28 +94,27 @@ def _minutes(seconds: float) -> str:
     return f"{seconds / 60:.0f} min" if seconds < 5940 else f"{seconds / 3600:.1f} h"
 
 
-def remaining_seconds(statuses: list[RunStatus]) -> tuple[float, int]:
-    """Training time still to go over all unfinished runs, and how many runs that estimate leaves out.
+def remaining_seconds(statuses: list[RunStatus]) -> tuple[float, dict[str, int]]:
+    """Training time still to go over the unfinished runs that have a pace to go by, and per label (setting),
+    how many unfinished runs have none.
 
-    A run's time per sample is its own if it has trained, else the median of its setting's (its label's)
-    runs, else the median over the experiment; runs with nothing to go by are counted, not guessed.
+    A run's time per sample is its own if it has trained, else the median of its setting's (its label's) runs.
+    Another setting's pace is no guide (PATRPO's minutes say nothing of PASVG(0)'s hours), so a setting none of
+    whose runs has trained is counted, not guessed.
     """
     by_label: dict[str, list[float]] = {}
     for s in statuses:
         if s.seconds_per_step is not None:
             by_label.setdefault(s.label, []).append(s.seconds_per_step)
-    overall = [x for xs in by_label.values() for x in xs]
-    total, unknown = 0.0, 0
+    total, unknown = 0.0, {}
     for s in statuses:
         if s.state == DONE:
             continue
         rate = s.seconds_per_step
         if rate is None and s.label in by_label:
             rate = statistics.median(by_label[s.label])
-        if rate is None and overall:
-            rate = statistics.median(overall)
         if rate is None:
-            unknown += 1
+            unknown[s.label] = unknown.get(s.label, 0) + 1
             continue
         total += rate * max(s.total_steps - s.steps, 0)
     return total, unknown
@@ -160,5 +159,6 @@ def format_status(name: str, statuses: list[RunStatus], workers: int = 1) -> str
                 f" (~{_minutes(left / workers)} with {workers} side by side)"
             )
         if unknown:
-            summary += f"; {unknown} runs with no time per sample to go by yet"
+            arms = ", ".join(f"{label} ({n} run{'s' if n > 1 else ''})" for label, n in unknown.items())
+            summary += f"; not counted, as none of their runs has trained yet: {arms}"
     return "\n".join(lines) + "\n\n" + summary + "\n"
