@@ -8,6 +8,7 @@ import subprocess
 import sys
 import time
 
+import numpy as np
 import pytest
 
 from pamdp.cli import main
@@ -265,6 +266,26 @@ def test_training_goal_rates_get_their_own_figure(tmp_path):
     plain.mkdir(parents=True)
     (plain / "progress.csv").write_text("time/total_timesteps,charts/episodic_return\n1000,0.1\n2000,0.2\n")
     assert "goal_png" not in write_report([tmp_path / "platform"], tmp_path / "fig2")
+
+
+def test_an_arm_still_training_keeps_its_finished_seeds_curves(tmp_path):
+    from pamdp.experiments.plots import aggregate, results_table, write_report
+
+    returns = {0: [0.1, 0.5, 0.9], 1: [0.3, 0.7, 1.3], 2: [0.0]}  # seed 2 has just started
+    for seed, values in returns.items():
+        run = tmp_path / "exp" / "arm" / f"seed{seed}"
+        run.mkdir(parents=True)
+        rows = "\n".join(f"{1000 * (i + 1)},{v}" for i, v in enumerate(values))
+        (run / "progress.csv").write_text("time/total_timesteps,charts/episodic_return\n" + rows + "\n")
+    runs = sorted((tmp_path / "exp" / "arm").iterdir())
+    agg = aggregate(runs)
+    assert agg["epoch"].tolist() == [1, 2, 3] and agg["seeds"].tolist() == [3, 2, 2]
+    assert agg["mean"] == pytest.approx([0.4 / 3, 0.6, 1.1]) and agg["std"][2] == pytest.approx(0.2)
+    assert agg["steps"].tolist() == [1000, 2000, 3000]
+    # each seed's own last epoch: (0.9 + 1.3 + 0.0) / 3, with the epochs it stands on
+    row = results_table({"arm": runs}).splitlines()[2]
+    assert f"| {2.2 / 3:.3f} +- {np.std([0.9, 1.3, 0.0]):.3f} (epochs 3, 3, 1) |" in row
+    assert "arm (3 seeds, 2 past epoch 1)" in write_report([tmp_path / "exp"], tmp_path / "fig")["svg"].read_text()
 
 
 def test_curves_are_drawn_over_epochs_as_the_paper_unless_epoch_sizes_differ(tmp_path):

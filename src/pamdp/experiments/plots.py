@@ -16,7 +16,16 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["find_groups", "aggregate", "x_axis", "plot_curves", "results_table", "write_report"]
+__all__ = [
+    "find_groups",
+    "aggregate",
+    "final_values",
+    "seeds_label",
+    "x_axis",
+    "plot_curves",
+    "results_table",
+    "write_report",
+]
 
 METRIC = "charts/episodic_return"
 GREEDY_METRIC = "eval/mean_return"  # logged every few epochs by runs with eval_every (``--eval-every``)
@@ -56,20 +65,47 @@ def _read_progress(run: Path, metric: str) -> tuple[np.ndarray, np.ndarray]:
 
 
 def aggregate(runs: list[Path], metric: str = METRIC) -> dict[str, np.ndarray]:
-    """Per-epoch mean and std across seeds, over the epochs every seed reached."""
+    """Per-epoch mean and std across the seeds that reached each epoch.
+
+    An arm still training has seeds at different epochs: every epoch any seed reached is kept, and ``seeds``
+    counts the seeds behind each epoch's mean, so a finished seed's curve is not cut to a new seed's first epoch.
+    """
     curves = [_read_progress(r, metric) for r in runs]
-    n = min(len(s) for s, _ in curves)
-    steps = np.mean([s[:n] for s, _ in curves], axis=0)
-    values = np.array([v[:n] for _, v in curves])
+    n = max((len(s) for s, _ in curves), default=0)
+    steps = np.full((len(curves), n), np.nan)
+    values = np.full((len(curves), n), np.nan)
+    for i, (s, v) in enumerate(curves):
+        steps[i, : len(s)], values[i, : len(v)] = s, v
     with warnings.catch_warnings():  # epochs where no seed logged the metric are NaN, not a warning
         warnings.simplefilter("ignore", RuntimeWarning)
         return {
             "epoch": np.arange(1, n + 1),
-            "steps": steps,
+            "steps": np.nanmean(steps, axis=0) if n else np.array([]),
             "mean": np.nanmean(values, axis=0) if n else np.array([]),
             "std": np.nanstd(values, axis=0) if n else np.array([]),
-            "seeds": np.full(n, len(runs)),
+            "seeds": np.isfinite(steps).sum(axis=0),
         }
+
+
+def final_values(runs: list[Path], metric: str = METRIC) -> tuple[np.ndarray, np.ndarray]:
+    """Each run's last logged ``metric`` and the epoch it was logged at (runs that logged none left out)."""
+    values, epochs = [], []
+    for run in runs:
+        _, v = _read_progress(run, metric)
+        logged = np.flatnonzero(np.isfinite(v))
+        if len(logged):
+            values.append(v[logged[-1]])
+            epochs.append(logged[-1] + 1)
+    return np.array(values), np.array(epochs, dtype=int)
+
+
+def seeds_label(agg: dict[str, np.ndarray], total: int) -> str:
+    """``5 seeds``, or, for an arm still training, ``3 seeds, 1 past epoch 12``: how many seeds each part of the
+    curve stands on."""
+    if not len(agg["seeds"]) or agg["seeds"].min() == total:
+        return f"{total} seeds"
+    full = int((agg["seeds"] == total).sum())  # seeds only drop out along the curve
+    return f"{total} seeds, {int(agg['seeds'][-1])} past epoch {full}"
 
 
 X_AXES = ("auto", "epochs", "samples")
@@ -120,9 +156,8 @@ def plot_curves(
         agg = aggs[label]
         ok = np.isfinite(agg["mean"])  # a metric logged every few epochs only (greedy evaluations)
         xv, mean, std = xs[label][ok], agg["mean"][ok], agg["std"][ok]
-        line = ax.plot(
-            xv, mean, label=f"{label} ({len(runs)} seeds)", linewidth=1.4, marker="." if ok.sum() < 40 else None
-        )[0]
+        name = f"{label} ({seeds_label(agg, len(runs))})"
+        line = ax.plot(xv, mean, label=name, linewidth=1.4, marker="." if ok.sum() < 40 else None)[0]
         ax.fill_between(xv, mean - std, mean + std, color=line.get_color(), alpha=0.2)
     ax.set_xlabel(xlabel)
     ax.set_ylabel(LABELS.get(metric, metric))
@@ -149,8 +184,12 @@ def results_table(groups: dict[str, list[Path]]) -> str:
     ]
     for label, runs in groups.items():
         evals = [json.loads((r / "evaluation.json").read_text()) for r in runs if (r / "evaluation.json").exists()]
-        agg = aggregate(runs)
-        last = f"{agg['mean'][-1]:.3f} +- {agg['std'][-1]:.3f}" if len(agg["mean"]) else "-"
+        finals, epochs = final_values(runs)
+        last = "-"
+        if len(finals):
+            last = f"{finals.mean():.3f} +- {finals.std():.3f}"
+            if epochs.min() != epochs.max():  # an arm still training: say where each seed is
+                last += f" (epochs {', '.join(map(str, epochs))})"
         if evals:
             ret = np.array([e["mean_return"] for e in evals])
             per_seed = ", ".join(f"{r:.3f}" for r in ret)
