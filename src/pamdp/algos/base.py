@@ -397,6 +397,22 @@ def atomic_save(payload: dict, path: str | os.PathLike) -> None:
         raise
 
 
+def _alone() -> float:
+    return 1.0
+
+
+def _own_storage(obj):
+    """``obj`` with every tensor that views a larger storage copied out: ``torch.save`` writes a view's whole
+    storage, which for a stacked seed's weights (pamdp.algos.stacking) holds every seed's."""
+    if isinstance(obj, torch.Tensor):
+        return obj.clone() if obj.untyped_storage().nbytes() != obj.nbytes else obj
+    if isinstance(obj, dict):
+        return {k: _own_storage(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return type(obj)(_own_storage(v) for v in obj)
+    return obj
+
+
 def _resolve_model_path(path: str | os.PathLike) -> Path:
     path = Path(path)
     if path.is_dir():
@@ -474,6 +490,7 @@ class Algorithm:
             torch.manual_seed(config.seed)
             self._build()
         self._vec_env: gymnasium.vector.VectorEnv | None = None
+        self._cpu_share: Callable[[], float] = _alone  # runs sharing this process's CPU time (seed stacks)
 
     # -- to be provided by each algorithm ----------------------------------------------------
     def _build(self) -> None:
@@ -596,7 +613,8 @@ class Algorithm:
                         "time/total_timesteps": float(self.num_timesteps),
                         "time/epoch_seconds": elapsed,
                         # CPU time of this process: unlike the wall clock, it stops while the run is suspended
-                        "time/epoch_cpu_seconds": time.process_time() - cpu0,
+                        # (shared equally by the seeds stacked in this process, see pamdp.algos.stacking)
+                        "time/epoch_cpu_seconds": (time.process_time() - cpu0) / self._cpu_share(),
                         "charts/SPS": (self.num_timesteps - start_steps) / (time.perf_counter() - start_time),
                     }
                 )
@@ -643,8 +661,8 @@ class Algorithm:
             "num_timesteps": self.num_timesteps,
             "epoch": self.epoch,
             "rng": {"numpy": self.np_rng.bit_generator.state, "torch": self.torch_gen.get_state()},
-            "modules": {k: m.state_dict() for k, m in self._modules().items()},
-            "optimizers": {k: o.state_dict() for k, o in self._optimizers().items()},
+            "modules": _own_storage({k: m.state_dict() for k, m in self._modules().items()}),
+            "optimizers": _own_storage({k: o.state_dict() for k, o in self._optimizers().items()}),
             "extra": self._extra_state(replay),
         }
         atomic_save(payload, path)

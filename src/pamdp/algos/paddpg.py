@@ -31,7 +31,6 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 import torch
-import torch.nn.functional as F
 from torch import nn
 
 from pamdp.algos.base import (
@@ -47,6 +46,7 @@ from pamdp.algos.base import (
 )
 from pamdp.algos.offpolicy import OffPolicyLoop, OUNoise, clipped_step, linear_epsilon, mixed_target, soft_update
 from pamdp.algos.replay import ReplayBuffer
+from pamdp.algos.stacking import clip_per_member
 from pamdp.policies import ACTIVATIONS, mlp
 from pamdp.spaces import HybridActionSpace
 
@@ -166,7 +166,7 @@ def backprop_actor(
         dq_dp = invert_gradients(dq_dp, p.detach())
     elif bound == "zero":
         dq_dp = zero_gradients(dq_dp, p.detach())
-    out.backward(-dq_dp / len(out))  # descend on -mean Q
+    out.backward(-dq_dp / out.shape[-2])  # descend on -mean Q over the batch (of each stacked seed)
     return out.detach(), q.detach()
 
 
@@ -307,29 +307,94 @@ class PADDPG(Algorithm):
     def _update(self) -> dict[str, float]:
         """One critic step on the mixed target and one actor step along the bounded ``dQ/dmu``."""
         cfg = self.config
-        b = self.replay.sample(cfg.batch_size, self.np_rng)
-        obs, next_obs = b["obs"], b["next_obs"]
-        with torch.no_grad():
-            q_next = self.critic_target(next_obs, self.actor_target(next_obs).clamp(-1.0, 1.0))
-            y = b["reward"] + cfg.gamma * (~b["terminated"]).float() * q_next
-            if cfg.beta > 0:
-                y = mixed_target(y, b["mc"], cfg.beta)
-        q = self.critic(obs, b["out"])
-        critic_loss = F.mse_loss(q, y)
-        self.critic_optimizer.zero_grad(set_to_none=True)
-        critic_loss.backward()
-        clipped_step(self.critic_optimizer, self.critic.parameters(), cfg.grad_clip)
+        b = self._stack_sample()
 
-        self.actor_optimizer.zero_grad(set_to_none=True)
-        out, q_mu = backprop_actor(self.actor, self.critic, obs, cfg.bound)
-        clipped_step(self.actor_optimizer, self.actor.parameters(), cfg.grad_clip)
+        def step(optimizer, params):
+            clipped_step(optimizer, params, cfg.grad_clip)
 
-        soft_update(self.critic_target, self.critic, cfg.tau)
-        soft_update(self.actor_target, self.actor, cfg.tau)
-        outside = (out.abs() > 1.0).float().mean()
-        return {
-            "losses/critic_loss": float(critic_loss.detach()),
-            "losses/actor_loss": float(-q_mu.mean()),
-            "train/q_mean": float(q.detach().mean()),
-            "train/outputs_out_of_bounds": float(outside),
-        }
+        stats = _update_step(
+            cfg,
+            b,
+            self.actor,
+            self.critic,
+            self.actor_target,
+            self.critic_target,
+            lambda: step(self.critic_optimizer, self.critic.parameters()),
+            lambda: step(self.actor_optimizer, self.actor.parameters()),
+            (self.critic_optimizer, self.actor_optimizer),
+            lambda: (
+                soft_update(self.critic_target, self.critic, cfg.tau),
+                soft_update(self.actor_target, self.actor, cfg.tau),
+            ),
+        )
+        return {k: float(v) for k, v in stats.items()}
+
+    # -- seed stacking (pamdp.algos.stacking) ---------------------------------------------------------
+    def _stack_sample(self) -> dict[str, torch.Tensor]:
+        return self.replay.sample(self.config.batch_size, self.np_rng)
+
+    @classmethod
+    def _stacked_update(cls, stack, b: dict[str, torch.Tensor]) -> list[dict[str, float]]:
+        """:meth:`_update` for every member of a seed stack at once, on their batches stacked ``(S, B, ...)``."""
+        cfg = stack.config
+
+        def actor(o):
+            return stack.sequential("actor", "net", o)
+
+        def critic(o, out):
+            return stack.sequential("critic", "net", torch.cat([o, out], dim=-1)).squeeze(-1)
+
+        def actor_target(o):
+            return stack.sequential("actor_target", "net", o)
+
+        def critic_target(o, out):
+            return stack.sequential("critic_target", "net", torch.cat([o, out], dim=-1)).squeeze(-1)
+
+        def step(name):
+            clip_per_member(list(stack.params[name].values()), cfg.grad_clip)
+            stack.optimizers[name].step()
+
+        stats = _update_step(
+            cfg,
+            b,
+            actor,
+            critic,
+            actor_target,
+            critic_target,
+            lambda: step("critic"),
+            lambda: step("actor"),
+            tuple(stack.optimizers.values()),
+            lambda: (
+                stack.soft_update("critic_target", "critic", cfg.tau),
+                stack.soft_update("actor_target", "actor", cfg.tau),
+            ),
+        )
+        columns = {k: v.tolist() for k, v in stats.items()}
+        return [{k: columns[k][j] for k in columns} for j in range(len(b["obs"]))]
+
+
+def _update_step(cfg, b, actor, critic, actor_target, critic_target, critic_step, actor_step, optimizers, soft):
+    """PADDPG's update on a batch ``(B, ...)``, or on the batches of stacked seeds ``(S, B, ...)`` with the
+    networks applied per seed: every mean is over the batch axis, so each seed's loss and gradient are its own.
+    Returns each statistic per seed (a scalar tensor without stacking)."""
+    obs, next_obs = b["obs"], b["next_obs"]
+    with torch.no_grad():
+        q_next = critic_target(next_obs, actor_target(next_obs).clamp(-1.0, 1.0))
+        y = b["reward"] + cfg.gamma * (~b["terminated"]).float() * q_next
+        if cfg.beta > 0:
+            y = mixed_target(y, b["mc"], cfg.beta)
+    q = critic(obs, b["out"])
+    critic_loss = (q - y).square().mean(-1)  # F.mse_loss, per seed
+    for opt in optimizers:
+        opt.zero_grad(set_to_none=True)
+    critic_loss.sum().backward()
+    critic_step()
+    out, q_mu = backprop_actor(actor, critic, obs, cfg.bound)
+    actor_step()
+    soft()
+    return {
+        "losses/critic_loss": critic_loss.detach(),
+        "losses/actor_loss": -q_mu.mean(-1),
+        "train/q_mean": q.detach().mean(-1),
+        "train/outputs_out_of_bounds": (out.abs() > 1.0).float().flatten(-2).mean(-1),
+    }
