@@ -405,7 +405,9 @@ def _own_storage(obj):
     """``obj`` with every tensor that views a larger storage copied out: ``torch.save`` writes a view's whole
     storage, which for a stacked seed's weights (pamdp.algos.stacking) holds every seed's."""
     if isinstance(obj, torch.Tensor):
-        return obj.clone() if obj.untyped_storage().nbytes() != obj.nbytes else obj
+        if obj.untyped_storage().nbytes() != obj.nbytes or not obj.is_contiguous():
+            return obj.clone(memory_format=torch.contiguous_format)
+        return obj
     if isinstance(obj, dict):
         return {k: _own_storage(v) for k, v in obj.items()}
     if isinstance(obj, list | tuple):

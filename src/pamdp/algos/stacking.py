@@ -124,15 +124,21 @@ class SeedStack:
             self.params, self.optimizers = {}, {}
             return
         stacked: dict[int, torch.Tensor] = {}  # id of member 0's parameter -> its stacked tensor
+        flip: dict[int, bool] = {}  # whether a parameter is stored transposed in the stack
         self.params = {}
         for name, module in members[0]._modules().items():
             own = {}
             for pname, p in module.named_parameters():
+                # A linear layer's weight is stacked as (S, in, out): the forward product needs no transpose
+                # and its gradient comes out in the layout of the stack (no copy into the .grad).
+                owner = module.get_submodule(pname.rpartition(".")[0]) if "." in pname else module
+                t = isinstance(owner, nn.Linear) and pname.endswith("weight")
                 views = [m._modules()[name].get_parameter(pname) for m in members]
-                s = torch.stack([v.detach() for v in views]).requires_grad_(p.requires_grad)
+                s = torch.stack([_t(v.detach(), t) for v in views]).requires_grad_(p.requires_grad)
                 for j, v in enumerate(views):
-                    v.data = s[j]
+                    v.data = _t(s[j], t)
                 own[pname] = stacked[id(p)] = s
+                flip[id(p)] = t
             self.params[name] = own
         self.optimizers = {}
         for name, opt in members[0]._optimizers().items():
@@ -145,19 +151,20 @@ class SeedStack:
             new = type(opt)(stacks, **kwargs)
             step = max(adam_step(m) for m in members)
             for k, s in enumerate(stacks):
+                t = flip[id(group["params"][k])]
                 member_params = [o.param_groups[0]["params"][k] for o in opts]
                 states = [o.state.get(p, {}) for o, p in zip(opts, member_params)]
                 state = {"step": torch.tensor(float(step), dtype=torch.float32)}
                 for key in ("exp_avg", "exp_avg_sq"):
                     state[key] = torch.stack(
-                        [st[key] if key in st else torch.zeros_like(p) for st, p in zip(states, member_params)]
+                        [_t(st[key] if key in st else torch.zeros_like(p), t) for st, p in zip(states, member_params)]
                     )
                 new.state[s] = state
                 for j, (o, p) in enumerate(zip(opts, member_params)):
                     o.state[p] = {
                         "step": state["step"],
-                        "exp_avg": state["exp_avg"][j],
-                        "exp_avg_sq": state["exp_avg_sq"][j],
+                        "exp_avg": _t(state["exp_avg"][j], t),
+                        "exp_avg_sq": _t(state["exp_avg_sq"][j], t),
                     }
             self.optimizers[name] = new
 
@@ -167,10 +174,10 @@ class SeedStack:
         with torch.no_grad():
             for module in member._modules().values():
                 for p in module.parameters():
-                    p.data = p.data.clone()
+                    p.data = p.data.clone(memory_format=torch.contiguous_format)
             for opt in member._optimizers().values():
                 for p, state in list(opt.state.items()):
-                    opt.state[p] = {k: v.clone() for k, v in state.items()}
+                    opt.state[p] = {k: v.clone(memory_format=torch.contiguous_format) for k, v in state.items()}
 
     def sequential(self, module: str, path: str, x: torch.Tensor) -> torch.Tensor:
         """The members' ``nn.Sequential`` at ``module.path`` on inputs ``x`` of shape ``(S, B, in)``.
@@ -183,7 +190,7 @@ class SeedStack:
         for k, layer in template.named_children():
             if isinstance(layer, nn.Linear):
                 w, b = params[f"{path}.{k}.weight"], params[f"{path}.{k}.bias"]
-                x = torch.baddbmm(b.unsqueeze(1), x, w.transpose(1, 2))
+                x = torch.baddbmm(b.unsqueeze(1), x, w)  # w stacked as (S, in, out)
             elif next(layer.parameters(), None) is None:
                 x = layer(x)
             else:
@@ -277,6 +284,10 @@ class SeedStack:
         for t in threads:
             t.join()
         return outcomes
+
+
+def _t(x: torch.Tensor, transpose: bool) -> torch.Tensor:
+    return x.transpose(-1, -2) if transpose else x
 
 
 def _stack(batches: list[dict[str, torch.Tensor]]) -> dict[str, torch.Tensor]:

@@ -1,0 +1,141 @@
+"""How much faster does ``pamdp reproduce --stack`` train PADDPG's seeds? The library's seed stacks, end to end.
+
+``benchmarks/seed_batching.md`` measured a model of the stacked update before it was built; this measures the
+library's :class:`~pamdp.algos.stacking.SeedStack` as ``pamdp reproduce --stack`` runs it: whole training runs
+(env steps, acting, replay, updates, logging, threads), paper preset on Platform, one torch thread a process,
+each process pinned to its own core and all of a case started together. The figure is seed-samples trained per
+second summed over the processes (median over ``--repeats``), against two processes of one seed each (the
+layout of ``pamdp reproduce --workers 2``).
+
+    python benchmarks/bench_seed_stacking.py --out benchmarks/seed_stacking.md
+
+Other training on the machine should be paused (``kill -STOP``) while it runs; the record says the load average.
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime as dt
+import json
+import os
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+HERE = Path(__file__).parent
+# (label, seeds per process, one entry per process)
+CASES = [
+    ("two processes, 1 seed each (`--workers 2`)", [1, 1]),
+    ("two processes, 2 seeds stacked each (`--workers 2 --stack 2`)", [2, 2]),
+    ("two processes, 3 seeds stacked each (`--workers 2 --stack 3`)", [3, 3]),
+]
+
+
+def worker(core: int, seeds: int, samples: int) -> None:
+    """Pinned to the ``core``-th allowed CPU: build ``seeds`` runs, say so, then train them once told to."""
+    import dataclasses
+
+    import torch
+
+    from pamdp.algos.paddpg import PADDPG, PADDPGConfig
+    from pamdp.algos.stacking import SeedStack
+
+    os.sched_setaffinity(0, {sorted(os.sched_getaffinity(0))[core]})
+    torch.set_num_threads(1)
+    # The paper preset with updates from the first batch on, so every measured sample carries its update.
+    config = dataclasses.replace(PADDPGConfig(), learning_starts=32, epoch_steps=1000)
+    models = [PADDPG("pamdp/Platform-v0", dataclasses.replace(config, seed=100 * core + s)) for s in range(seeds)]
+    print("ready", flush=True)
+    sys.stdin.readline()
+    start, cpu = time.perf_counter(), time.process_time()
+    if seeds == 1:
+        models[0].learn(samples, progress_bar=False)
+    else:
+        SeedStack(models).run([lambda leave, m=m: m.learn(samples, progress_bar=False) for m in models])
+    wall, cpu = time.perf_counter() - start, time.process_time() - cpu
+    trained = sum(m.num_timesteps for m in models)
+    print(json.dumps({"seeds": seeds, "samples": trained, "wall": wall, "cpu": cpu}), flush=True)
+
+
+def run_case(counts: list[int], samples: int) -> list[dict]:
+    procs = [
+        subprocess.Popen(
+            [sys.executable, __file__, "--worker", str(core), str(n), str(samples)],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            text=True,
+        )
+        for core, n in enumerate(counts)
+    ]
+    for proc in procs:
+        if proc.stdout.readline().strip() != "ready":
+            raise SystemExit(f"a worker failed before timing (exit code {proc.wait()})")
+    for proc in procs:
+        proc.stdin.write("go\n")
+        proc.stdin.flush()
+    results = []
+    for proc in procs:
+        out, _ = proc.communicate()
+        if proc.returncode != 0:
+            raise SystemExit(f"worker failed with exit code {proc.returncode}")
+        results.append(json.loads(out.strip().splitlines()[-1]))
+    return results
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--samples", type=int, default=3000, help="samples per seed (default: %(default)s)")
+    parser.add_argument("--repeats", type=int, default=3, help="repeats per case (default: %(default)s)")
+    parser.add_argument("--out", default=None, help="markdown record to write (default: print only)")
+    parser.add_argument("--worker", nargs=3, type=int, help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if args.worker:
+        worker(*args.worker)
+        return
+    if len(os.sched_getaffinity(0)) < 2:
+        raise SystemExit("needs two cores (each case pins one process to each)")
+    load = os.getloadavg()[0]
+    rates: dict[str, list[float]] = {label: [] for label, _ in CASES}
+    per_process: dict[str, list[list[float]]] = {label: [] for label, _ in CASES}
+    for rep in range(args.repeats):  # cases interleaved, so a drift of the machine's speed hits them alike
+        for label, counts in CASES:
+            results = run_case(counts, args.samples)
+            rates[label].append(sum(r["samples"] / r["wall"] for r in results))
+            per_process[label].append([r["samples"] / r["cpu"] for r in results])
+            print(f"repeat {rep}: {label}: {rates[label][-1]:.0f} seed-samples/s", file=sys.stderr)
+    base = statistics.median(rates[CASES[0][0]])
+    sys.path.insert(0, str(HERE))
+    from _record import hand_notes, machine
+
+    command = f"python benchmarks/bench_seed_stacking.py --samples {args.samples} --repeats {args.repeats}"
+    lines = [
+        "# Seed stacking, end to end: `pamdp reproduce --stack` against one seed per process (PADDPG, Platform)",
+        "",
+        f"- command: `{command}" + (f" --out {args.out}`" if args.out else "`"),
+        f"- date: {dt.datetime.now().isoformat(timespec='seconds')}",
+        f"- load average at the start: {load:.1f}; machine: {machine()}",
+        f"- PADDPG's paper preset ({{400, 300}}, batch 32, one update per sample) with `learning_starts = 32`, "
+        f"{args.samples:,} samples per seed from a fresh start; one torch thread per process, each pinned to its "
+        f"own core; medians of {args.repeats} repeats, the cases interleaved",
+        "",
+        "| layout | seed-samples/s in all (median) | each repeat | per process, samples per CPU-second | "
+        "vs. one seed per process |",
+        "|---|---|---|---|---|",
+    ]
+    for label, _ in CASES:
+        med = statistics.median(rates[label])
+        each = ", ".join(f"{r:.0f}" for r in rates[label])
+        cpu = ", ".join(f"{statistics.median(col):.0f}" for col in zip(*per_process[label]))
+        lines.append(f"| {label} | {med:.0f} | {each} | {cpu} | {med / base:.2f}x |")
+    record = Path(args.out) if args.out else None
+    notes = hand_notes(record) if record else ""
+    text = "\n".join(lines) + "\n" + (f"\n{notes}\n" if notes else "")
+    if record:
+        record.write_text(text)
+    print(text)
+
+
+if __name__ == "__main__":
+    main()
