@@ -34,6 +34,8 @@
 #   7. soccer's PADDPG arm: 3 x 5M at one update per sample is ~15 core-hours a run here, so it runs as far
 #      as the sessions allow (issue 7 asks for "as far as the machine allows")
 # Steps 3 (seed 2), 5 and 7 run in a side queue beside steps 4 and 6 (below), step 7 at the lowest priority.
+# The off-policy arms run as seed stacks (pamdp reproduce --stack, since 2026-11-29): the core-hours above are
+# per run alone, and a stack of three trains ~1.3x the seeds an hour.
 set -euo pipefail
 cd "$(dirname "$0")"
 RUNS=${PAMDP_RUNS:-/root/pamdp-runs}
@@ -57,15 +59,17 @@ main() {
     (
         pamdp reproduce soccer --runs PATRPO --seeds 2 --workers 1 --out "$RUNS/repro"
         python bench_paddpg_hausknecht_stone.py --workers 1 --out "$RUNS/bench"    # issue 5
-        nice -n 19 pamdp reproduce soccer --workers 2 --out "$RUNS/repro"
+        nice -n 19 pamdp reproduce soccer --workers 2 --stack 3 --out "$RUNS/repro"
     ) &
     side=$!
     set +m
     # If the main queue fails (set -e) the side queue must not run on alone: a new start of this script would
     # then train the same runs in two processes at once.
     trap 'kill -TERM -- "-$side" 2>/dev/null || true' EXIT
-    python bench_paddpg_platform.py --workers 2 --out "$RUNS/repro"    # = platform --runs PADDPG, + record (issue 5)
-    pamdp reproduce platform --workers 2 --out "$RUNS/repro"          # its PASVG(0) arm, then the figure (issue 7)
+    # --stack 3: seeds 0-2 in one process, 3-4 in the other, each stack's updates batched (~1.3x the seeds an hour,
+    # benchmarks/seed_stacking.md)
+    python bench_paddpg_platform.py --workers 2 --stack 3 --out "$RUNS/repro"  # = platform --runs PADDPG + record (issue 5)
+    pamdp reproduce platform --workers 2 --stack 3 --out "$RUNS/repro"        # its PASVG(0) arm, the figure (issue 7)
     wait "$side"
     trap - EXIT
 }
