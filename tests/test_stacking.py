@@ -8,6 +8,7 @@ import torch
 
 from pamdp import PADDPG, PATRPO
 from pamdp.algos.paddpg import PADDPGConfig
+from pamdp.algos.pasvg import PASVG0, PASVG0Config
 from pamdp.algos.stacking import ALIGNED_STEPS, SeedStack, clip_per_member, step_class
 from pamdp.experiments.runner import RunSpec, group_jobs, train_stack
 
@@ -57,6 +58,32 @@ def test_stacked_seeds_train_as_they_would_alone(bound):
         assert m.epoch == a.epoch and m.replay.added == a.replay.added
         # once out of the stack, its tensors are its own again
         assert all(p.untyped_storage().nbytes() == p.nbytes for p in m.actor.parameters())
+
+
+@pytest.mark.parametrize("discrete_gradient", ["gumbel", "expected"])
+def test_stacked_pasvg0_seeds_train_as_they_would_alone(discrete_gradient):
+    config = PASVG0Config(
+        hidden_sizes=(16, 8),
+        learning_starts=100,
+        epoch_steps=300,
+        num_envs=4,
+        batch_size=16,
+        discrete_gradient=discrete_gradient,
+        entropy_coef=0.05,
+        explore_epsilon=0.1,  # draws from the same torch generator as the update's noise
+    )
+
+    def run(seed):
+        return PASVG0("pamdp/Platform-v0", dataclasses.replace(config, seed=seed))
+
+    alone = [run(seed).learn(600, progress_bar=False) for seed in range(2)]
+    members = [run(seed) for seed in range(2)]
+    _, outcomes = trained_together(members, 600)
+    assert outcomes == [m.num_timesteps for m in alone]
+    for a, m in zip(alone, members):
+        assert max_difference(a, m) < 1e-4
+        assert m.critic_updates == a.critic_updates > 400
+        assert torch.equal(m.torch_gen.get_state(), a.torch_gen.get_state())  # the same noise drawn
 
 
 def test_a_stacked_member_saves_its_own_weights_and_optimiser_state(tmp_path):
@@ -111,6 +138,8 @@ def test_clipping_per_member_is_each_members_own_clip_grad_norm():
 def test_a_stack_refuses_what_it_cannot_batch():
     with pytest.raises(ValueError, match="differ in their seed only; they differ in batch_size"):
         SeedStack([tiny(0), tiny(1, batch_size=8)])
+    with pytest.raises(ValueError, match="PASVG0 cannot stack seeds with target_entropy"):
+        SeedStack([PASVG0("pamdp/Platform-v0", PASVG0Config.preset("tuned"))])
     with pytest.raises(ValueError, match="PATRPO does not support seed stacking"):
         SeedStack([PATRPO("pamdp/Platform-v0", {"hidden_sizes": (8,)})])
     resumed = [tiny(seed) for seed in range(2)]
@@ -153,6 +182,7 @@ def test_jobs_are_grouped_by_setting_evenly_and_in_order():
 
     jobs = [spec("patrpo", s) for s in range(2)] + [spec("paddpg", s) for s in range(5)]
     jobs += [spec("paddpg", s, tau=0.01) for s in range(2)]
+    jobs += [(RunSpec("pasvg0", "pamdp/Platform-v0", 1000, s, preset="tuned"), f"tuned{s}") for s in range(2)]
     groups = [[out for _, out in g] for g in group_jobs(jobs, 3)]
     assert groups == [
         ["patrpo0"],
@@ -160,6 +190,8 @@ def test_jobs_are_grouped_by_setting_evenly_and_in_order():
         ["paddpg0", "paddpg1", "paddpg2"],
         ["paddpg3", "paddpg4"],
         ["paddpg0", "paddpg1"],
+        ["tuned0"],  # settings a stack cannot take run alone
+        ["tuned1"],
     ]
     assert all(len(g) == 1 for g in group_jobs(jobs, 1))
     with pytest.raises(ValueError, match="stack = 0; expected an integer >= 1"):

@@ -49,6 +49,7 @@ from pamdp.algos.base import (
 )
 from pamdp.algos.offpolicy import OffPolicyLoop, clipped_step, soft_update
 from pamdp.algos.replay import ReplayBuffer
+from pamdp.algos.stacking import clip_per_member
 from pamdp.policies import ACTIVATIONS, mlp
 from pamdp.spaces import HybridActionSpace
 
@@ -499,3 +500,114 @@ class PASVG0(Algorithm):
             "train/entropy_coef": alpha,
             "train/param_std": float(self.policy.log_std.detach().exp()[mask].mean()),
         }
+
+    # -- seed stacking (pamdp.algos.stacking) ---------------------------------------------------------
+    @classmethod
+    def _stack_refusal(cls, config: PASVG0Config) -> str | None:
+        """The settings a seed stack cannot take (it batches the paper's update, not every variant)."""
+        if config.twin_critics:
+            return "twin_critics"
+        if config.policy_delay != 1:
+            return f"policy_delay = {config.policy_delay} (its counter is per run)"
+        if config.target_entropy is not None:
+            return "target_entropy (a tuned entropy weight)"
+        return None
+
+    def _stack_sample(self) -> dict[str, torch.Tensor]:
+        """What :meth:`_update` draws from this run's random streams, in its order: the batch, then the noise."""
+        b = self.replay.sample(self.config.batch_size, self.np_rng)
+        b["next_eta_a"], b["next_eta_x"] = self._noise(self.config.batch_size)
+        return b
+
+    @classmethod
+    def _stacked_update(cls, stack, b: dict[str, torch.Tensor]) -> list[dict[str, float]]:
+        """:meth:`_update` for every member of a seed stack at once, on their batches stacked ``(S, B, ...)``.
+
+        The same computation written over a leading seed axis: every mean is over the batch, and each seed's
+        rows of ``log_std`` are gathered with its own actions.
+        """
+        cfg = stack.config
+        mask = stack.buffer("policy", "mask")
+        K = mask.shape[0]
+
+        def policy(module):
+            log_std = stack.params[module]["log_std"]
+
+            def params(obs, index, a, eta_x):  # GumbelHybridPolicy.params
+                std = log_std.clamp(LOG_STD_MIN, LOG_STD_MAX).exp()
+                std = std.reshape(std.shape[0], *([1] * (index.dim() - 2)), K, std.shape[-1])
+                std = std.expand(*index.shape[:-1], K, std.shape[-1])
+                std = torch.gather(std, -2, index.unsqueeze(-1).expand(*index.shape, std.shape[-1]))
+                pre = stack.sequential(module, "pi_c", torch.cat([obs, a], dim=-1))
+                return torch.tanh(pre + std * eta_x) * mask[index]
+
+            def pi_d(obs):
+                return stack.sequential(module, "pi_d", obs)
+
+            def sample(obs, eta_a, eta_x):  # GumbelHybridPolicy.sample
+                logits = pi_d(obs)
+                index, a = gumbel_softmax_sample(logits, eta_a, cfg.temperature, cfg.straight_through)
+                return logits, index, a, params(obs, index, a, eta_x)
+
+            def expected(q_fn, obs, eta_x):  # expected_q, with GumbelHybridPolicy.params_all
+                S, B = obs.shape[:2]
+                index = torch.arange(K).expand(S, B, K)
+                onehots = torch.eye(K, dtype=obs.dtype).expand(S, B, K, K)
+                obs_k = obs.unsqueeze(2).expand(S, B, K, obs.shape[-1])
+                logits = pi_d(obs)
+                q_all = q_fn(obs_k, onehots, params(obs_k, index, onehots, eta_x.unsqueeze(2)))
+                return logits, (logits.softmax(-1) * q_all).sum(-1)
+
+            return pi_d, sample, expected
+
+        def critic(module):
+            return lambda o, a, x: stack.sequential(module, "net", torch.cat([o, a, x], dim=-1)).squeeze(-1)
+
+        obs, next_obs = b["obs"], b["next_obs"]
+        _, target_sample, target_expected = policy("policy_target")
+        with torch.no_grad():
+            if cfg.discrete_gradient == "expected":
+                _, q_next = target_expected(critic("critic_target"), next_obs, b["next_eta_x"])
+            else:
+                _, _, a_next, x_next = target_sample(next_obs, b["next_eta_a"], b["next_eta_x"])
+                q_next = critic("critic_target")(next_obs, a_next, x_next)
+            y = b["reward"] + cfg.gamma * (~b["terminated"]).float() * q_next
+        q = critic("critic")(obs, b["a_in"], b["x"])
+        critic_loss = (q - y).square().mean(-1)  # F.mse_loss, per seed
+        critic_params = list(stack.params["critic"].values())
+        stack.optimizers["critic"].zero_grad(set_to_none=True)
+        critic_loss.sum().backward()
+        clip_per_member(critic_params, cfg.grad_clip)
+        stack.optimizers["critic"].step()
+
+        _, sample, expected = policy("policy")
+        if cfg.discrete_gradient == "expected":
+            logits, q_pi = expected(critic("critic"), obs, b["eta_x"])
+        else:
+            logits, _, a, x = sample(obs, b["eta_a"], b["eta_x"])
+            q_pi = critic("critic")(obs, a, x)
+        entropy = -(logits.softmax(-1) * logits.log_softmax(-1)).sum(-1).mean(-1)
+        actor_loss = -q_pi.mean(-1) - cfg.entropy_coef * entropy
+        policy_params = [p for p in stack.params["policy"].values() if p.requires_grad]
+        grads = torch.autograd.grad(actor_loss.sum(), policy_params)
+        for p, g in zip(policy_params, grads):
+            p.grad = g
+        clip_per_member(policy_params, cfg.grad_clip)
+        stack.optimizers["policy"].step()
+        stack.soft_update("critic_target", "critic", cfg.tau)
+        stack.soft_update("policy_target", "policy", cfg.tau)
+        std = stack.params["policy"]["log_std"].detach().exp()[:, mask.bool()].mean(-1)
+        columns = {
+            "losses/critic_loss": critic_loss.detach().tolist(),
+            "train/q_mean": q.detach().mean(-1).tolist(),
+            "losses/actor_loss": actor_loss.detach().tolist(),
+            "train/q_pi_mean": q_pi.detach().mean(-1).tolist(),
+            "train/entropy": entropy.detach().tolist(),
+            "train/param_std": std.tolist(),
+        }
+        stats = [{k: v[j] for k, v in columns.items()} for j in range(len(obs))]
+        for st in stats:
+            st["train/entropy_coef"] = cfg.entropy_coef
+        for m in stack.members_active():
+            m.critic_updates += 1
+        return stats

@@ -22,9 +22,11 @@ at different updates do not, and are stacked only when every count is past :data
 bias corrections equal 1 to float precision, so taking the largest changes nothing (:class:`SeedStack` refuses
 others; :func:`step_class` sorts members into those that can share a stack).
 
-An algorithm supports stacking by defining ``_stack_sample(self) -> batch`` (a dict of tensors) and the class
-method ``_stacked_update(stack, batch) -> list of per-member stats``, where ``batch`` holds the members'
-batches stacked on a new first axis. See :class:`~pamdp.algos.paddpg.PADDPG`.
+An algorithm supports stacking by defining ``_stack_sample(self) -> batch`` (a dict of tensors: what its update
+draws from its own random streams) and the class method ``_stacked_update(stack, batch) -> list of per-member
+stats``, where ``batch`` holds the members' batches stacked on a new first axis; optionally the class method
+``_stack_refusal(config) -> str | None`` names settings it cannot stack. See :class:`~pamdp.algos.paddpg.PADDPG`
+and :class:`~pamdp.algos.pasvg.PASVG0`.
 """
 
 from __future__ import annotations
@@ -89,6 +91,9 @@ class SeedStack:
         cls = type(members[0])
         if not can_stack(cls):
             raise ValueError(f"{cls.__name__} does not support seed stacking")
+        refusal = cls._stack_refusal(members[0].config) if hasattr(cls, "_stack_refusal") else None
+        if refusal:
+            raise ValueError(f"{cls.__name__} cannot stack seeds with {refusal}")
         if any(type(m) is not cls for m in members):
             raise ValueError(f"a seed stack holds one algorithm; got {sorted({type(m).__name__ for m in members})}")
         base = {k: v for k, v in members[0].config.to_dict().items() if k != "seed"}
@@ -180,13 +185,15 @@ class SeedStack:
                     opt.state[p] = {k: v.clone(memory_format=torch.contiguous_format) for k, v in state.items()}
 
     def sequential(self, module: str, path: str, x: torch.Tensor) -> torch.Tensor:
-        """The members' ``nn.Sequential`` at ``module.path`` on inputs ``x`` of shape ``(S, B, in)``.
+        """The members' ``nn.Sequential`` at ``module.path`` on inputs ``x`` of shape ``(S, ..., in)``.
 
         Linear layers become batched products over the members' stacked weights; parameter-free layers
         (activations) are applied as they are.
         """
         template = self.members[self.active[0]]._modules()[module].get_submodule(path)
         params = self.params[module]
+        shape = x.shape[:-1]
+        x = x.reshape(shape[0], -1, x.shape[-1])
         for k, layer in template.named_children():
             if isinstance(layer, nn.Linear):
                 w, b = params[f"{path}.{k}.weight"], params[f"{path}.{k}.bias"]
@@ -195,7 +202,15 @@ class SeedStack:
                 x = layer(x)
             else:
                 raise ValueError(f"seed stacking cannot batch a {type(layer).__name__} layer")
-        return x
+        return x.reshape(*shape, x.shape[-1])
+
+    def members_active(self) -> list[Any]:
+        """The members in the stack, in the order of its leading axis."""
+        return [self.members[i] for i in self.active]
+
+    def buffer(self, module: str, name: str) -> torch.Tensor:
+        """A buffer of the members' ``module`` (the same in every member: masks, index tables)."""
+        return self.members[self.active[0]]._modules()[module].get_buffer(name)
 
     def soft_update(self, target: str, source: str, tau: float) -> None:
         with torch.no_grad():

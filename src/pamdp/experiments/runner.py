@@ -185,6 +185,8 @@ def stack_key(spec: RunSpec):
     cls = algorithm_class(spec.algo)
     if cls is None or not can_stack(cls):
         return None
+    if hasattr(cls, "_stack_refusal") and cls._stack_refusal(spec.config()[2]):
+        return None
     return json.dumps(dataclasses.asdict(dataclasses.replace(spec, seed=0)), sort_keys=True, default=repr)
 
 
