@@ -1,8 +1,9 @@
-"""How much faster does ``pamdp reproduce --stack`` train PADDPG's seeds? The library's seed stacks, end to end.
+"""How much faster does ``pamdp reproduce --stack`` train off-policy seeds? The library's seed stacks, end to end.
 
 ``benchmarks/seed_batching.md`` measured a model of the stacked update before it was built; this measures the
 library's :class:`~pamdp.algos.stacking.SeedStack` as ``pamdp reproduce --stack`` runs it: whole training runs
-(env steps, acting, replay, updates, logging, threads), paper preset on Platform, one torch thread a process,
+(env steps, acting, replay, updates, logging, threads) of PADDPG and PASVG(0), paper presets on Platform (the
+platform experiment's off-policy arms), one torch thread a process,
 each process pinned to its own core and all of a case started together. The figure is seed-samples trained per
 second summed over the processes (median over ``--repeats``), against two processes of one seed each (the
 layout of ``pamdp reproduce --workers 2``).
@@ -33,20 +34,25 @@ CASES = [
 ]
 
 
-def worker(core: int, seeds: int, samples: int) -> None:
+ALGOS = {"paddpg": "PADDPG", "pasvg0": "PASVG(0)"}
+
+
+def worker(core: int, seeds: int, samples: int, algo: str) -> None:
     """Pinned to the ``core``-th allowed CPU: build ``seeds`` runs, say so, then train them once told to."""
     import dataclasses
 
     import torch
 
-    from pamdp.algos.paddpg import PADDPG, PADDPGConfig
     from pamdp.algos.stacking import SeedStack
+    from pamdp.experiments.runner import algorithm_class
 
     os.sched_setaffinity(0, {sorted(os.sched_getaffinity(0))[core]})
     torch.set_num_threads(1)
+    cls = algorithm_class(algo)
     # The paper preset with updates from the first batch on, so every measured sample carries its update.
-    config = dataclasses.replace(PADDPGConfig(), learning_starts=32, epoch_steps=1000)
-    models = [PADDPG("pamdp/Platform-v0", dataclasses.replace(config, seed=100 * core + s)) for s in range(seeds)]
+    base = cls.config_class.preset("paper")
+    config = dataclasses.replace(base, learning_starts=base.batch_size, epoch_steps=1000)
+    models = [cls("pamdp/Platform-v0", dataclasses.replace(config, seed=100 * core + s)) for s in range(seeds)]
     print("ready", flush=True)
     sys.stdin.readline()
     start, cpu = time.perf_counter(), time.process_time()
@@ -59,10 +65,10 @@ def worker(core: int, seeds: int, samples: int) -> None:
     print(json.dumps({"seeds": seeds, "samples": trained, "wall": wall, "cpu": cpu}), flush=True)
 
 
-def run_case(counts: list[int], samples: int) -> list[dict]:
+def run_case(counts: list[int], samples: int, algo: str) -> list[dict]:
     procs = [
         subprocess.Popen(
-            [sys.executable, __file__, "--worker", str(core), str(n), str(samples)],
+            [sys.executable, __file__, "--worker", str(core), str(n), str(samples), algo],
             stdin=subprocess.PIPE,
             stdout=subprocess.PIPE,
             text=True,
@@ -89,46 +95,59 @@ def main() -> None:
     parser.add_argument("--samples", type=int, default=3000, help="samples per seed (default: %(default)s)")
     parser.add_argument("--repeats", type=int, default=3, help="repeats per case (default: %(default)s)")
     parser.add_argument("--out", default=None, help="markdown record to write (default: print only)")
-    parser.add_argument("--worker", nargs=3, type=int, help=argparse.SUPPRESS)
+    parser.add_argument(
+        "--algos", default="paddpg,pasvg0", help="comma-separated: paddpg, pasvg0 (default: %(default)s)"
+    )
+    parser.add_argument("--worker", nargs=4, help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.worker:
-        worker(*args.worker)
+        core, seeds, samples, algo = args.worker
+        worker(int(core), int(seeds), int(samples), algo)
         return
+    algos = args.algos.split(",")
+    if unknown := [a for a in algos if a not in ALGOS]:
+        raise SystemExit(f"--algos {args.algos}: unknown {', '.join(unknown)}; expected some of {', '.join(ALGOS)}")
     if len(os.sched_getaffinity(0)) < 2:
         raise SystemExit("needs two cores (each case pins one process to each)")
     load = os.getloadavg()[0]
-    rates: dict[str, list[float]] = {label: [] for label, _ in CASES}
-    per_process: dict[str, list[list[float]]] = {label: [] for label, _ in CASES}
+    keys = [(algo, label) for algo in algos for label, _ in CASES]
+    rates: dict[tuple[str, str], list[float]] = {k: [] for k in keys}
+    per_process: dict[tuple[str, str], list[list[float]]] = {k: [] for k in keys}
     for rep in range(args.repeats):  # cases interleaved, so a drift of the machine's speed hits them alike
-        for label, counts in CASES:
-            results = run_case(counts, args.samples)
-            rates[label].append(sum(r["samples"] / r["wall"] for r in results))
-            per_process[label].append([r["samples"] / r["cpu"] for r in results])
-            print(f"repeat {rep}: {label}: {rates[label][-1]:.0f} seed-samples/s", file=sys.stderr)
-    base = statistics.median(rates[CASES[0][0]])
+        for algo in algos:
+            for label, counts in CASES:
+                results = run_case(counts, args.samples, algo)
+                rates[algo, label].append(sum(r["samples"] / r["wall"] for r in results))
+                per_process[algo, label].append([r["samples"] / r["cpu"] for r in results])
+                print(f"repeat {rep}: {algo}: {label}: {rates[algo, label][-1]:.0f} seed-samples/s", file=sys.stderr)
     sys.path.insert(0, str(HERE))
     from _record import hand_notes, machine
 
-    command = f"python benchmarks/bench_seed_stacking.py --samples {args.samples} --repeats {args.repeats}"
+    command = (
+        f"python benchmarks/bench_seed_stacking.py --samples {args.samples} --repeats {args.repeats} "
+        f"--algos {args.algos}"
+    )
     lines = [
-        "# Seed stacking, end to end: `pamdp reproduce --stack` against one seed per process (PADDPG, Platform)",
+        "# Seed stacking, end to end: `pamdp reproduce --stack` against one seed per process (Platform)",
         "",
         f"- command: `{command}" + (f" --out {args.out}`" if args.out else "`"),
         f"- date: {dt.datetime.now().isoformat(timespec='seconds')}",
         f"- load average at the start: {load:.1f}; machine: {machine()}",
-        f"- PADDPG's paper preset ({{400, 300}}, batch 32, one update per sample) with `learning_starts = 32`, "
-        f"{args.samples:,} samples per seed from a fresh start; one torch thread per process, each pinned to its "
-        f"own core; medians of {args.repeats} repeats, the cases interleaved",
+        "- the paper presets ({400, 300}; one update per sample; batch 32 for PADDPG, 64 for PASVG(0)) with "
+        f"`learning_starts` = one batch, {args.samples:,} samples per seed from a fresh start; one torch thread "
+        f"per process, each pinned to its own core; medians of {args.repeats} repeats, the cases interleaved",
         "",
-        "| layout | seed-samples/s in all (median) | each repeat | per process, samples per CPU-second | "
-        "vs. one seed per process |",
-        "|---|---|---|---|---|",
+        "| algorithm | layout | seed-samples/s in all (median) | each repeat | per process, samples per "
+        "CPU-second | vs. one seed per process |",
+        "|---|---|---|---|---|---|",
     ]
-    for label, _ in CASES:
-        med = statistics.median(rates[label])
-        each = ", ".join(f"{r:.0f}" for r in rates[label])
-        cpu = ", ".join(f"{statistics.median(col):.0f}" for col in zip(*per_process[label]))
-        lines.append(f"| {label} | {med:.0f} | {each} | {cpu} | {med / base:.2f}x |")
+    for algo in algos:
+        base = statistics.median(rates[algo, CASES[0][0]])
+        for label, _ in CASES:
+            med = statistics.median(rates[algo, label])
+            each = ", ".join(f"{r:.0f}" for r in rates[algo, label])
+            cpu = ", ".join(f"{statistics.median(col):.0f}" for col in zip(*per_process[algo, label]))
+            lines.append(f"| {ALGOS[algo]} | {label} | {med:.0f} | {each} | {cpu} | {med / base:.2f}x |")
     record = Path(args.out) if args.out else None
     notes = hand_notes(record) if record else ""
     text = "\n".join(lines) + "\n" + (f"\n{notes}\n" if notes else "")
