@@ -66,10 +66,16 @@ main() {
     # If the main queue fails (set -e) the side queue must not run on alone: a new start of this script would
     # then train the same runs in two processes at once.
     trap 'kill -TERM -- "-$side" 2>/dev/null || true' EXIT
-    # --stack 3: seeds 0-2 in one process, 3-4 in the other, each stack's updates batched (~1.3x the seeds an hour,
-    # benchmarks/seed_stacking.md)
-    python bench_paddpg_platform.py --workers 2 --stack 3 --out "$RUNS/repro"  # = platform --runs PADDPG + record (issue 5)
-    pamdp reproduce platform --workers 2 --stack 3 --out "$RUNS/repro"        # its PASVG(0) arm, the figure (issue 7)
+    # The two platform arms side by side, each one process of its five seeds stacked (pamdp reproduce --stack):
+    # in the update, a stack of five PASVG(0) seeds does 1.8x the seed-updates of one seed on a core, a stack of
+    # three 1.5x (profiled 2026-11-29; end-to-end figures in benchmarks/seed_stacking.md), so one arm a core beats
+    # each arm in turn on both cores.
+    python bench_paddpg_platform.py --workers 1 --stack 5 --out "$RUNS/repro" &  # = platform --runs PADDPG + record (issue 5)
+    paddpg=$!
+    trap 'kill -TERM -- "-$side" 2>/dev/null || true; kill -TERM "$paddpg" 2>/dev/null || true' EXIT
+    pamdp reproduce platform --runs "PASVG(0)" --workers 1 --stack 5 --out "$RUNS/repro"
+    wait "$paddpg"
+    pamdp reproduce platform --workers 2 --stack 5 --out "$RUNS/repro"  # every run done by now: the figure (issue 7)
     wait "$side"
     trap - EXIT
 }
