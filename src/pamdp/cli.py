@@ -290,7 +290,7 @@ def cmd_reproduce(args) -> int:
     print(f"{exp.name}: {exp.description}; {len(jobs)} runs of {jobs[0][0].total_steps:,} steps", file=sys.stderr)
     if args.backend == "ray":
         if args.stack > 1:
-            raise SystemExit(f"--stack {args.stack}: seed stacks run on the local backend only; drop --stack for Ray")
+            raise ValueError(f"--stack {args.stack}: seed stacks run on the local backend only; drop it for Ray")
         from pamdp.experiments.ray_backend import run_all_ray
 
         outcomes = run_all_ray(jobs, address=args.address, log=lambda m: print(m, file=sys.stderr))
