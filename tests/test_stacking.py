@@ -219,3 +219,14 @@ def test_runs_resumed_at_different_steps_train_in_stacks_of_their_own(tmp_path):
     with open(outs[1] / "progress.csv", newline="") as f:
         first_epoch = next(csv.DictReader(f))
     assert float(first_epoch["time/epoch_cpu_seconds"]) < 0.6 * float(first_epoch["time/epoch_seconds"])
+
+
+def test_a_stack_that_fails_as_a_whole_fails_each_of_its_runs(tmp_path, monkeypatch):
+    def broken(self, jobs):
+        raise RuntimeError("stack broke")
+
+    monkeypatch.setattr(SeedStack, "run", broken)
+    spec = RunSpec("paddpg", "pamdp/Platform-v0", 300, 0, preset="paper", settings=(("hidden_sizes", (8,)),))
+    specs = [dataclasses.replace(spec, seed=s) for s in range(2)]
+    results = train_stack(specs, [tmp_path / "a", tmp_path / "b"], [print, print])
+    assert all(isinstance(r, RuntimeError) and str(r) == "stack broke" for r in results)  # not reported as done

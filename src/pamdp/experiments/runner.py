@@ -251,8 +251,12 @@ def train_stack(specs: list[RunSpec], outs: list[str | os.PathLike], logs: list)
                 logs[i](f"stacked with seeds {seeds}; {len(models)} runs in this process")
             else:
                 logs[i](f"in a stack of its own (Adam step {adam_step(models[i])}); {len(models)} runs in this process")
-        for i, outcome in zip(order, SeedStack([models[i] for i in order]).run([job(i) for i in order])):
-            results[i] = outcome
+        try:
+            for i, outcome in zip(order, SeedStack([models[i] for i in order]).run([job(i) for i in order])):
+                results[i] = outcome
+        except Exception as exc:  # noqa: BLE001 - the stack itself failed: so did each of its runs
+            for i in order:
+                results[i] = exc
 
     threads = [threading.Thread(target=run_class, args=(order,)) for order in classes.values()]
     for t in threads:
