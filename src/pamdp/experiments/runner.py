@@ -369,7 +369,11 @@ def run_all(jobs: list[tuple[RunSpec, str]], workers: int = 1, log=print, stack:
             t0 = time.time()
             if len(group) > 1:
                 specs, outs = [s for s, _ in group], [o for _, o in group]
-                new = outcomes_of(group, _stack_worker(specs, outs), t0)
+                try:
+                    new = outcomes_of(group, _stack_worker(specs, outs), t0)
+                except Exception:
+                    error = traceback.format_exc()
+                    new = [RunOutcome(spec, out, None, error, time.time() - t0) for spec, out in group]
             else:
                 spec, out = group[0]
                 try:
