@@ -43,6 +43,25 @@ def machine() -> str:
 NOTES_HEADING = "## Notes (written by hand"
 
 
+def run_together(commands: list[list[str]]) -> list[dict]:
+    """Start the worker processes ``commands`` and let them time together: each prints ``ready`` once built and
+    warmed up, starts on a line ``go`` on its stdin, and ends by printing its result as one JSON line."""
+    procs = [subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True) for cmd in commands]
+    for proc in procs:
+        if proc.stdout.readline().strip() != "ready":
+            raise SystemExit(f"a worker failed before timing (exit code {proc.wait()})")
+    for proc in procs:
+        proc.stdin.write("go\n")
+        proc.stdin.flush()
+    results = []
+    for proc in procs:
+        out, _ = proc.communicate()
+        if proc.returncode != 0:
+            raise SystemExit(f"worker failed with exit code {proc.returncode}")
+        results.append(json.loads(out.strip().splitlines()[-1]))
+    return results
+
+
 def hand_notes(record: Path) -> str:
     """The hand-written notes section of an existing record (from its heading to the end), or ``""``.
 

@@ -25,7 +25,6 @@ import datetime as dt
 import json
 import os
 import statistics
-import subprocess
 import sys
 import time
 from pathlib import Path
@@ -134,28 +133,14 @@ def worker(core: int, members: int, updates: int, repeats: int) -> None:
 
 
 def run_case(counts: list[int], updates: int, repeats: int) -> list[dict]:
-    procs = [
-        subprocess.Popen(
-            [sys.executable, __file__, "--worker", str(core), str(m), str(updates), str(repeats)],
-            stdin=subprocess.PIPE,
-            stdout=subprocess.PIPE,
-            text=True,
-        )
-        for core, m in enumerate(counts)
-    ]
-    for proc in procs:  # all built and warmed up
-        if proc.stdout.readline().strip() != "ready":
-            raise SystemExit(f"a worker failed before timing (exit code {proc.wait()})")
-    for proc in procs:
-        proc.stdin.write("go\n")
-        proc.stdin.flush()
-    results = []
-    for proc in procs:
-        out, _ = proc.communicate()
-        if proc.returncode != 0:
-            raise SystemExit(f"worker failed with exit code {proc.returncode}")
-        results.append(json.loads(out.strip().splitlines()[-1]))
-    return results
+    from _record import run_together
+
+    return run_together(
+        [
+            [sys.executable, __file__, "--worker", str(core), str(m), str(updates), str(repeats)]
+            for core, m in enumerate(counts)
+        ]
+    )
 
 
 def main() -> None:

@@ -20,7 +20,6 @@ import datetime as dt
 import json
 import os
 import statistics
-import subprocess
 import sys
 import time
 from pathlib import Path
@@ -66,28 +65,11 @@ def worker(core: int, seeds: int, samples: int, algo: str) -> None:
 
 
 def run_case(counts: list[int], samples: int, algo: str) -> list[dict]:
-    procs = [
-        subprocess.Popen(
-            [sys.executable, __file__, "--worker", str(core), str(n), str(samples), algo],
-            stdin=subprocess.PIPE,
-            stdout=subprocess.PIPE,
-            text=True,
-        )
-        for core, n in enumerate(counts)
-    ]
-    for proc in procs:
-        if proc.stdout.readline().strip() != "ready":
-            raise SystemExit(f"a worker failed before timing (exit code {proc.wait()})")
-    for proc in procs:
-        proc.stdin.write("go\n")
-        proc.stdin.flush()
-    results = []
-    for proc in procs:
-        out, _ = proc.communicate()
-        if proc.returncode != 0:
-            raise SystemExit(f"worker failed with exit code {proc.returncode}")
-        results.append(json.loads(out.strip().splitlines()[-1]))
-    return results
+    from _record import run_together
+
+    return run_together(
+        [[sys.executable, __file__, "--worker", str(core), str(n), str(samples), algo] for core, n in enumerate(counts)]
+    )
 
 
 def main() -> None:
