@@ -60,6 +60,25 @@ def test_stacked_seeds_train_as_they_would_alone(bound):
         assert all(p.untyped_storage().nbytes() == p.nbytes for p in m.actor.parameters())
 
 
+def test_a_stack_learns_as_its_members_would_and_again_only_when_their_steps_align(tmp_path, monkeypatch):
+    alone = [tiny(seed).learn(600, progress_bar=False) for seed in range(2)]
+    members = [tiny(seed) for seed in range(2)]
+    stack = SeedStack(members)
+    assert stack.learn(600, run_dirs=[tmp_path / "a", tmp_path / "b"]) == members
+    for a, m in zip(alone, members):
+        assert m.num_timesteps == a.num_timesteps and max_difference(a, m) < 1e-4
+    assert (tmp_path / "b" / "checkpoint.pt").exists()
+    with pytest.raises(ValueError, match="1 run_dirs for 2 members"):
+        stack.learn(300, run_dirs=[tmp_path / "a"])
+    # the members left the stack at different updates: a second part would change one's Adam bias correction
+    assert len({m.critic_optimizer.state_dict()["state"][0]["step"].item() for m in members}) == 2
+    with pytest.raises(ValueError, match="members at Adam steps"):
+        stack.learn(300)
+    monkeypatch.setattr("pamdp.algos.stacking.ALIGNED_STEPS", 0)  # as if past it: the stack runs again
+    stack.learn(300)
+    assert all(m.num_timesteps >= 900 for m in members)
+
+
 @pytest.mark.parametrize("discrete_gradient", ["gumbel", "expected"])
 def test_stacked_pasvg0_seeds_train_as_they_would_alone(discrete_gradient):
     config = PASVG0Config(

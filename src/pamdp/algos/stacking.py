@@ -64,6 +64,15 @@ def step_class(member) -> int:
     return -1 if step >= ALIGNED_STEPS else step
 
 
+def _check_steps(members: Sequence[Any]) -> None:
+    steps = [adam_step(m) for m in members]
+    if len(set(steps)) > 1 and min(steps) < ALIGNED_STEPS:
+        raise ValueError(
+            f"members at Adam steps {steps}: stacking shares one step count, which differing counts below "
+            f"{ALIGNED_STEPS} would change; train them alone until they pass it"
+        )
+
+
 def clip_per_member(params: Sequence[torch.Tensor], max_norm: float) -> None:
     """``clip_grad_norm_`` applied to each member's slice of stacked parameters on its own (0: no clipping)."""
     if max_norm <= 0:
@@ -81,8 +90,15 @@ def clip_per_member(params: Sequence[torch.Tensor], max_norm: float) -> None:
 class SeedStack:
     """Train ``members`` (same algorithm, same settings but the seed) together; see the module docstring.
 
-    Use :meth:`run` with one job per member: the job trains its member (``learn`` and whatever follows, such
-    as saving and evaluating) and returns a result.
+    :meth:`learn` trains every member for the same number of steps, as each one's own ``learn`` would (once:
+    members leave a stack at different updates, so a second call needs their Adam steps past
+    :data:`ALIGNED_STEPS`, or it says so)::
+
+        models = [PADDPG("pamdp/Platform-v0", {"seed": seed}) for seed in range(3)]
+        SeedStack(models).learn(100_000, run_dirs=[f"runs/seed{seed}" for seed in range(3)])
+
+    :meth:`run` takes one job per member instead: the job trains its member (``learn`` and whatever follows,
+    such as saving and evaluating) and returns a result.
     """
 
     def __init__(self, members: Sequence[Any]):
@@ -102,12 +118,7 @@ class SeedStack:
             differ = sorted(k for k in base if base[k] != other.get(k))
             if differ:
                 raise ValueError(f"stacked members must differ in their seed only; they differ in {', '.join(differ)}")
-        steps = [adam_step(m) for m in members]
-        if len(set(steps)) > 1 and min(steps) < ALIGNED_STEPS:
-            raise ValueError(
-                f"members at Adam steps {steps}: stacking shares one step count, which differing counts below "
-                f"{ALIGNED_STEPS} would change; train them alone until they pass it"
-            )
+        _check_steps(members)
         self.members = list(members)
         self.config = members[0].config
         self._cond = threading.Condition()
@@ -244,6 +255,29 @@ class SeedStack:
             self._cond.notify_all()
             self._cond.wait_for(lambda: i in self._left)
 
+    def learn(self, total_timesteps: int, run_dirs: Sequence[Any] | None = None, **learn_kwargs) -> list[Any]:
+        """``member.learn(total_timesteps, run_dir=run_dirs[i], **learn_kwargs)`` for every member, stacked.
+
+        No progress bars (several threads would mix them). Returns the members; the first member's error, if
+        any, is raised once every member has stopped.
+        """
+        if run_dirs is not None and len(run_dirs) != len(self.members):
+            raise ValueError(f"{len(run_dirs)} run_dirs for {len(self.members)} members")
+        learn_kwargs["progress_bar"] = False
+
+        def job(i: int) -> Callable[[Callable[[], None]], Any]:
+            def train(leave: Callable[[], None]) -> Any:
+                run_dir = None if run_dirs is None else run_dirs[i]
+                return self.members[i].learn(total_timesteps, run_dir=run_dir, **learn_kwargs)
+
+            return train
+
+        outcomes = self.run([job(i) for i in range(len(self.members))])
+        for outcome in outcomes:
+            if isinstance(outcome, BaseException):
+                raise outcome
+        return outcomes
+
     def run(self, jobs: Sequence[Callable[[Callable[[], None]], Any]]) -> list[Any]:
         """Run ``jobs[i](leave)``, member ``i``'s training, in a thread each; returns each job's result or exception.
 
@@ -252,7 +286,9 @@ class SeedStack:
         """
         if len(jobs) != len(self.members):
             raise ValueError(f"{len(jobs)} jobs for {len(self.members)} members")
+        _check_steps(self.members)  # members that left the stack one by one last time have differing counts
         outcomes: list[Any] = [None] * len(jobs)
+        self._requests, self._results, self._leaving, self._left = {}, {}, [], set()  # a stack can run again
         self.active = list(range(len(self.members)))
         self._build()
         for i in self.active:
