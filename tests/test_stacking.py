@@ -234,10 +234,11 @@ def test_runs_resumed_at_different_steps_train_in_stacks_of_their_own(tmp_path):
     assert any("stacked with seeds [1, 2]" in line for line in logs[1])
     for s in range(3):
         assert PADDPG.load(outs[s] / "final_model.pt").num_timesteps >= 900
-    # the process's CPU time is divided among the runs training in it: three at seed 1's first epoch
+    # The process's CPU time is divided among the runs training in it, three at seed 1's first epoch. Undivided
+    # it would exceed the wall time: torch ops release the GIL, so the stack's threads use up to ~2 cores.
     with open(outs[1] / "progress.csv", newline="") as f:
         first_epoch = next(csv.DictReader(f))
-    assert float(first_epoch["time/epoch_cpu_seconds"]) < 0.6 * float(first_epoch["time/epoch_seconds"])
+    assert float(first_epoch["time/epoch_cpu_seconds"]) < float(first_epoch["time/epoch_seconds"])
 
 
 def test_a_stack_that_fails_as_a_whole_fails_each_of_its_runs(tmp_path, monkeypatch):
