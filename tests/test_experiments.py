@@ -124,7 +124,8 @@ def test_resume_after_a_killed_worker(tmp_path):
     assert status.returncode == 0, status.stderr
     row0 = next(line for line in status.stdout.splitlines() if line.startswith("| small delta | 0 |"))
     assert "| partial" in row0 and "/ 3,000 |" in row0
-    assert "tiny: 0 of 2 runs done" in status.stdout
+    # seed 1 may have finished in the meantime (its process can start seconds before seed 0's on an idle machine)
+    assert "tiny: 0 of 2 runs done" in status.stdout or "tiny: 1 of 2 runs done" in status.stdout, status.stdout
     done = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr
     log = (out / "tiny" / "small_delta" / "seed0" / "stdout.log").read_text()
