@@ -28,6 +28,7 @@ from __future__ import annotations
 import copy
 import dataclasses
 import math
+from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -223,7 +224,58 @@ def gumbel_softmax_sample(
     return index, onehot - soft.detach() + soft
 
 
-class GumbelHybridPolicy(nn.Module):
+def _rows(table: torch.Tensor, index: torch.Tensor) -> torch.Tensor:
+    """The rows of a per-action table ``(K, m)`` at actions ``index`` (any shape): ``index.shape + (m,)``. A seed
+    stack's table ``(S, K, m)`` with ``index`` of shape ``(S, ...)`` gives each seed the rows of its own table."""
+    if table.dim() == 2:
+        return table[index]
+    K, m = table.shape[1:]
+    table = table.reshape(table.shape[0], *([1] * (index.dim() - 2)), K, m).expand(*index.shape[:-1], K, m)
+    return torch.gather(table, -2, index.unsqueeze(-1).expand(*index.shape, m))
+
+
+class HybridSampling:
+    """How ``(pi_d, pi_c, log_std)`` turn noise into actions, written over any leading axes, so that the same code
+    serves one policy (:class:`GumbelHybridPolicy`) and a seed stack's (``PASVG0._stacked_update``).
+
+    A subclass provides ``pi_d(obs)`` (logits over K actions), ``pi_c(inputs)`` (pre-Tanh means), ``log_std``
+    (``(K, m)``, or ``(S, K, m)`` stacked), ``mask`` (``(K, m)``) and ``n_actions``.
+    """
+
+    pi_d: Callable[[torch.Tensor], torch.Tensor]
+    pi_c: Callable[[torch.Tensor], torch.Tensor]
+    log_std: torch.Tensor
+    mask: torch.Tensor
+    n_actions: int
+
+    def sample(
+        self, obs: torch.Tensor, eta_a: torch.Tensor, eta_x: torch.Tensor, temperature: float, hard: bool
+    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
+        """``(logits, index, a, x)`` for the noise ``(eta_a, eta_x)``: ``pi_d``'s logits, the action, the critic's
+        action input ``a`` and the parameters ``x``, so an update runs ``pi_d`` once."""
+        logits = self.pi_d(obs)
+        index, a = gumbel_softmax_sample(logits, eta_a, temperature, hard)
+        return logits, index, a, self.params(obs, index, a, eta_x)
+
+    def params(self, obs: torch.Tensor, index: torch.Tensor, a: torch.Tensor, eta_x: torch.Tensor) -> torch.Tensor:
+        """``x = g(s, a, eta_x)``: ``pi_c``'s parameters for action ``a`` (one-hot or soft; ``index`` its argmax)."""
+        std = _rows(self.log_std.clamp(LOG_STD_MIN, LOG_STD_MAX).exp(), index)
+        return torch.tanh(self.pi_c(torch.cat([obs, a], dim=-1)) + std * eta_x) * self.mask[index]
+
+    def params_all(self, obs: torch.Tensor, eta_x: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+        """Every action's parameters for the noise ``eta_x``: ``(obs_k, onehots, x)``, each ``(..., K, .)``.
+
+        ``obs_k`` and ``onehots`` are the critic's matching state and action inputs, so that
+        ``critic(obs_k, onehots, x)`` is ``Q(s, k, x_k)`` for every ``k`` in one batched pass.
+        """
+        lead, K = obs.shape[:-1], self.n_actions
+        index = torch.arange(K).expand(*lead, K)
+        onehots = torch.eye(K, dtype=obs.dtype).expand(*lead, K, K)
+        obs_k = obs.unsqueeze(-2).expand(*lead, K, obs.shape[-1])
+        return obs_k, onehots, self.params(obs_k, index, onehots, eta_x.unsqueeze(-2))
+
+
+class GumbelHybridPolicy(nn.Module, HybridSampling):
     """``pi_d`` (logits over K actions) and ``pi_c`` (pre-Tanh means of ``m`` parameters given ``[s, a]``).
 
     The parameter noise has a state-independent log-std per action and parameter; parameters an action does
@@ -248,31 +300,6 @@ class GumbelHybridPolicy(nn.Module):
         """``(index, a, x)`` for the noise ``(eta_a, eta_x)``; ``a`` is the critic's action input."""
         return self.sample(obs, eta_a, eta_x, temperature, hard)[1:]
 
-    def sample(
-        self, obs: torch.Tensor, eta_a: torch.Tensor, eta_x: torch.Tensor, temperature: float, hard: bool
-    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
-        """``(logits, index, a, x)``: :meth:`forward` plus ``pi_d``'s logits, so an update runs ``pi_d`` once."""
-        logits = self.pi_d(obs)
-        index, a = gumbel_softmax_sample(logits, eta_a, temperature, hard)
-        return logits, index, a, self.params(obs, index, a, eta_x)
-
-    def params(self, obs: torch.Tensor, index: torch.Tensor, a: torch.Tensor, eta_x: torch.Tensor) -> torch.Tensor:
-        """``x = g(s, a, eta_x)``: ``pi_c``'s parameters for action ``a`` (one-hot or soft; ``index`` its argmax)."""
-        std = self.log_std.clamp(LOG_STD_MIN, LOG_STD_MAX).exp()[index]
-        return torch.tanh(self.pi_c(torch.cat([obs, a], dim=-1)) + std * eta_x) * self.mask[index]
-
-    def params_all(self, obs: torch.Tensor, eta_x: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
-        """Every action's parameters for the noise ``eta_x``: ``(obs_k, onehots, x)``, each ``(B, K, .)``.
-
-        ``obs_k`` and ``onehots`` are the critic's matching state and action inputs, so that
-        ``critic(obs_k, onehots, x)`` is ``Q(s, k, x_k)`` for every ``k`` in one batched pass.
-        """
-        batch, K = obs.shape[0], self.n_actions
-        index = torch.arange(K).expand(batch, K)
-        onehots = torch.eye(K, dtype=obs.dtype).expand(batch, K, K)
-        obs_k = obs.unsqueeze(1).expand(batch, K, obs.shape[-1])
-        return obs_k, onehots, self.params(obs_k, index, onehots, eta_x.unsqueeze(1))
-
     def mode(self, obs: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
         """The greedy action: the most probable discrete action and its mean parameters."""
         index = self.pi_d(obs).argmax(-1)
@@ -281,7 +308,7 @@ class GumbelHybridPolicy(nn.Module):
 
 
 def expected_q(
-    policy: GumbelHybridPolicy, critic: nn.Module, obs: torch.Tensor, eta_x: torch.Tensor
+    policy: HybridSampling, critic: Callable, obs: torch.Tensor, eta_x: torch.Tensor
 ) -> tuple[torch.Tensor, torch.Tensor]:
     """``(logits, E_{k ~ pi_d}[Q(s, k, g(s, k, eta_x))])``: the value the Gumbel-Softmax sample estimates, exactly.
 
@@ -527,49 +554,19 @@ class PASVG0(Algorithm):
         rows of ``log_std`` are gathered with its own actions.
         """
         cfg = stack.config
-        mask = stack.buffer("policy", "mask")
-        K = mask.shape[0]
-
-        def policy(module):
-            log_std = stack.params[module]["log_std"]
-
-            def params(obs, index, a, eta_x):  # GumbelHybridPolicy.params
-                std = log_std.clamp(LOG_STD_MIN, LOG_STD_MAX).exp()
-                std = std.reshape(std.shape[0], *([1] * (index.dim() - 2)), K, std.shape[-1])
-                std = std.expand(*index.shape[:-1], K, std.shape[-1])
-                std = torch.gather(std, -2, index.unsqueeze(-1).expand(*index.shape, std.shape[-1]))
-                pre = stack.sequential(module, "pi_c", torch.cat([obs, a], dim=-1))
-                return torch.tanh(pre + std * eta_x) * mask[index]
-
-            def pi_d(obs):
-                return stack.sequential(module, "pi_d", obs)
-
-            def sample(obs, eta_a, eta_x):  # GumbelHybridPolicy.sample
-                logits = pi_d(obs)
-                index, a = gumbel_softmax_sample(logits, eta_a, cfg.temperature, cfg.straight_through)
-                return logits, index, a, params(obs, index, a, eta_x)
-
-            def expected(q_fn, obs, eta_x):  # expected_q, with GumbelHybridPolicy.params_all
-                S, B = obs.shape[:2]
-                index = torch.arange(K).expand(S, B, K)
-                onehots = torch.eye(K, dtype=obs.dtype).expand(S, B, K, K)
-                obs_k = obs.unsqueeze(2).expand(S, B, K, obs.shape[-1])
-                logits = pi_d(obs)
-                q_all = q_fn(obs_k, onehots, params(obs_k, index, onehots, eta_x.unsqueeze(2)))
-                return logits, (logits.softmax(-1) * q_all).sum(-1)
-
-            return pi_d, sample, expected
 
         def critic(module):
             return lambda o, a, x: stack.sequential(module, "net", torch.cat([o, a, x], dim=-1)).squeeze(-1)
 
         obs, next_obs = b["obs"], b["next_obs"]
-        _, target_sample, target_expected = policy("policy_target")
+        policy, policy_target = _StackedPolicy(stack, "policy"), _StackedPolicy(stack, "policy_target")
         with torch.no_grad():
             if cfg.discrete_gradient == "expected":
-                _, q_next = target_expected(critic("critic_target"), next_obs, b["next_eta_x"])
+                _, q_next = expected_q(policy_target, critic("critic_target"), next_obs, b["next_eta_x"])
             else:
-                _, _, a_next, x_next = target_sample(next_obs, b["next_eta_a"], b["next_eta_x"])
+                _, _, a_next, x_next = policy_target.sample(
+                    next_obs, b["next_eta_a"], b["next_eta_x"], cfg.temperature, cfg.straight_through
+                )
                 q_next = critic("critic_target")(next_obs, a_next, x_next)
             y = b["reward"] + cfg.gamma * (~b["terminated"]).float() * q_next
         q = critic("critic")(obs, b["a_in"], b["x"])
@@ -580,11 +577,10 @@ class PASVG0(Algorithm):
         clip_per_member(critic_params, cfg.grad_clip)
         stack.optimizers["critic"].step()
 
-        _, sample, expected = policy("policy")
         if cfg.discrete_gradient == "expected":
-            logits, q_pi = expected(critic("critic"), obs, b["eta_x"])
+            logits, q_pi = expected_q(policy, critic("critic"), obs, b["eta_x"])
         else:
-            logits, _, a, x = sample(obs, b["eta_a"], b["eta_x"])
+            logits, _, a, x = policy.sample(obs, b["eta_a"], b["eta_x"], cfg.temperature, cfg.straight_through)
             q_pi = critic("critic")(obs, a, x)
         entropy = -(logits.softmax(-1) * logits.log_softmax(-1)).sum(-1).mean(-1)
         actor_loss = -q_pi.mean(-1) - cfg.entropy_coef * entropy
@@ -596,7 +592,7 @@ class PASVG0(Algorithm):
         stack.optimizers["policy"].step()
         stack.soft_update("critic_target", "critic", cfg.tau)
         stack.soft_update("policy_target", "policy", cfg.tau)
-        std = stack.params["policy"]["log_std"].detach().exp()[:, mask.bool()].mean(-1)
+        std = policy.log_std.detach().exp()[:, policy.mask.bool()].mean(-1)
         columns = {
             "losses/critic_loss": critic_loss.detach().tolist(),
             "train/q_mean": q.detach().mean(-1).tolist(),
@@ -611,3 +607,19 @@ class PASVG0(Algorithm):
         for m in stack.members_active():
             m.critic_updates += 1
         return stats
+
+
+class _StackedPolicy(HybridSampling):
+    """A seed stack's ``module`` (a :class:`GumbelHybridPolicy` in every member) as one policy over ``(S, ...)``."""
+
+    def __init__(self, stack, module: str):
+        self.stack, self.module = stack, module
+        self.log_std = stack.params[module]["log_std"]
+        self.mask = stack.buffer(module, "mask")
+        self.n_actions = self.mask.shape[0]
+
+    def pi_d(self, obs: torch.Tensor) -> torch.Tensor:
+        return self.stack.sequential(self.module, "pi_d", obs)
+
+    def pi_c(self, inputs: torch.Tensor) -> torch.Tensor:
+        return self.stack.sequential(self.module, "pi_c", inputs)
