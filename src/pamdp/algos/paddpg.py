@@ -307,20 +307,15 @@ class PADDPG(Algorithm):
     def _update(self) -> dict[str, float]:
         """One critic step on the mixed target and one actor step along the bounded ``dQ/dmu``."""
         cfg = self.config
-        b = self._stack_sample()
-
-        def step(optimizer, params):
-            clipped_step(optimizer, params, cfg.grad_clip)
-
         stats = _update_step(
             cfg,
-            b,
+            self._stack_sample(),
             self.actor,
             self.critic,
             self.actor_target,
             self.critic_target,
-            lambda: step(self.critic_optimizer, self.critic.parameters()),
-            lambda: step(self.actor_optimizer, self.actor.parameters()),
+            lambda: clipped_step(self.critic_optimizer, self.critic.parameters(), cfg.grad_clip),
+            lambda: clipped_step(self.actor_optimizer, self.actor.parameters(), cfg.grad_clip),
             (self.critic_optimizer, self.actor_optimizer),
             lambda: (
                 soft_update(self.critic_target, self.critic, cfg.tau),

@@ -300,8 +300,7 @@ class SeedStack:
             except BaseException as exc:  # noqa: BLE001 - reported to the caller, member by member
                 outcomes[i] = exc
             finally:
-                if i not in self._left and i not in self._leaving:
-                    self._leave(i)
+                self._leave(i)  # a no-op for a member whose job has already left
 
         threads = [threading.Thread(target=body, args=(i,), name=f"member{i}", daemon=True) for i in self.active]
         self._running = len(threads)

@@ -220,26 +220,21 @@ def train_stack(specs: list[RunSpec], outs: list[str | os.PathLike], logs: list)
     classes: dict[int, list[int]] = {}
     for i, model in models.items():
         classes.setdefault(step_class(model), []).append(i)
-    census = {"training": len(models)}
-    lock = threading.Lock()
+    training = set(models)  # the runs whose training is not over; set.discard is atomic and idempotent
 
     def share() -> float:  # the process's CPU time goes to the runs still training in it
-        return float(max(census["training"], 1))
+        return float(max(len(training), 1))
 
     def job(i):
         def train(leave):
-            counted = [True]
-
             def trained():
-                with lock:
-                    census["training"] -= counted.pop() if counted else 0
+                training.discard(i)
                 leave()
 
             try:
                 return _train(models[i], specs[i], outs[i], False, logs[i], trained=trained)
             finally:
-                with lock:
-                    census["training"] -= counted.pop() if counted else 0
+                training.discard(i)
 
         return train
 
