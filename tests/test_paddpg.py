@@ -11,7 +11,7 @@ from torch import nn
 import pamdp
 from pamdp import PADDPG
 from pamdp.algos.base import load_model
-from pamdp.algos.paddpg import Actor, PADDPGConfig, invert_gradients, zero_gradients
+from pamdp.algos.paddpg import Actor, Critic, PADDPGConfig, invert_gradients, zero_gradients
 from pamdp.cli import main
 from pamdp.spaces import HybridActionSpace
 
@@ -58,20 +58,20 @@ def test_zeroing_gradients_by_hand():
 # it, which is why Hausknecht & Stone found zeroing unreliable.
 @pytest.mark.parametrize("bound", ["invert", "squash"])
 def test_actor_chasing_an_unbounded_critic_stays_in_bounds(bound):
-    class Greedy(nn.Module):  # a critic that wants every output as large as possible
-        def __init__(self):
-            super().__init__()
-            self.w = nn.Parameter(torch.ones(()))
-
-        def forward(self, obs, out):
-            return 10.0 * self.w * out.sum(-1)
-
     cfg = dataclasses.replace(SMALL, bound=bound, actor_lr=3e-2, grad_clip=0.0, learning_starts=10**6)
     model = PADDPG("pamdp/Platform-v0", cfg)
     model.learn(100, progress_bar=False)
-    model.critic = Greedy()
-    model.critic_target = Greedy().requires_grad_(False)
+
+    def greedy():  # a critic that wants every output as large as possible: Q = 10 * sum(out), no hidden layer
+        critic = Critic(model.obs_dim, model.out_size, (), "relu")
+        with torch.no_grad():
+            critic.net[0].weight.copy_(torch.cat([torch.zeros(model.obs_dim), torch.full((model.out_size,), 10.0)]))
+            critic.net[0].bias.zero_()
+        return critic
+
+    model.critic, model.critic_target = greedy(), greedy().requires_grad_(False)
     model.critic_optimizer = torch.optim.SGD(model.critic.parameters(), lr=0.0)
+    model._bind_networks()
     for _ in range(200):
         model._update()
     with torch.no_grad():

@@ -142,7 +142,7 @@ def test_clipping_per_member_is_each_members_own_clip_grad_norm():
     member_grads[1] = [g * 1e-3 for g in member_grads[1]]  # a member below the threshold keeps its gradient
     for p in stacked:
         p.grad[1] *= 1e-3
-    clip_per_member(stacked, 1.0)
+    clip_per_member([p.grad for p in stacked], 1.0)
     for j, grads in enumerate(member_grads):
         params = [torch.zeros_like(g, requires_grad=True) for g in grads]
         for p, g in zip(params, grads):

@@ -16,7 +16,7 @@ buffer's ``"mc"`` field when its episode ends (``NaN`` until then), for PADDPG's
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 import numpy as np
 import torch
@@ -31,6 +31,8 @@ __all__ = [
     "soft_update",
     "hard_update",
     "clipped_step",
+    "clip_grads",
+    "optimizer_step",
     "linear_epsilon",
     "mixed_target",
     "discounted_returns",
@@ -78,6 +80,58 @@ def clipped_step(optimizer: torch.optim.Optimizer, params, max_norm: float) -> N
     if max_norm > 0:
         nn.utils.clip_grad_norm_(params, max_norm)
     optimizer.step()
+
+
+def clip_grads(grads: Sequence[torch.Tensor], max_norm: float) -> None:
+    """``nn.utils.clip_grad_norm_`` on gradient tensors themselves (0: no clipping), in place."""
+    if max_norm <= 0:
+        return
+    total = torch.linalg.vector_norm(torch.stack(torch._foreach_norm(list(grads))))
+    torch._foreach_mul_(list(grads), (max_norm / (total + 1e-6)).clamp(max=1.0))
+
+
+def optimizer_step(optimizer: torch.optim.Optimizer, grads: Sequence[torch.Tensor]) -> None:
+    """``optimizer.step()`` with ``grads``, in the order of its one parameter group.
+
+    A fused ``Adam`` whose state exists gets one ``torch._fused_adam_`` call, the kernel its own ``step`` ends
+    in, without the bookkeeping around it (about 0.15 ms of Python a call, a tenth of an update of PADDPG);
+    any other optimizer gets the gradients as ``.grad`` and its own ``step``.
+    """
+    group = optimizer.param_groups[0]
+    params = group["params"]
+    state = optimizer.state
+    fast = (
+        len(optimizer.param_groups) == 1
+        and group.get("fused")
+        and not (group["amsgrad"] or group["maximize"] or group["capturable"] or group["differentiable"])
+        and not group.get("decoupled_weight_decay", False)
+        and all(p in state for p in params)
+    )
+    if not fast:
+        for p, g in zip(params, grads, strict=True):
+            p.grad = g
+        optimizer.step()
+        return
+    steps = [state[p]["step"] for p in params]
+    torch._foreach_add_(steps, 1)
+    beta1, beta2 = group["betas"]
+    torch._fused_adam_(
+        params,
+        list(grads),
+        [state[p]["exp_avg"] for p in params],
+        [state[p]["exp_avg_sq"] for p in params],
+        [],
+        steps,
+        amsgrad=False,
+        lr=float(group["lr"]),
+        beta1=float(beta1),
+        beta2=float(beta2),
+        weight_decay=float(group["weight_decay"]),
+        eps=float(group["eps"]),
+        maximize=False,
+        grad_scale=None,
+        found_inf=None,
+    )
 
 
 def linear_epsilon(step: int, start: float, end: float, steps: int) -> float:

@@ -44,7 +44,8 @@ from pamdp.algos.base import (
     one_of,
     setting,
 )
-from pamdp.algos.offpolicy import OffPolicyLoop, OUNoise, clipped_step, linear_epsilon, mixed_target, soft_update
+from pamdp.algos.dense import Dense
+from pamdp.algos.offpolicy import OffPolicyLoop, OUNoise, clip_grads, linear_epsilon, mixed_target, optimizer_step
 from pamdp.algos.replay import ReplayBuffer
 from pamdp.algos.stacking import clip_per_member
 from pamdp.policies import ACTIVATIONS, mlp
@@ -219,6 +220,7 @@ class PADDPG(Algorithm):
         self.critic = Critic(self.obs_dim, self.out_size, cfg.hidden_sizes, cfg.activation)
         self.actor_target = copy.deepcopy(self.actor).requires_grad_(False)
         self.critic_target = copy.deepcopy(self.critic).requires_grad_(False)
+        self._bind_networks()
         betas = (cfg.adam_beta1, 0.999)
         # fused: one kernel per step instead of a dozen foreach passes, about 3x faster on a CPU.
         self.actor_optimizer = torch.optim.Adam(self.actor.parameters(), lr=cfg.actor_lr, betas=betas, fused=True)
@@ -238,6 +240,14 @@ class PADDPG(Algorithm):
         self.replay = ReplayBuffer(cfg.buffer_size, fields)
         self.loop = OffPolicyLoop(h, self.replay, cfg.gamma, mc_returns=cfg.beta > 0, tail_value=self._target_value)
         self._ou = OUNoise(cfg.ou_theta, cfg.ou_sigma)
+
+    def _bind_networks(self) -> None:
+        """The update's hand-written passes (:mod:`pamdp.algos.dense`) over the modules' own tensors; called
+        again by whoever replaces a module."""
+        self._dense = {name: Dense.of(module.net) for name, module in self._modules().items()}
+        targets, sources = (self.actor_target, self.critic_target), (self.actor, self.critic)
+        # soft_update of both targets in one call
+        self._soft_pairs = ([p for m in targets for p in m.parameters()], [p for m in sources for p in m.parameters()])
 
     def _modules(self):
         return {
@@ -306,21 +316,26 @@ class PADDPG(Algorithm):
 
     def _update(self) -> dict[str, float]:
         """One critic step on the mixed target and one actor step along the bounded ``dQ/dmu``."""
+        return self._update_with(self._stack_sample())
+
+    def _update_with(self, batch: dict[str, torch.Tensor]) -> dict[str, float]:
         cfg = self.config
+
+        def step(optimizer):
+            def apply(grads):
+                clip_grads(grads, cfg.grad_clip)
+                optimizer_step(optimizer, grads)
+
+            return apply
+
         stats = _update_step(
             cfg,
-            self._stack_sample(),
-            self.actor,
-            self.critic,
-            self.actor_target,
-            self.critic_target,
-            lambda: clipped_step(self.critic_optimizer, self.critic.parameters(), cfg.grad_clip),
-            lambda: clipped_step(self.actor_optimizer, self.actor.parameters(), cfg.grad_clip),
-            (self.critic_optimizer, self.actor_optimizer),
-            lambda: (
-                soft_update(self.critic_target, self.critic, cfg.tau),
-                soft_update(self.actor_target, self.actor, cfg.tau),
-            ),
+            batch,
+            self._dense,
+            self.obs_dim,
+            step(self.critic_optimizer),
+            step(self.actor_optimizer),
+            lambda: torch._foreach_lerp_(*self._soft_pairs, cfg.tau),
         )
         return {k: float(v) for k, v in stats.items()}
 
@@ -333,32 +348,23 @@ class PADDPG(Algorithm):
         """:meth:`_update` for every member of a seed stack at once, on their batches stacked ``(S, B, ...)``."""
         cfg = stack.config
 
-        def actor(o):
-            return stack.sequential("actor", "net", o)
-
-        def critic(o, out):
-            return stack.sequential("critic", "net", torch.cat([o, out], dim=-1)).squeeze(-1)
-
-        def actor_target(o):
-            return stack.sequential("actor_target", "net", o)
-
-        def critic_target(o, out):
-            return stack.sequential("critic_target", "net", torch.cat([o, out], dim=-1)).squeeze(-1)
+        nets = {name: stack.dense(name, "net") for name in ("actor", "critic", "actor_target", "critic_target")}
 
         def step(name):
-            clip_per_member(list(stack.params[name].values()), cfg.grad_clip)
-            stack.optimizers[name].step()
+            def apply(grads):
+                clip_per_member(grads, cfg.grad_clip)
+                optimizer_step(stack.optimizers[name], grads)
 
+            return apply
+
+        obs_dim = stack.members_active()[0].obs_dim
         stats = _update_step(
             cfg,
             b,
-            actor,
-            critic,
-            actor_target,
-            critic_target,
-            lambda: step("critic"),
-            lambda: step("actor"),
-            tuple(stack.optimizers.values()),
+            nets,
+            obs_dim,
+            step("critic"),
+            step("actor"),
             lambda: (
                 stack.soft_update("critic_target", "critic", cfg.tau),
                 stack.soft_update("actor_target", "actor", cfg.tau),
@@ -368,28 +374,42 @@ class PADDPG(Algorithm):
         return [{k: columns[k][j] for k in columns} for j in range(len(b["obs"]))]
 
 
-def _update_step(cfg, b, actor, critic, actor_target, critic_target, critic_step, actor_step, optimizers, soft):
+def _update_step(cfg, b, nets, obs_dim, critic_step, actor_step, soft):
     """PADDPG's update on a batch ``(B, ...)``, or on the batches of stacked seeds ``(S, B, ...)`` with the
     networks applied per seed: every mean is over the batch axis, so each seed's loss and gradient are its own.
-    Returns each statistic per seed (a scalar tensor without stacking)."""
+
+    ``nets`` maps actor, critic and their targets to :class:`~pamdp.algos.dense.Dense` views of their
+    networks; the gradients are back-propagated by hand (autograd's numbers, ``tests/test_dense.py``) and
+    handed to ``critic_step`` and ``actor_step``. Returns each statistic per seed (a scalar tensor without
+    stacking)."""
     obs, next_obs = b["obs"], b["next_obs"]
+    batch = obs.shape[-2]
+    actor, critic = nets["actor"], nets["critic"]
     with torch.no_grad():
-        q_next = critic_target(next_obs, actor_target(next_obs).clamp(-1.0, 1.0))
+        out_next = nets["actor_target"](next_obs).clamp(-1.0, 1.0)
+        q_next = nets["critic_target"](torch.cat([next_obs, out_next], dim=-1)).squeeze(-1)
         y = b["reward"] + cfg.gamma * (~b["terminated"]).float() * q_next
         if cfg.beta > 0:
             y = mixed_target(y, b["mc"], cfg.beta)
-    q = critic(obs, b["out"])
-    critic_loss = (q - y).square().mean(-1)  # F.mse_loss, per seed
-    for opt in optimizers:
-        opt.zero_grad(set_to_none=True)
-    critic_loss.sum().backward()
-    critic_step()
-    out, q_mu = backprop_actor(actor, critic, obs, cfg.bound)
-    actor_step()
-    soft()
+        # critic: descend on mean (Q - y)^2 over the batch
+        q, cache = critic.forward_cached(torch.cat([obs, b["out"]], dim=-1))
+        q = q.squeeze(-1)
+        error = q - y
+        critic_step(critic.backward(cache, error * (2.0 / batch))[0])
+        # actor: ascend on Q(s, mu(s)) with the critic just updated, dQ/dmu edited at the bounds
+        out, actor_cache = actor.forward_cached(obs)
+        q_mu, q_cache = critic.forward_cached(torch.cat([obs, out], dim=-1))
+        _, dq_dx = critic.backward(q_cache, torch.ones_like(q_mu), weights=False, inputs=True)
+        dq_dp = dq_dx[..., obs_dim:].reshape(out.shape)
+        if cfg.bound == "invert":
+            dq_dp = invert_gradients(dq_dp, out)
+        elif cfg.bound == "zero":
+            dq_dp = zero_gradients(dq_dp, out)
+        actor_step(actor.backward(actor_cache, -dq_dp / batch)[0])
+        soft()
     return {
-        "losses/critic_loss": critic_loss.detach(),
-        "losses/actor_loss": -q_mu.mean(-1),
-        "train/q_mean": q.detach().mean(-1),
+        "losses/critic_loss": error.square().mean(-1),
+        "losses/actor_loss": -q_mu.squeeze(-1).mean(-1),
+        "train/q_mean": q.mean(-1),
         "train/outputs_out_of_bounds": (out.abs() > 1.0).float().flatten(-2).mean(-1),
     }

@@ -574,7 +574,7 @@ class PASVG0(Algorithm):
         critic_params = list(stack.params["critic"].values())
         stack.optimizers["critic"].zero_grad(set_to_none=True)
         critic_loss.sum().backward()
-        clip_per_member(critic_params, cfg.grad_clip)
+        clip_per_member([p.grad for p in critic_params], cfg.grad_clip)
         stack.optimizers["critic"].step()
 
         if cfg.discrete_gradient == "expected":
@@ -588,7 +588,7 @@ class PASVG0(Algorithm):
         grads = torch.autograd.grad(actor_loss.sum(), policy_params)
         for p, g in zip(policy_params, grads):
             p.grad = g
-        clip_per_member(policy_params, cfg.grad_clip)
+        clip_per_member([p.grad for p in policy_params], cfg.grad_clip)
         stack.optimizers["policy"].step()
         stack.soft_update("critic_target", "critic", cfg.tau)
         stack.soft_update("policy_target", "policy", cfg.tau)

@@ -38,6 +38,8 @@ from typing import Any
 import torch
 from torch import nn
 
+from pamdp.algos.dense import Dense
+
 __all__ = ["SeedStack", "can_stack", "ALIGNED_STEPS", "adam_step", "step_class", "clip_per_member"]
 
 # Adam's bias corrections 1 - beta^t equal 1 in float32 once beta2^t < 2^-24: t > 16 600 for beta2 = 0.999.
@@ -73,11 +75,13 @@ def _check_steps(members: Sequence[Any]) -> None:
         )
 
 
-def clip_per_member(params: Sequence[torch.Tensor], max_norm: float) -> None:
-    """``clip_grad_norm_`` applied to each member's slice of stacked parameters on its own (0: no clipping)."""
+def clip_per_member(grads: Sequence[torch.Tensor | None], max_norm: float) -> None:
+    """``clip_grad_norm_`` applied to each member's slice of stacked gradients on its own (0: no clipping).
+
+    ``grads`` are the gradient tensors themselves (``None`` entries are skipped)."""
     if max_norm <= 0:
         return
-    grads = [p.grad for p in params if p.grad is not None]
+    grads = [g for g in grads if g is not None]
     if not grads:
         return
     norms = torch.stack([torch.linalg.vector_norm(g.flatten(1), dim=1) for g in grads])  # (tensors, S)
@@ -214,6 +218,12 @@ class SeedStack:
             else:
                 raise ValueError(f"seed stacking cannot batch a {type(layer).__name__} layer")
         return x.reshape(*shape, x.shape[-1])
+
+    def dense(self, module: str, path: str) -> Dense:
+        """The members' ``nn.Sequential`` at ``module.path`` as one :class:`~pamdp.algos.dense.Dense` over the
+        stacked ``(S, in, out)`` weights, for updates that back-propagate by hand."""
+        template = self.members[self.active[0]]._modules()[module].get_submodule(path)
+        return Dense.of_stack(template, self.params[module], path)
 
     def members_active(self) -> list[Any]:
         """The members in the stack, in the order of its leading axis."""

@@ -1,0 +1,150 @@
+"""The hand-written passes of pamdp.algos.dense against autograd, and PADDPG's update built on them against
+the autograd update it replaced."""
+
+import copy
+import dataclasses
+
+import pytest
+import torch
+from torch import nn
+
+from pamdp import PADDPG
+from pamdp.algos.dense import Dense
+from pamdp.algos.offpolicy import clip_grads, optimizer_step
+from pamdp.algos.paddpg import PADDPGConfig, backprop_actor
+from pamdp.policies import mlp
+
+
+def _net(activation, output=None, seed=0):
+    torch.manual_seed(seed)
+    return mlp(7, (16, 12), 5, activation, output)
+
+
+@pytest.mark.parametrize("activation", ["relu", "leaky_relu", "tanh", "elu"])
+@pytest.mark.parametrize("output", [None, nn.Tanh])
+def test_backward_matches_autograd(activation, output):
+    net = _net(activation, output)
+    x = torch.randn(9, 7, requires_grad=True)
+    g = torch.randn(9, 5)
+    out = net(x)
+    out.backward(g)
+    dense = Dense.of(net)
+    with torch.no_grad():
+        y, cache = dense.forward_cached(x)
+        grads, dx = dense.backward(cache, g, inputs=True)
+    torch.testing.assert_close(y, out.detach())
+    torch.testing.assert_close(dense(x.detach()), out.detach())
+    for p, mine in zip(net.parameters(), grads, strict=True):
+        torch.testing.assert_close(mine, p.grad)
+    torch.testing.assert_close(dx, x.grad)
+    _, none = dense.backward(cache, g)  # the input gradient only when asked for
+    assert none is None
+
+
+def test_backward_matches_finite_differences():
+    net = _net("tanh").double()
+    x = torch.randn(3, 7, dtype=torch.float64)
+    g = torch.randn(3, 5, dtype=torch.float64)
+    dense = Dense.of(net)
+    with torch.no_grad():
+        _, cache = dense.forward_cached(x)
+        grads, _ = dense.backward(cache, g)
+        w = net[2].weight  # the middle layer
+        i, j, eps = 4, 7, 1e-6
+        w[i, j] += eps
+        up = (dense(x) * g).sum()
+        w[i, j] -= 2 * eps
+        down = (dense(x) * g).sum()
+        w[i, j] += eps
+    assert grads[2][i, j].item() == pytest.approx(((up - down) / (2 * eps)).item(), rel=1e-6)
+
+
+def test_stacked_passes_are_each_members_own():
+    nets = [_net("leaky_relu", seed=s) for s in range(3)]
+    params = {}
+    for name, _ in nets[0].named_parameters():
+        ts = [n.get_parameter(name).detach() for n in nets]
+        params[f"net.{name}"] = torch.stack([t.t() if name.endswith("weight") else t for t in ts])  # (S, in, out)
+    dense = Dense.of_stack(nets[0], params, "net")
+    x = torch.randn(3, 6, 7)
+    g = torch.randn(3, 6, 5)
+    with torch.no_grad():
+        y, cache = dense.forward_cached(x)
+        grads, dx = dense.backward(cache, g, inputs=True)
+    for s, net in enumerate(nets):
+        xs = x[s].clone().requires_grad_(True)
+        out = net(xs)
+        out.backward(g[s])
+        torch.testing.assert_close(y[s], out.detach())
+        for (name, p), mine in zip(net.named_parameters(), grads, strict=True):
+            expect = p.grad.t() if name.endswith("weight") else p.grad
+            torch.testing.assert_close(mine[s], expect)
+        torch.testing.assert_close(dx[s], xs.grad)
+
+
+def test_layers_it_cannot_apply_are_refused():
+    with pytest.raises(TypeError, match="Dropout"):
+        Dense.of(nn.Sequential(nn.Linear(3, 4), nn.Dropout(0.1), nn.Linear(4, 1)))
+
+
+def test_optimizer_step_is_adams_own_step():
+    torch.manual_seed(1)
+    a = nn.Linear(5, 3)
+    b = copy.deepcopy(a)
+    opt_a = torch.optim.Adam(a.parameters(), lr=0.1, betas=(0.95, 0.999), fused=True)
+    opt_b = torch.optim.Adam(b.parameters(), lr=0.1, betas=(0.95, 0.999), fused=True)
+    for _ in range(4):  # the first step initialises the state through Adam's own step, the rest take the kernel
+        grads = [torch.randn_like(p) * 5 for p in a.parameters()]
+        for p, g in zip(a.parameters(), grads):
+            p.grad = g.clone()
+        nn.utils.clip_grad_norm_(a.parameters(), 1.0)
+        opt_a.step()
+        mine = [g.clone() for g in grads]
+        clip_grads(mine, 1.0)
+        optimizer_step(opt_b, mine)
+        for pa, pb in zip(a.parameters(), b.parameters()):
+            torch.testing.assert_close(pa, pb)
+    assert opt_b.state[b.weight]["step"].item() == 4
+    torch.testing.assert_close(opt_a.state[a.weight]["exp_avg_sq"], opt_b.state[b.weight]["exp_avg_sq"])
+
+
+SMALL = PADDPGConfig(hidden_sizes=(32, 24), learning_starts=64, batch_size=16, epoch_steps=200, beta=0.3)
+
+
+def _autograd_update(model, batch):
+    """PADDPG's update as it was written before pamdp.algos.dense, on autograd."""
+    cfg = model.config
+    obs, next_obs = batch["obs"], batch["next_obs"]
+    with torch.no_grad():
+        q_next = model.critic_target(next_obs, model.actor_target(next_obs).clamp(-1.0, 1.0))
+        y = batch["reward"] + cfg.gamma * (~batch["terminated"]).float() * q_next
+        y = torch.where(torch.isnan(batch["mc"]), y, cfg.beta * batch["mc"].nan_to_num() + (1 - cfg.beta) * y)
+    q = model.critic(obs, batch["out"])
+    model.critic_optimizer.zero_grad(set_to_none=True)
+    model.actor_optimizer.zero_grad(set_to_none=True)
+    (q - y).square().mean().backward()
+    nn.utils.clip_grad_norm_(model.critic.parameters(), cfg.grad_clip)
+    model.critic_optimizer.step()
+    backprop_actor(model.actor, model.critic, obs, cfg.bound)
+    nn.utils.clip_grad_norm_(model.actor.parameters(), cfg.grad_clip)
+    model.actor_optimizer.step()
+    with torch.no_grad():
+        for target, source in ((model.critic_target, model.critic), (model.actor_target, model.actor)):
+            for t, s in zip(target.parameters(), source.parameters()):
+                t.lerp_(s, cfg.tau)
+
+
+@pytest.mark.parametrize("bound", ["invert", "squash", "zero"])
+def test_paddpg_update_matches_the_autograd_update(bound):
+    cfg = dataclasses.replace(SMALL, bound=bound, grad_clip=0.5, activation="leaky_relu")
+    mine = PADDPG("pamdp/Platform-v0", cfg)
+    mine.learn(200, progress_bar=False)  # fills the replay and takes ~140 updates, so Adam's state exists
+    ref = copy.deepcopy(mine)
+    for _ in range(30):
+        batch = mine._stack_sample()
+        mine_batch = {k: v.clone() for k, v in batch.items()}
+        _autograd_update(ref, batch)
+        mine._update_with(mine_batch)
+    for name, module in mine._modules().items():
+        for (pname, p), q in zip(module.named_parameters(), ref._modules()[name].parameters()):
+            torch.testing.assert_close(p, q, atol=2e-6, rtol=1e-4, msg=f"{name}.{pname}")
