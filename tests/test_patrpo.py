@@ -121,7 +121,8 @@ def test_gauss_newton_and_double_backprop_take_the_same_step(estimator):
         assert stats[0]["train/line_search_success"] == 1.0
         params.append(torch.cat([p.detach().flatten() for p in model.policy.parameters()]))
     step = params[1] - before
-    torch.testing.assert_close(params[0] - before, step, atol=1e-4 * float(step.abs().max()), rtol=0)
+    # float32 conjugate gradients on two roundings of one matrix: agreement to a few 1e-4 of the largest entry
+    torch.testing.assert_close(params[0] - before, step, atol=3e-4 * float(step.abs().max()), rtol=0)
 
 
 def test_save_load_predict_round_trip(tmp_path):

@@ -15,6 +15,7 @@ from __future__ import annotations
 import csv
 import dataclasses
 import importlib
+import importlib.util
 import math
 import os
 import tempfile
@@ -113,7 +114,8 @@ class AlgoConfig:
     )
     vector_mode: str = setting(
         "auto",
-        "How env copies are stepped: batched, sync (scalar copies in turn) or auto (batched from 48 copies).",
+        "How env copies are stepped: batched, sync (scalar copies in turn) or auto (batched from 2 copies with Numba "
+        "installed, from 48 without).",
         one_of(("auto", "batched", "sync")),
     )
 
@@ -199,10 +201,19 @@ def _coerce(name: str, value: Any, hint: Any) -> Any:
 
 
 # -- environments -----------------------------------------------------------------------------------
-# A batched env pays NumPy's per-call cost on every inner loop iteration, whatever its number of copies;
-# below about this many copies, scalar envs stepped one after the other are faster (measured on Platform:
-# 8 copies run ~600 steps/s batched, ~3 500 as scalar copies; the two meet near 48; HFO's meet near 32).
+# A batched env on its NumPy backend pays NumPy's per-call cost on every inner loop iteration, whatever its
+# number of copies; below about this many copies, scalar envs stepped one after the other are faster (measured
+# on Platform: 8 copies run ~600 steps/s batched, ~3 500 as scalar copies; the two meet near 48; HFO's near 32).
 AUTO_BATCH_MIN = 48
+# With Numba (pamdp[fast]) the batched envs run compiled kernels and win from two copies on (2026-11-29, one
+# core: Platform 13 000 against 4 000 steps/s at 2 copies, 73 000 against 6 300 at 8; HFO 55 000 against
+# 21 000 at 2, 196 000 against 29 000 at 8); a single HFO copy is faster scalar (34 000 against 16 000).
+AUTO_BATCH_MIN_NUMBA = 2
+
+
+def auto_batch_min() -> int:
+    """The number of copies from which ``"auto"`` steps an env's batched version."""
+    return AUTO_BATCH_MIN_NUMBA if importlib.util.find_spec("numba") is not None else AUTO_BATCH_MIN
 
 
 def env_spec(env_id: str) -> gymnasium.envs.registration.EnvSpec:
@@ -233,13 +244,14 @@ def make_vector_env(
     env_id: str, num_envs: int, env_kwargs: dict | None = None, mode: str = "auto"
 ) -> gymnasium.vector.VectorEnv:
     """``num_envs`` copies of the env: ``"batched"`` (its ``vector_entry_point``), ``"sync"`` (scalar copies
-    stepped in turn) or ``"auto"`` (batched from ``AUTO_BATCH_MIN`` copies on, when the env has a batched version).
+    stepped in turn) or ``"auto"`` (batched from :func:`auto_batch_min` copies on, when the env has a batched
+    version).
     """
     if mode not in ("auto", "batched", "sync"):
         raise ValueError(f"vector env mode {mode!r}; expected 'auto', 'batched' or 'sync'")
     spec = env_spec(env_id)
     batched = spec.vector_entry_point is not None and (
-        mode == "batched" or (mode == "auto" and num_envs >= AUTO_BATCH_MIN)
+        mode == "batched" or (mode == "auto" and num_envs >= auto_batch_min())
     )
     if mode == "batched" and spec.vector_entry_point is None:
         raise ValueError(f"{env_id} has no batched version (no vector_entry_point); use 'sync'")

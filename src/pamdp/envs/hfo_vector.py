@@ -36,6 +36,7 @@ from pamdp.envs.hfo_interface import (
     hfo_action_space,
     parse_reset_options,
 )
+from pamdp.envs.numba_cache import KernelPickling
 
 _STATUS_NAMES = np.array(phys.STATUS_NAMES)
 
@@ -228,7 +229,7 @@ def post_collisions(x, y, vx, vy, reach):
     return collided
 
 
-class HalfFieldOffenseVectorEnv(gymnasium.vector.VectorEnv):
+class HalfFieldOffenseVectorEnv(KernelPickling, gymnasium.vector.VectorEnv):
     """``num_envs`` HFO 1v0 games in NumPy, with Gymnasium's next-step autoreset.
 
     Takes the keyword arguments of :class:`pamdp.envs.hfo.HalfFieldOffenseEnv`. Actions are the

@@ -9,10 +9,11 @@ modules next to the cache and drops the cached kernels when the digest changes.
 from __future__ import annotations
 
 import hashlib
+import importlib
 from collections.abc import Sequence
 from pathlib import Path
 
-__all__ = ["refresh_cache"]
+__all__ = ["refresh_cache", "KernelPickling"]
 
 
 def refresh_cache(kernel_file: str | Path, dependencies: Sequence[str], directory: Path | None = None) -> bool:
@@ -38,3 +39,19 @@ def refresh_cache(kernel_file: str | Path, dependencies: Sequence[str], director
     except OSError:
         return False
     return True
+
+
+class KernelPickling:
+    """Lets a batched env that keeps its kernel module in ``self._kernel`` be pickled and deep-copied (a module
+    object is neither): the module travels by name and is imported again on the other side."""
+
+    def __getstate__(self) -> dict:
+        state = self.__dict__.copy()
+        if state.get("_kernel") is not None:
+            state["_kernel"] = state["_kernel"].__name__
+        return state
+
+    def __setstate__(self, state: dict) -> None:
+        if isinstance(state.get("_kernel"), str):
+            state["_kernel"] = importlib.import_module(state["_kernel"])
+        self.__dict__.update(state)

@@ -22,6 +22,7 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
 from pamdp.envs.hfo_vector import _pick_backend
+from pamdp.envs.numba_cache import KernelPickling
 from pamdp.envs.platform import (
     AX_MAX,
     AY_MAX,
@@ -105,7 +106,7 @@ def _on_platform(x: np.ndarray, y: np.ndarray) -> np.ndarray:
     return over & (y == PLATFORM_HEIGHT)
 
 
-class PlatformVectorEnv(VectorEnv):
+class PlatformVectorEnv(KernelPickling, VectorEnv):
     """``num_envs`` independent Platform episodes, stepped together.
 
     Actions are batched like ``batch_space`` of the scalar action space: ``(a, (p_run, p_hop, p_leap))``
