@@ -65,3 +65,28 @@ def test_cached_kernels_are_dropped_when_a_module_they_compile_in_changes(tmp_pa
     # A change of a dependency (here: a digest written for other contents) drops them again.
     (tmp_path / f"{module}.deps").write_text("another digest")
     assert kernel.refresh_cache(tmp_path) is True and not any(f.exists() for f in cached)
+
+
+@pytest.mark.parametrize("backend", ["numpy", "numba"])
+@pytest.mark.parametrize("env_id", ["pamdp/Platform-v0", "pamdp/HalfFieldOffense-v0"])
+def test_a_copied_batched_env_goes_on_as_the_original(env_id, backend):
+    # A copy keeps the kernel (by module name) and the views of its state (HFO's rows of one matrix): it steps
+    # on exactly as the original does.
+    import copy
+    import pickle
+
+    import numpy as np
+
+    env = gymnasium.make_vec(env_id, num_envs=3, vectorization_mode="vector_entry_point", backend=backend)
+    env.reset(seed=1)
+    env.action_space.seed(0)
+    for _ in range(5):
+        env.step(env.action_space.sample())
+    copies = [copy.deepcopy(env), pickle.loads(pickle.dumps(env))]
+    for _ in range(60):
+        action = env.action_space.sample()
+        obs, reward, *_ = env.step(action)
+        for other in copies:
+            obs2, reward2, *_ = other.step(action)
+            np.testing.assert_array_equal(obs2, obs)
+            np.testing.assert_array_equal(reward2, reward)

@@ -489,18 +489,30 @@ class HalfFieldOffenseVectorEnv(KernelPickling, gymnasium.vector.VectorEnv):
         self.bonus_paid[idx] = False
         self.status[idx] = phys.IN_GAME  # the agents' view (_sense) is left to the caller
 
-    def _allocate(self) -> None:
+    def _bind_views(self) -> None:
+        """The attributes that are views of ``_state`` and ``_accel``: bound at allocation and again after a copy
+        (``copy.deepcopy`` and pickling copy each view on its own, which would cut it off the state)."""
         n = self.num_envs
-        # The state's attributes are rows of one matrix, updated in place, which the agents' view rounds.
-        self._state = np.zeros((len(_STATE), n))
         for name, row in zip(_STATE, self._state):
             setattr(self, name, row)
         # (2, N) blocks of the movement: positions x and y, velocities x and y (views of the state).
         self._xy = self._state[_PX : _BY + 1].reshape(2, 2, n)
         self._v = self._state[_PVX : _BVY + 1].reshape(2, 2, n)
+        (self.pax, self.bax), (self.pay, self.bay) = self._accel
+        if getattr(self, "_kernel", None) is not None:
+            self._state_bits = self._state.view(np.int64)  # for the agents' view: rounding by the exponent bits
+
+    def __setstate__(self, state: dict) -> None:
+        super().__setstate__(state)
+        self._bind_views()
+
+    def _allocate(self) -> None:
+        n = self.num_envs
+        # The state's attributes are rows of one matrix, updated in place, which the agents' view rounds.
+        self._state = np.zeros((len(_STATE), n))
         # Accelerations accumulated this cycle, x and y, player (row 0) and ball (row 1).
         self._accel = np.zeros((2, 2, n))
-        (self.pax, self.bax), (self.pay, self.bay) = self._accel
+        self._bind_views()
         self._rand = np.array([[self.player_rand], [self.ball_rand]])
         self._noise_draws = np.zeros((4, n))
         self._turn_draws = np.zeros(n)
