@@ -8,10 +8,11 @@ import pytest
 import torch
 from torch import nn
 
-from pamdp import PADDPG
+from pamdp import PADDPG, PASVG0
 from pamdp.algos.dense import Dense
 from pamdp.algos.offpolicy import clip_grads, optimizer_step
 from pamdp.algos.paddpg import PADDPGConfig, backprop_actor
+from pamdp.algos.pasvg import PASVG0Config
 from pamdp.policies import mlp
 
 
@@ -148,3 +149,36 @@ def test_paddpg_update_matches_the_autograd_update(bound):
     for name, module in mine._modules().items():
         for (pname, p), q in zip(module.named_parameters(), ref._modules()[name].parameters()):
             torch.testing.assert_close(p, q, atol=2e-6, rtol=1e-4, msg=f"{name}.{pname}")
+
+
+SVG_SMALL = PASVG0Config(hidden_sizes=(32, 24), learning_starts=64, batch_size=16, epoch_steps=200, grad_clip=0.5)
+
+
+@pytest.mark.parametrize(
+    "settings",
+    [
+        {},  # the paper's: straight-through, learned log-std, no entropy bonus
+        {"straight_through": False, "entropy_coef": 0.05, "activation": "tanh"},
+        {"learn_std": False, "temperature": 0.5, "init_log_std": 2.0},  # log-std at the clamp's bound
+    ],
+)
+def test_pasvg_update_matches_the_autograd_update(settings):
+    cfg = dataclasses.replace(SVG_SMALL, **settings)
+    mine = PASVG0("pamdp/Platform-v0", cfg)
+    assert mine._dense is not None
+    mine.learn(200, progress_bar=False)
+    ref = copy.deepcopy(mine)
+    for _ in range(30):  # both draw the same batch and noise from their (equal) random streams
+        stats = mine._update()
+        ref_stats = ref._update_autograd()
+    assert stats.keys() == ref_stats.keys() and list(stats) == list(ref_stats)  # the same log columns
+    for key in stats:
+        assert stats[key] == pytest.approx(ref_stats[key], rel=1e-4, abs=1e-6), key
+    for name, module in mine._modules().items():
+        for (pname, p), q in zip(module.named_parameters(), ref._modules()[name].parameters()):
+            torch.testing.assert_close(p, q, atol=2e-6, rtol=1e-4, msg=f"{name}.{pname}")
+
+
+def test_pasvg_variants_without_a_hand_written_update_keep_autograd():
+    for settings in ({"discrete_gradient": "expected"}, {"twin_critics": True}, {"policy_delay": 2}):
+        assert PASVG0("pamdp/Platform-v0", dataclasses.replace(SVG_SMALL, **settings))._dense is None

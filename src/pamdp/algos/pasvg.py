@@ -48,7 +48,8 @@ from pamdp.algos.base import (
     one_of,
     setting,
 )
-from pamdp.algos.offpolicy import OffPolicyLoop, clipped_step, soft_update
+from pamdp.algos.dense import Dense
+from pamdp.algos.offpolicy import OffPolicyLoop, clip_grads, clipped_step, optimizer_step, soft_update
 from pamdp.algos.replay import ReplayBuffer
 from pamdp.algos.stacking import clip_per_member
 from pamdp.policies import ACTIVATIONS, mlp
@@ -395,6 +396,27 @@ class PASVG0(Algorithm):
         }
         self.replay = ReplayBuffer(cfg.buffer_size, fields)
         self.loop = OffPolicyLoop(h, self.replay, cfg.gamma)
+        self._bind_networks()
+
+    def _bind_networks(self) -> None:
+        """The hand-written update's views of the networks (:mod:`pamdp.algos.dense`), for the settings it
+        covers (:func:`_dense_update`); ``_dense = None`` runs the autograd update. Called again by whoever
+        replaces a module."""
+        self._dense = None
+        if self._stack_refusal(self.config) is None and self.config.discrete_gradient == "gumbel":
+            self._dense = {
+                "pi_d": Dense.of(self.policy.pi_d),
+                "pi_c": Dense.of(self.policy.pi_c),
+                "critic": Dense.of(self.critic.net),
+                "pi_d_target": Dense.of(self.policy_target.pi_d),
+                "pi_c_target": Dense.of(self.policy_target.pi_c),
+                "critic_target": Dense.of(self.critic_target.net),
+            }
+            targets, sources = (self.critic_target, self.policy_target), (self.critic, self.policy)
+            self._soft_pairs = (
+                [p for m in targets for p in m.parameters()],
+                [p for m in sources for p in m.parameters()],
+            )
 
     def _modules(self):
         modules = {
@@ -467,6 +489,40 @@ class PASVG0(Algorithm):
 
     def _update(self) -> dict[str, float]:
         """One critic TD step and (every ``policy_delay``-th call) one value-gradient step of both policies."""
+        if self._dense is not None:
+            return self._update_dense(self._stack_sample())
+        return self._update_autograd()
+
+    def _update_dense(self, b: dict[str, torch.Tensor]) -> dict[str, float]:
+        """:meth:`_update_autograd`'s step, back-propagated by hand (:func:`_dense_update`), on the batch and
+        noise ``b`` of :meth:`_stack_sample`."""
+        cfg = self.config
+
+        def step(optimizer):
+            def apply(grads):
+                clip_grads(grads, cfg.grad_clip)
+                optimizer_step(optimizer, grads)
+
+            return apply
+
+        stats = _dense_update(
+            cfg,
+            b,
+            self._dense,
+            self.policy.log_std,
+            self.policy_target.log_std,
+            self.policy.mask,
+            step(self.critic_optimizer),
+            step(self.policy_optimizer),
+            lambda: torch._foreach_lerp_(*self._soft_pairs, cfg.tau),
+        )
+        self.critic_updates += 1
+        out = {k: float(v) for k, v in stats.items()}
+        out["train/entropy_coef"] = cfg.entropy_coef
+        out["train/param_std"] = float(self.policy.log_std.detach().exp()[self.policy.mask.bool()].mean())
+        return out
+
+    def _update_autograd(self) -> dict[str, float]:
         cfg = self.config
         b = self.replay.sample(cfg.batch_size, self.np_rng)
         obs, next_obs = b["obs"], b["next_obs"]
@@ -554,6 +610,8 @@ class PASVG0(Algorithm):
         rows of ``log_std`` are gathered with its own actions.
         """
         cfg = stack.config
+        if cfg.discrete_gradient == "gumbel":
+            return cls._stacked_dense_update(stack, b)
 
         def critic(module):
             return lambda o, a, x: stack.sequential(module, "net", torch.cat([o, a, x], dim=-1)).squeeze(-1)
@@ -608,6 +666,55 @@ class PASVG0(Algorithm):
             m.critic_updates += 1
         return stats
 
+    @classmethod
+    def _stacked_dense_update(cls, stack, b: dict[str, torch.Tensor]) -> list[dict[str, float]]:
+        """:meth:`_update_dense` for every member of a seed stack at once (:func:`_dense_update` over ``(S, ...)``)."""
+        cfg = stack.config
+        nets = {
+            "pi_d": stack.dense("policy", "pi_d"),
+            "pi_c": stack.dense("policy", "pi_c"),
+            "critic": stack.dense("critic", "net"),
+            "pi_d_target": stack.dense("policy_target", "pi_d"),
+            "pi_c_target": stack.dense("policy_target", "pi_c"),
+            "critic_target": stack.dense("critic_target", "net"),
+        }
+
+        def step(name):
+            def apply(grads):
+                clip_per_member(grads, cfg.grad_clip)
+                optimizer_step(stack.optimizers[name], grads)
+
+            return apply
+
+        def soft():
+            stack.soft_update("critic_target", "critic", cfg.tau)
+            stack.soft_update("policy_target", "policy", cfg.tau)
+
+        log_std = stack.params["policy"]["log_std"]
+        mask = stack.buffer("policy", "mask")
+        stats = _dense_update(
+            cfg,
+            b,
+            nets,
+            log_std,
+            stack.params["policy_target"]["log_std"],
+            mask,
+            step("critic"),
+            step("policy"),
+            soft,
+        )
+        columns = {k: v.tolist() for k, v in stats.items()}
+        columns["train/param_std"] = log_std.detach().exp()[:, mask.bool()].mean(-1).tolist()
+        rows = []
+        for j in range(len(b["obs"])):
+            row = {k: v[j] for k, v in columns.items()}
+            row["train/entropy_coef"] = cfg.entropy_coef
+            row["train/param_std"] = row.pop("train/param_std")  # the solo update's column order
+            rows.append(row)
+        for m in stack.members_active():
+            m.critic_updates += 1
+        return rows
+
 
 class _StackedPolicy(HybridSampling):
     """A seed stack's ``module`` (a :class:`GumbelHybridPolicy` in every member) as one policy over ``(S, ...)``."""
@@ -623,3 +730,79 @@ class _StackedPolicy(HybridSampling):
 
     def pi_c(self, inputs: torch.Tensor) -> torch.Tensor:
         return self.stack.sequential(self.module, "pi_c", inputs)
+
+
+def _dense_update(cfg, b, nets, log_std, log_std_target, mask, critic_step, policy_step, soft) -> dict:
+    """The paper's update (``discrete_gradient="gumbel"``, one critic, a fixed entropy weight, no policy delay),
+    back-propagated by hand on a batch ``(B, ...)`` or a seed stack's ``(S, B, ...)``.
+
+    ``nets`` maps ``pi_d``, ``pi_c``, ``critic`` and their ``*_target`` to :class:`~pamdp.algos.dense.Dense`
+    views; ``log_std`` is ``(K, m)`` or ``(S, K, m)``. The gradients are autograd's through
+    :meth:`HybridSampling.sample` and the critic (``tests/test_dense.py``): the straight-through one-hot carries
+    the softmax's gradient, ``pi_c`` sees the action, and ``log_std`` gets its rows' share through ``exp`` and
+    the clamp. ``policy_step`` receives them in the order of the policy's trainable parameters (``log_std``,
+    then ``pi_d``'s and ``pi_c``'s). Returns the
+    statistics per seed (scalars without stacking)."""
+    obs, next_obs = b["obs"], b["next_obs"]
+    batch, d = obs.shape[-2], obs.shape[-1]
+    K = mask.shape[0]
+    temperature, hard = cfg.temperature, cfg.straight_through
+    with torch.no_grad():
+        # TD target: the target policy's action for fresh noise, valued by the target critic
+        index_next, a_next = gumbel_softmax_sample(nets["pi_d_target"](next_obs), b["next_eta_a"], temperature, hard)
+        std_next = _rows(log_std_target.clamp(LOG_STD_MIN, LOG_STD_MAX).exp(), index_next)
+        pre_next = nets["pi_c_target"](torch.cat([next_obs, a_next], dim=-1))
+        x_next = torch.tanh(pre_next + std_next * b["next_eta_x"]) * mask[index_next]
+        q_next = nets["critic_target"](torch.cat([next_obs, a_next, x_next], dim=-1)).squeeze(-1)
+        y = b["reward"] + cfg.gamma * (~b["terminated"]).float() * q_next
+
+        critic = nets["critic"]
+        q, cache = critic.forward_cached(torch.cat([obs, b["a_in"], b["x"]], dim=-1))
+        q = q.squeeze(-1)
+        error = q - y
+        critic_step(critic.backward(cache, error * (2.0 / batch))[0])
+
+        # The policy loss -mean Q(s, a, x) - alpha * mean H(pi_d), with the recorded noise
+        logits, d_cache = nets["pi_d"].forward_cached(obs)
+        log_p = logits.log_softmax(-1)
+        z = log_p + b["eta_a"]
+        soft_a = torch.softmax(z / temperature, dim=-1)
+        index = z.argmax(-1)
+        a = F.one_hot(index, K).to(soft_a.dtype) if hard else soft_a
+        std = _rows(log_std.clamp(LOG_STD_MIN, LOG_STD_MAX).exp(), index)
+        pre, c_cache = nets["pi_c"].forward_cached(torch.cat([obs, a], dim=-1))
+        t = torch.tanh(pre + std * b["eta_x"])
+        rows = mask[index]
+        x = t * rows
+        q_pi, q_cache = critic.forward_cached(torch.cat([obs, a, x], dim=-1))
+        _, d_in = critic.backward(q_cache, torch.full_like(q_pi, -1.0 / batch), weights=False, inputs=True)
+        d_in = d_in.reshape(*obs.shape[:-1], -1)
+        d_u = torch.ops.aten.tanh_backward(d_in[..., d + K :] * rows, t)  # through x = tanh(u) * mask
+        pc_grads, d_pc_in = nets["pi_c"].backward(c_cache, d_u, inputs=True)
+        d_a = d_in[..., d : d + K] + d_pc_in.reshape(*obs.shape[:-1], -1)[..., d:]
+        # a carries softmax(z / t)'s gradient (straight-through, or the soft sample itself), z = log pi_d + eta_a
+        d_z = soft_a * (d_a - (d_a * soft_a).sum(-1, keepdim=True)) / temperature
+        p = log_p.exp()
+        d_logits = d_z - p * d_z.sum(-1, keepdim=True)
+        entropy = -(p * log_p).sum(-1)
+        alpha = cfg.entropy_coef
+        if alpha:
+            d_logits = d_logits + (alpha / batch) * p * (log_p + entropy.unsqueeze(-1))
+        pd_grads, _ = nets["pi_d"].backward(d_cache, d_logits)
+        grads = pd_grads + pc_grads
+        if log_std.requires_grad:  # the policy's own parameter, so first in its parameters()
+            # u = mu + exp(clamp(log_std))[a] * eta_x: each row's share, summed over the samples of its action
+            onehot_t = F.one_hot(index, K).to(d_u.dtype).transpose(-1, -2)
+            d_table = torch.matmul(onehot_t, d_u * b["eta_x"] * std).reshape(log_std.shape)
+            inside = (log_std >= LOG_STD_MIN) & (log_std <= LOG_STD_MAX)
+            grads.insert(0, d_table * inside)
+        policy_step(grads)
+        soft()
+    q_pi = q_pi.squeeze(-1)
+    return {
+        "losses/critic_loss": error.square().mean(-1),
+        "train/q_mean": q.mean(-1),
+        "losses/actor_loss": -q_pi.mean(-1) - alpha * entropy.mean(-1),
+        "train/q_pi_mean": q_pi.mean(-1),
+        "train/entropy": entropy.mean(-1),
+    }
