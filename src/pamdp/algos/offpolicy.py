@@ -33,6 +33,7 @@ __all__ = [
     "clipped_step",
     "clip_grads",
     "optimizer_step",
+    "gradient_step",
     "linear_epsilon",
     "mixed_target",
     "discounted_returns",
@@ -132,6 +133,17 @@ def optimizer_step(optimizer: torch.optim.Optimizer, grads: Sequence[torch.Tenso
         grad_scale=None,
         found_inf=None,
     )
+
+
+def gradient_step(optimizer: torch.optim.Optimizer, max_norm: float) -> Callable[[Sequence[torch.Tensor]], None]:
+    """A step of ``optimizer`` on hand-computed gradients: their total norm clipped to ``max_norm`` (0: none),
+    then :func:`optimizer_step`."""
+
+    def step(grads: Sequence[torch.Tensor]) -> None:
+        clip_grads(grads, max_norm)
+        optimizer_step(optimizer, grads)
+
+    return step
 
 
 def linear_epsilon(step: int, start: float, end: float, steps: int) -> float:

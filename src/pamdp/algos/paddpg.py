@@ -45,7 +45,7 @@ from pamdp.algos.base import (
     setting,
 )
 from pamdp.algos.dense import Dense
-from pamdp.algos.offpolicy import OffPolicyLoop, OUNoise, clip_grads, linear_epsilon, mixed_target, optimizer_step
+from pamdp.algos.offpolicy import OffPolicyLoop, OUNoise, gradient_step, linear_epsilon, mixed_target, optimizer_step
 from pamdp.algos.replay import ReplayBuffer
 from pamdp.algos.stacking import clip_per_member
 from pamdp.policies import ACTIVATIONS, mlp
@@ -321,20 +321,13 @@ class PADDPG(Algorithm):
     def _update_with(self, batch: dict[str, torch.Tensor]) -> dict[str, float]:
         cfg = self.config
 
-        def step(optimizer):
-            def apply(grads):
-                clip_grads(grads, cfg.grad_clip)
-                optimizer_step(optimizer, grads)
-
-            return apply
-
         stats = _update_step(
             cfg,
             batch,
             self._dense,
             self.obs_dim,
-            step(self.critic_optimizer),
-            step(self.actor_optimizer),
+            gradient_step(self.critic_optimizer, cfg.grad_clip),
+            gradient_step(self.actor_optimizer, cfg.grad_clip),
             lambda: torch._foreach_lerp_(*self._soft_pairs, cfg.tau),
         )
         return {k: float(v) for k, v in stats.items()}

@@ -49,7 +49,7 @@ from pamdp.algos.base import (
     setting,
 )
 from pamdp.algos.dense import Dense
-from pamdp.algos.offpolicy import OffPolicyLoop, clip_grads, clipped_step, optimizer_step, soft_update
+from pamdp.algos.offpolicy import OffPolicyLoop, clipped_step, gradient_step, optimizer_step, soft_update
 from pamdp.algos.replay import ReplayBuffer
 from pamdp.algos.stacking import clip_per_member
 from pamdp.policies import ACTIVATIONS, mlp
@@ -498,13 +498,6 @@ class PASVG0(Algorithm):
         noise ``b`` of :meth:`_stack_sample`."""
         cfg = self.config
 
-        def step(optimizer):
-            def apply(grads):
-                clip_grads(grads, cfg.grad_clip)
-                optimizer_step(optimizer, grads)
-
-            return apply
-
         stats = _dense_update(
             cfg,
             b,
@@ -512,8 +505,8 @@ class PASVG0(Algorithm):
             self.policy.log_std,
             self.policy_target.log_std,
             self.policy.mask,
-            step(self.critic_optimizer),
-            step(self.policy_optimizer),
+            gradient_step(self.critic_optimizer, cfg.grad_clip),
+            gradient_step(self.policy_optimizer, cfg.grad_clip),
             lambda: torch._foreach_lerp_(*self._soft_pairs, cfg.tau),
         )
         self.critic_updates += 1
