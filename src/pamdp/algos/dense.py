@@ -14,13 +14,13 @@ autograd; ``benchmarks/offpolicy_speed.md`` has the times).
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import torch
 from torch import nn
 
-__all__ = ["Dense", "assign_grads"]
+__all__ = ["Dense"]
 
 _aten = torch.ops.aten
 
@@ -146,33 +146,22 @@ class Dense:
         shaped as the flattened inputs.
         """
         g = grad.reshape(cache[-1].shape)
-        n = len(self.acts)
-        grads: list[torch.Tensor] = [] if weights else None  # type: ignore[assignment]
+        pairs: list[tuple[torch.Tensor, torch.Tensor]] = []  # (weight, bias) gradients, last layer first
         pos = len(cache) - 1
-        for i in reversed(range(n)):
+        for i in reversed(range(len(self.acts))):
             act = self.acts[i]
             if act is not None:
-                y, z = cache[pos], cache[pos - 1]
-                g = _slope_times(*act, g, z, y)
+                g = _slope_times(*act, g, cache[pos - 1], cache[pos])  # (pre-activation, output)
                 pos -= 2
             else:
                 pos -= 1
             h = cache[pos]  # the layer's input
             if weights:
                 if self.stacked:
-                    grads += [torch.bmm(h.transpose(1, 2), g), g.sum(1)]
+                    pairs.append((torch.bmm(h.transpose(1, 2), g), g.sum(1)))
                 else:
-                    grads += [torch.mm(g.t(), h), g.sum(0)]
+                    pairs.append((torch.mm(g.t(), h), g.sum(0)))
             if i > 0 or inputs:
                 g = torch.bmm(g, self.weights[i].transpose(1, 2)) if self.stacked else torch.mm(g, self.weights[i])
-        if weights:
-            # built last layer first, two per layer: put them in parameter order
-            pairs = [grads[j : j + 2] for j in range(0, len(grads), 2)][::-1]
-            grads = [t for pair in pairs for t in pair]
+        grads = [t for pair in reversed(pairs) for t in pair] if weights else None
         return grads, (g if inputs else None)
-
-
-def assign_grads(params: Sequence[torch.Tensor], grads: Sequence[torch.Tensor]) -> None:
-    """Set ``p.grad`` for an optimizer step (the tensors are fresh, so no copy is needed)."""
-    for p, g in zip(params, grads, strict=True):
-        p.grad = g
