@@ -29,6 +29,7 @@ __all__ = [
     "OffPolicyLoop",
     "OUNoise",
     "soft_update",
+    "soft_updater",
     "hard_update",
     "clipped_step",
     "clip_grads",
@@ -50,6 +51,19 @@ def soft_update(target: nn.Module, source: nn.Module, tau: float) -> None:
     """Polyak averaging of target networks, as DDPG: ``theta' <- tau * theta + (1 - tau) * theta'``."""
     with torch.no_grad():  # one foreach call, not a Python loop of a kernel per tensor
         torch._foreach_lerp_(list(target.parameters()), list(source.parameters()), tau)
+
+
+def soft_updater(pairs: Sequence[tuple[nn.Module, nn.Module]]) -> Callable[[float], None]:
+    """:func:`soft_update` of every ``(target, source)`` pair in one foreach call, the parameter lists gathered
+    once (a module's ``parameters()`` walk costs more than the update itself at these sizes)."""
+    targets = [p for target, _ in pairs for p in target.parameters()]
+    sources = [p for _, source in pairs for p in source.parameters()]
+
+    def update(tau: float) -> None:
+        with torch.no_grad():
+            torch._foreach_lerp_(targets, sources, tau)
+
+    return update
 
 
 def hard_update(target: nn.Module, source: nn.Module) -> None:

@@ -45,9 +45,8 @@ from pamdp.algos.base import (
     setting,
 )
 from pamdp.algos.dense import Dense
-from pamdp.algos.offpolicy import OffPolicyLoop, OUNoise, gradient_step, linear_epsilon, mixed_target, optimizer_step
+from pamdp.algos.offpolicy import OffPolicyLoop, OUNoise, gradient_step, linear_epsilon, mixed_target, soft_updater
 from pamdp.algos.replay import ReplayBuffer
-from pamdp.algos.stacking import clip_per_member
 from pamdp.policies import ACTIVATIONS, mlp
 from pamdp.spaces import HybridActionSpace
 
@@ -245,9 +244,7 @@ class PADDPG(Algorithm):
         """The update's hand-written passes (:mod:`pamdp.algos.dense`) over the modules' own tensors; called
         again by whoever replaces a module."""
         self._dense = {name: Dense.of(module.net) for name, module in self._modules().items()}
-        targets, sources = (self.actor_target, self.critic_target), (self.actor, self.critic)
-        # soft_update of both targets in one call
-        self._soft_pairs = ([p for m in targets for p in m.parameters()], [p for m in sources for p in m.parameters()])
+        self._soft_update = soft_updater(((self.actor_target, self.actor), (self.critic_target, self.critic)))
 
     def _modules(self):
         return {
@@ -328,7 +325,7 @@ class PADDPG(Algorithm):
             self.obs_dim,
             gradient_step(self.critic_optimizer, cfg.grad_clip),
             gradient_step(self.actor_optimizer, cfg.grad_clip),
-            lambda: torch._foreach_lerp_(*self._soft_pairs, cfg.tau),
+            lambda: self._soft_update(cfg.tau),
         )
         return {k: float(v) for k, v in stats.items()}
 
@@ -343,21 +340,14 @@ class PADDPG(Algorithm):
 
         nets = {name: stack.dense(name, "net") for name in ("actor", "critic", "actor_target", "critic_target")}
 
-        def step(name):
-            def apply(grads):
-                clip_per_member(grads, cfg.grad_clip)
-                optimizer_step(stack.optimizers[name], grads)
-
-            return apply
-
         obs_dim = stack.members_active()[0].obs_dim
         stats = _update_step(
             cfg,
             b,
             nets,
             obs_dim,
-            step("critic"),
-            step("actor"),
+            stack.gradient_step("critic", cfg.grad_clip),
+            stack.gradient_step("actor", cfg.grad_clip),
             lambda: (
                 stack.soft_update("critic_target", "critic", cfg.tau),
                 stack.soft_update("actor_target", "actor", cfg.tau),

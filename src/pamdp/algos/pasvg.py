@@ -49,7 +49,7 @@ from pamdp.algos.base import (
     setting,
 )
 from pamdp.algos.dense import Dense
-from pamdp.algos.offpolicy import OffPolicyLoop, clipped_step, gradient_step, optimizer_step, soft_update
+from pamdp.algos.offpolicy import OffPolicyLoop, clipped_step, gradient_step, soft_update, soft_updater
 from pamdp.algos.replay import ReplayBuffer
 from pamdp.algos.stacking import clip_per_member
 from pamdp.policies import ACTIVATIONS, mlp
@@ -412,11 +412,7 @@ class PASVG0(Algorithm):
                 "pi_c_target": Dense.of(self.policy_target.pi_c),
                 "critic_target": Dense.of(self.critic_target.net),
             }
-            targets, sources = (self.critic_target, self.policy_target), (self.critic, self.policy)
-            self._soft_pairs = (
-                [p for m in targets for p in m.parameters()],
-                [p for m in sources for p in m.parameters()],
-            )
+            self._soft_update = soft_updater(((self.critic_target, self.critic), (self.policy_target, self.policy)))
 
     def _modules(self):
         modules = {
@@ -507,7 +503,7 @@ class PASVG0(Algorithm):
             self.policy.mask,
             gradient_step(self.critic_optimizer, cfg.grad_clip),
             gradient_step(self.policy_optimizer, cfg.grad_clip),
-            lambda: torch._foreach_lerp_(*self._soft_pairs, cfg.tau),
+            lambda: self._soft_update(cfg.tau),
         )
         self.critic_updates += 1
         out = {k: float(v) for k, v in stats.items()}
@@ -672,13 +668,6 @@ class PASVG0(Algorithm):
             "critic_target": stack.dense("critic_target", "net"),
         }
 
-        def step(name):
-            def apply(grads):
-                clip_per_member(grads, cfg.grad_clip)
-                optimizer_step(stack.optimizers[name], grads)
-
-            return apply
-
         def soft():
             stack.soft_update("critic_target", "critic", cfg.tau)
             stack.soft_update("policy_target", "policy", cfg.tau)
@@ -692,18 +681,15 @@ class PASVG0(Algorithm):
             log_std,
             stack.params["policy_target"]["log_std"],
             mask,
-            step("critic"),
-            step("policy"),
+            stack.gradient_step("critic", cfg.grad_clip),
+            stack.gradient_step("policy", cfg.grad_clip),
             soft,
         )
-        columns = {k: v.tolist() for k, v in stats.items()}
+        seeds = len(b["obs"])
+        columns = {k: v.tolist() for k, v in stats.items()}  # then the solo update's last two columns
+        columns["train/entropy_coef"] = [cfg.entropy_coef] * seeds
         columns["train/param_std"] = log_std.detach().exp()[:, mask.bool()].mean(-1).tolist()
-        rows = []
-        for j in range(len(b["obs"])):
-            row = {k: v[j] for k, v in columns.items()}
-            row["train/entropy_coef"] = cfg.entropy_coef
-            row["train/param_std"] = row.pop("train/param_std")  # the solo update's column order
-            rows.append(row)
+        rows = [{k: v[j] for k, v in columns.items()} for j in range(seeds)]
         for m in stack.members_active():
             m.critic_updates += 1
         return rows
@@ -734,8 +720,7 @@ def _dense_update(cfg, b, nets, log_std, log_std_target, mask, critic_step, poli
     :meth:`HybridSampling.sample` and the critic (``tests/test_dense.py``): the straight-through one-hot carries
     the softmax's gradient, ``pi_c`` sees the action, and ``log_std`` gets its rows' share through ``exp`` and
     the clamp. ``policy_step`` receives them in the order of the policy's trainable parameters (``log_std``,
-    then ``pi_d``'s and ``pi_c``'s). Returns the
-    statistics per seed (scalars without stacking)."""
+    then ``pi_d``'s and ``pi_c``'s). Returns the statistics per seed (scalars without stacking)."""
     obs, next_obs = b["obs"], b["next_obs"]
     batch, d = obs.shape[-2], obs.shape[-1]
     K = mask.shape[0]

@@ -39,6 +39,7 @@ import torch
 from torch import nn
 
 from pamdp.algos.dense import Dense
+from pamdp.algos.offpolicy import optimizer_step
 
 __all__ = ["SeedStack", "can_stack", "ALIGNED_STEPS", "adam_step", "step_class", "clip_per_member"]
 
@@ -224,6 +225,16 @@ class SeedStack:
         stacked ``(S, in, out)`` weights, for updates that back-propagate by hand."""
         template = self.members[self.active[0]]._modules()[module].get_submodule(path)
         return Dense.of_stack(template, self.params[module], path)
+
+    def gradient_step(self, name: str, max_norm: float) -> Callable[[Sequence[torch.Tensor]], None]:
+        """:func:`~pamdp.algos.offpolicy.gradient_step` for the stacked optimizer ``name``: each member's slice
+        of the hand-computed gradients clipped on its own (:func:`clip_per_member`), then one fused step."""
+
+        def step(grads: Sequence[torch.Tensor]) -> None:
+            clip_per_member(grads, max_norm)
+            optimizer_step(self.optimizers[name], grads)
+
+        return step
 
     def members_active(self) -> list[Any]:
         """The members in the stack, in the order of its leading axis."""
