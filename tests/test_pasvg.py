@@ -372,3 +372,15 @@ def test_critic_loss_falls_on_a_fixed_batch():
 
 def test_top_level_import():
     assert pamdp.PASVG0 is PASVG0
+
+
+@pytest.mark.parametrize("flush", [True, False])
+def test_subnormals_are_flushed_during_learn_only_when_asked(flush):
+    """``flush_denormal``: inside learn() (its epoch callback) a subnormal float32 product is zero, after it the
+    IEEE subnormal comes back; with the setting off it survives inside too."""
+    tiny = torch.tensor(1e-39, dtype=torch.float32)  # below float32's smallest normal, 1.18e-38
+    seen = []
+    model = PASVG0("pamdp/Platform-v0", dataclasses.replace(SMALL, flush_denormal=flush))
+    model.learn(200, progress_bar=False, callback=lambda m, stats: seen.append(float(tiny * 1.5)))
+    assert seen == ([0.0] if flush else [pytest.approx(1.5e-39)])
+    assert float(tiny * 1.5) == pytest.approx(1.5e-39)

@@ -112,6 +112,12 @@ class AlgoConfig:
     torch_threads: int = setting(
         1, "Torch intra-op threads; 1 is fastest for these small networks on a laptop CPU.", at_least(1)
     )
+    flush_denormal: bool = setting(
+        True,
+        "Flush subnormal floats to zero in the CPU arithmetic of learn() (x86 FTZ/DAZ, torch.set_flush_denormal): "
+        "Adam's second moments decay into the subnormal range, where each operation on them is many times slower "
+        "(PASVG(0) trains 1.4x faster with it). learn() restores IEEE subnormals on return.",
+    )
     vector_mode: str = setting(
         "auto",
         "How env copies are stepped: batched, sync (scalar copies in turn) or auto (batched from 2 copies with Numba "
@@ -604,6 +610,7 @@ class Algorithm:
         if eval_every > 0 and self.env_id is None:  # before training, not after its first epoch
             raise ValueError("eval_every needs a registered env (an env id); this model's env has none")
         torch.set_num_threads(self.config.torch_threads)
+        flush = self.config.flush_denormal and torch.set_flush_denormal(True)  # False where the CPU cannot
         target = self.num_timesteps + int(total_timesteps)
         logger = Logger(run_dir, resume_step=self.num_timesteps) if run_dir is not None else None
         start_steps, start_time = self.num_timesteps, time.perf_counter()
@@ -644,6 +651,8 @@ class Algorithm:
                 if callback is not None and callback(self, stats) is False:
                     break
         finally:
+            if flush:
+                torch.set_flush_denormal(False)
             bar.close()
             if logger is not None:
                 logger.close()
