@@ -116,7 +116,7 @@ class AlgoConfig:
         True,
         "Flush subnormal floats to zero in the CPU arithmetic of learn() (x86 FTZ/DAZ, torch.set_flush_denormal): "
         "Adam's second moments decay into the subnormal range, where each operation on them is many times slower "
-        "(PASVG(0) trains 1.4x faster with it). learn() restores IEEE subnormals on return.",
+        "(PASVG(0) trains 1.7x faster with it, benchmarks/denormals.md). learn() restores IEEE subnormals on return.",
     )
     vector_mode: str = setting(
         "auto",
