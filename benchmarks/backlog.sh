@@ -16,8 +16,9 @@
 #   2. platform's PATRPO arm, paper preset, 5 x 1M: 4 to 10 min a run                ~0.5 core-hours
 #   3. PADDPG with Hausknecht & Stone's preset on Platform, 1 seed x 300k (issue 5): ~107 s of CPU an epoch
 #      beside other runs                                                           ~0.9 core-hours
-#   4. platform's PASVG(0) arm, paper preset, 5 x 1M, unstacked (stacking no longer pays for it): ~5 ms an
-#      update on an idle core                                                      ~7-9 core-hours
+#   4. platform's PASVG(0) arm, paper preset, 5 x 1M, unstacked (stacking no longer pays for it): ~4 ms an
+#      update on an idle core with subnormals flushed (denormals.md; ~7 ms before), 40-45 s of CPU an epoch
+#      with two runs side by side                                                  ~6 core-hours
 #   5. soccer's PADDPG arm (3 x 5M) and PATRPO seed 2: as far as the sessions allow (issue 7 asks for "as far
 #      as the machine allows"); PATRPO seeds 0 and 1 are recorded in docs/results.md
 # Steps 3 and 5 run in a side queue beside the main one (2, 1, 4, then the figure), step 5 at the lowest
