@@ -250,3 +250,20 @@ def test_a_stack_that_fails_as_a_whole_fails_each_of_its_runs(tmp_path, monkeypa
     specs = [dataclasses.replace(spec, seed=s) for s in range(2)]
     results = train_stack(specs, [tmp_path / "a", tmp_path / "b"], [print, print])
     assert all(isinstance(r, RuntimeError) and str(r) == "stack broke" for r in results)  # not reported as done
+
+
+def test_stacked_updates_flush_subnormals_as_the_members_learn_would(monkeypatch):
+    """The stacked update runs in the stack's own thread, outside the members' learn(); it flushes subnormals
+    (``flush_denormal``) all the same, and the thread gets IEEE subnormals back afterwards."""
+    subnormal = torch.tensor(1e-39, dtype=torch.float32)  # subnormal in float32
+    seen = []
+    stacked_update = PADDPG._stacked_update.__func__
+
+    def spy(cls, stack, batch):
+        seen.append(float(subnormal * 1.5))
+        return stacked_update(cls, stack, batch)
+
+    monkeypatch.setattr(PADDPG, "_stacked_update", classmethod(spy))
+    trained_together([tiny(0), tiny(1)], 300)
+    assert seen and set(seen) == {0.0}
+    assert float(subnormal * 1.5) == pytest.approx(1.5e-39)

@@ -12,6 +12,7 @@ data only; they are read back with ``torch.load(weights_only=True)``, so loading
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import dataclasses
 import importlib
@@ -215,6 +216,19 @@ AUTO_BATCH_MIN = 48
 # core: Platform 13 000 against 4 000 steps/s at 2 copies, 73 000 against 6 300 at 8; HFO 55 000 against
 # 21 000 at 2, 196 000 against 29 000 at 8); a single HFO copy is faster scalar (34 000 against 16 000).
 AUTO_BATCH_MIN_NUMBA = 2
+
+
+@contextlib.contextmanager
+def subnormals_flushed(enabled: bool = True):
+    """Flush subnormal floats to zero (x86 FTZ/DAZ, ``torch.set_flush_denormal``) in this thread's CPU arithmetic
+    inside the block, and restore IEEE subnormals after it. Yields whether flushing is on: ``False`` when not
+    ``enabled`` or where the CPU cannot flush."""
+    flush = enabled and torch.set_flush_denormal(True)
+    try:
+        yield flush
+    finally:
+        if flush:
+            torch.set_flush_denormal(False)
 
 
 def auto_batch_min() -> int:
@@ -610,7 +624,6 @@ class Algorithm:
         if eval_every > 0 and self.env_id is None:  # before training, not after its first epoch
             raise ValueError("eval_every needs a registered env (an env id); this model's env has none")
         torch.set_num_threads(self.config.torch_threads)
-        flush = self.config.flush_denormal and torch.set_flush_denormal(True)  # False where the CPU cannot
         target = self.num_timesteps + int(total_timesteps)
         logger = Logger(run_dir, resume_step=self.num_timesteps) if run_dir is not None else None
         start_steps, start_time = self.num_timesteps, time.perf_counter()
@@ -622,37 +635,36 @@ class Algorithm:
             dynamic_ncols=True,
         )
         try:
-            while self.num_timesteps < target:
-                t0, cpu0 = time.perf_counter(), time.process_time()
-                stats = self._run_epoch()
-                self.num_timesteps += int(stats.pop("steps"))
-                self.epoch += 1
-                elapsed = time.perf_counter() - t0
-                stats.update(
-                    {
-                        "time/epoch": float(self.epoch),
-                        "time/total_timesteps": float(self.num_timesteps),
-                        "time/epoch_seconds": elapsed,
-                        # CPU time of this process: unlike the wall clock, it stops while the run is suspended
-                        # (shared equally by the seeds stacked in this process, see pamdp.algos.stacking)
-                        "time/epoch_cpu_seconds": (time.process_time() - cpu0) / self._cpu_share(),
-                        "charts/SPS": (self.num_timesteps - start_steps) / (time.perf_counter() - start_time),
-                    }
-                )
-                if eval_every > 0 and self.epoch % eval_every == 0:
-                    stats.update(self._greedy_evaluation(eval_episodes))
-                if logger is not None:
-                    logger.record(stats, self.num_timesteps)
-                    if self.epoch % checkpoint_every == 0:
-                        self.save(Path(run_dir) / CHECKPOINT)
-                bar.update(self.num_timesteps - bar.n)
-                if "charts/episodic_return" in stats:
-                    bar.set_postfix(ret=f"{stats['charts/episodic_return']:.3f}", epoch=self.epoch)
-                if callback is not None and callback(self, stats) is False:
-                    break
+            with subnormals_flushed(self.config.flush_denormal):
+                while self.num_timesteps < target:
+                    t0, cpu0 = time.perf_counter(), time.process_time()
+                    stats = self._run_epoch()
+                    self.num_timesteps += int(stats.pop("steps"))
+                    self.epoch += 1
+                    elapsed = time.perf_counter() - t0
+                    stats.update(
+                        {
+                            "time/epoch": float(self.epoch),
+                            "time/total_timesteps": float(self.num_timesteps),
+                            "time/epoch_seconds": elapsed,
+                            # CPU time of this process: unlike the wall clock, it stops while the run is suspended
+                            # (shared equally by the seeds stacked in this process, see pamdp.algos.stacking)
+                            "time/epoch_cpu_seconds": (time.process_time() - cpu0) / self._cpu_share(),
+                            "charts/SPS": (self.num_timesteps - start_steps) / (time.perf_counter() - start_time),
+                        }
+                    )
+                    if eval_every > 0 and self.epoch % eval_every == 0:
+                        stats.update(self._greedy_evaluation(eval_episodes))
+                    if logger is not None:
+                        logger.record(stats, self.num_timesteps)
+                        if self.epoch % checkpoint_every == 0:
+                            self.save(Path(run_dir) / CHECKPOINT)
+                    bar.update(self.num_timesteps - bar.n)
+                    if "charts/episodic_return" in stats:
+                        bar.set_postfix(ret=f"{stats['charts/episodic_return']:.3f}", epoch=self.epoch)
+                    if callback is not None and callback(self, stats) is False:
+                        break
         finally:
-            if flush:
-                torch.set_flush_denormal(False)
             bar.close()
             if logger is not None:
                 logger.close()

@@ -38,6 +38,7 @@ from typing import Any
 import torch
 from torch import nn
 
+from pamdp.algos.base import subnormals_flushed
 from pamdp.algos.dense import Dense
 from pamdp.algos.offpolicy import optimizer_step
 
@@ -327,31 +328,33 @@ class SeedStack:
         self._running = len(threads)
         for t in threads:
             t.start()
-        while True:
-            with self._cond:
-                self._cond.wait_for(lambda: self._running == 0)
-                if self._leaving:
-                    for i in self._leaving:
-                        self.members[i].__dict__.pop("_update", None)
-                        self._detach(self.members[i])
-                        self.active.remove(i)
-                    self._build()
-                    self._left.update(self._leaving)
-                    self._leaving.clear()
-                if not self.active:
+        # the stacked updates run in this thread, not in the members' learn(): flush as they would
+        with subnormals_flushed(any(m.config.flush_denormal for m in self.members)):
+            while True:
+                with self._cond:
+                    self._cond.wait_for(lambda: self._running == 0)
+                    if self._leaving:
+                        for i in self._leaving:
+                            self.members[i].__dict__.pop("_update", None)
+                            self._detach(self.members[i])
+                            self.active.remove(i)
+                        self._build()
+                        self._left.update(self._leaving)
+                        self._leaving.clear()
+                    if not self.active:
+                        self._cond.notify_all()
+                        break
+                    if len(self._requests) == len(self.active):
+                        order = list(self.active)
+                        batches = [self._requests.pop(i) for i in order]
+                        try:
+                            stats = type(self.members[order[0]])._stacked_update(self, _stack(batches))
+                        except BaseException as exc:  # noqa: BLE001 - every waiting member raises it
+                            stats = [exc] * len(order)
+                        self.rounds += 1
+                        self._results.update(zip(order, stats))
+                        self._running = len(order)
                     self._cond.notify_all()
-                    break
-                if len(self._requests) == len(self.active):
-                    order = list(self.active)
-                    batches = [self._requests.pop(i) for i in order]
-                    try:
-                        stats = type(self.members[order[0]])._stacked_update(self, _stack(batches))
-                    except BaseException as exc:  # noqa: BLE001 - every waiting member raises it
-                        stats = [exc] * len(order)
-                    self.rounds += 1
-                    self._results.update(zip(order, stats))
-                    self._running = len(order)
-                self._cond.notify_all()
         for t in threads:
             t.join()
         return outcomes
