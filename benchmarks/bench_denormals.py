@@ -1,8 +1,8 @@
 """What flushing subnormal floats to zero (the ``flush_denormal`` setting, on by default) buys in training speed.
 
-For each algorithm's paper preset a model is trained for ``--warm`` samples with IEEE subnormals (the
-behaviour before the setting existed), so that its Adam moments and weights are those of such a run in
-progress, and saved. Then the same model, loaded
+For each algorithm's paper preset (or ``--presets``) on Platform (or ``--env``) a model is trained for
+``--warm`` samples with IEEE subnormals (the behaviour before the setting existed), so that its Adam moments
+and weights are those of such a run in progress, and saved. Then the same model, loaded
 afresh each time, trains ``--samples`` more with ``flush_denormal`` off and on, alternating, ``--repeats``
 times, in this one process pinned to one core. Medians are written as a markdown record with the command,
 date and machine. Stop other work on the machine while it runs: the two settings alternate so a steady load
@@ -42,16 +42,16 @@ def subnormal_share(model) -> float:
     return sub / total
 
 
-def time_case(name: str, epoch: int | None, warm: int, samples: int, repeats: int, folder: Path) -> dict:
+def time_case(name: str, preset: str, env: str, epoch: int | None, warm: int, samples: int, repeats: int, folder: Path):
     import pamdp
 
     cls = getattr(pamdp, name)
-    config = cls.config_class.preset("paper")
+    config = cls.config_class.preset(preset)
     if epoch is not None:
         config = dataclasses.replace(config, epoch_steps=epoch)
     samples = max(samples, getattr(config, "epoch_steps", None) or config.batch_size)  # whole epochs
     path = folder / f"{name}.pt"
-    model = cls("pamdp/Platform-v0", dataclasses.replace(config, flush_denormal=False)).learn(warm, progress_bar=False)
+    model = cls(env, dataclasses.replace(config, flush_denormal=False)).learn(warm, progress_bar=False)
     model.save(path, replay=True)
     share = subnormal_share(model)
     times = {False: [], True: []}
@@ -64,7 +64,15 @@ def time_case(name: str, epoch: int | None, warm: int, samples: int, repeats: in
             times[flush].append((time.perf_counter() - start) / samples * 1e3)
             print(f"{name} flush={flush}: {times[flush][-1]:.3f} ms/sample", flush=True)
     off, on = statistics.median(times[False]), statistics.median(times[True])
-    return {"algo": name, "samples": samples, "subnormal": share, "off": off, "on": on, "times": times}
+    return {
+        "algo": name,
+        "preset": preset,
+        "samples": samples,
+        "subnormal": share,
+        "off": off,
+        "on": on,
+        "times": times,
+    }
 
 
 def main() -> None:
@@ -73,16 +81,32 @@ def main() -> None:
     parser.add_argument("--samples", type=int, default=2_000, help="samples per timing (default: 2000)")
     parser.add_argument("--repeats", type=int, default=3, help="timings per setting (default: 3)")
     parser.add_argument("--algos", default="PASVG0,PADDPG,PATRPO", help="comma-separated (default: all three)")
+    parser.add_argument("--env", default="pamdp/Platform-v0", help="env id (default: pamdp/Platform-v0)")
+    parser.add_argument(
+        "--presets", default="", help="ALGO=PRESET,... instead of the paper presets, e.g. PADDPG=paper_hfo"
+    )
     parser.add_argument("--out", help="markdown record to write (default: print only)")
     args = parser.parse_args()
     os.sched_setaffinity(0, {sorted(os.sched_getaffinity(0))[0]})
     torch.set_num_threads(1)
     wanted = args.algos.split(",")
+    presets = dict(item.split("=", 1) for item in args.presets.split(",") if item)
     rows = []
     with tempfile.TemporaryDirectory() as folder:
         for name, epoch in CASES:
             if name in wanted:
-                rows.append(time_case(name, epoch, args.warm, args.samples, args.repeats, Path(folder)))
+                rows.append(
+                    time_case(
+                        name,
+                        presets.get(name, "paper"),
+                        args.env,
+                        epoch,
+                        args.warm,
+                        args.samples,
+                        args.repeats,
+                        Path(folder),
+                    )
+                )
     lines = [
         "# Flushing subnormal floats to zero: training speed",
         "",
@@ -90,18 +114,19 @@ def main() -> None:
         f"Date: {dt.datetime.now().strftime('%Y-%m-%d %H:%M')}  ",
         f"Machine: {machine()}",
         "",
-        f"Each paper preset on Platform, trained {args.warm:,} samples with IEEE subnormals first, then timed on one "
+        f"Each preset on `{args.env}`, trained {args.warm:,} samples with IEEE subnormals first, then timed on one "
         f"core over the samples below, medians of {args.repeats} alternating repeats. Subnormal share: of the weights "
         "and Adam's state "
         "after the warm-up.",
         "",
-        "| algorithm | samples timed | subnormal share | ms/sample, IEEE subnormals | ms/sample, flushed | speed-up |",
-        "|---|---|---|---|---|---|",
+        "| algorithm | preset | samples timed | subnormal share | ms/sample, IEEE subnormals | ms/sample, flushed "
+        "| speed-up |",
+        "|---|---|---|---|---|---|---|",
     ]
     for r in rows:
         lines.append(
-            f"| {r['algo']} | {r['samples']:,} | {r['subnormal']:.1%} | {r['off']:.3f} | {r['on']:.3f} | "
-            f"{r['off'] / r['on']:.2f}x |"
+            f"| {r['algo']} | {r['preset']} | {r['samples']:,} | {r['subnormal']:.1%} | {r['off']:.3f} | "
+            f"{r['on']:.3f} | {r['off'] / r['on']:.2f}x |"
         )
     text = "\n".join(lines) + "\n"
     print(text)

@@ -375,12 +375,26 @@ def test_top_level_import():
 
 
 @pytest.mark.parametrize("flush", [True, False])
-def test_subnormals_are_flushed_during_learn_only_when_asked(flush):
-    """``flush_denormal``: inside learn() (its epoch callback) a subnormal float32 product is zero, after it the
-    IEEE subnormal comes back; with the setting off it survives inside too."""
-    tiny = torch.tensor(1e-39, dtype=torch.float32)  # below float32's smallest normal, 1.18e-38
-    seen = []
+def test_updates_flush_subnormals_when_asked_and_env_steps_never(flush):
+    """``flush_denormal``: inside a gradient update a subnormal float32 product is zero; the env steps (whose
+    physics relies on IEEE subnormals, see hfo_features._directions) and the code after learn() see it intact.
+    With the setting off it survives everywhere."""
+    subnormal = torch.tensor(1e-39, dtype=torch.float32)  # below float32's smallest normal, 1.18e-38
+    in_updates, in_steps = set(), set()
     model = PASVG0("pamdp/Platform-v0", dataclasses.replace(SMALL, flush_denormal=flush))
-    model.learn(200, progress_bar=False, callback=lambda m, stats: seen.append(float(tiny * 1.5)))
-    assert seen == ([0.0] if flush else [pytest.approx(1.5e-39)])
-    assert float(tiny * 1.5) == pytest.approx(1.5e-39)
+    update, step = model._update, model.vec_env.step
+
+    def spy_update():
+        in_updates.add(float(subnormal * 1.5))
+        return update()
+
+    def spy_step(actions):
+        in_steps.add(float(subnormal * 1.5))
+        return step(actions)
+
+    model._update, model.vec_env.step = spy_update, spy_step
+    model.learn(400, progress_bar=False)
+    product = float(torch.tensor(1.5e-39, dtype=torch.float32))  # IEEE's, rounded to float32
+    assert in_updates == ({0.0} if flush else {product})
+    assert in_steps == {product}
+    assert float(subnormal * 1.5) == pytest.approx(1.5e-39)

@@ -115,9 +115,9 @@ class AlgoConfig:
     )
     flush_denormal: bool = setting(
         True,
-        "Flush subnormal floats to zero in the CPU arithmetic of learn() (x86 FTZ/DAZ, torch.set_flush_denormal): "
-        "Adam's second moments decay into the subnormal range, where each operation on them is many times slower "
-        "(PASVG(0) trains 1.7x faster with it, benchmarks/denormals.md). learn() restores IEEE subnormals on return.",
+        "Flush subnormal floats to zero (x86 FTZ/DAZ) in the CPU arithmetic of the gradient updates, never while "
+        "the env steps: Adam's decaying moments can reach the subnormal range, where each operation is many times "
+        "slower (PASVG(0) trains 1.7x faster with it, benchmarks/denormals.md).",
     )
     vector_mode: str = setting(
         "auto",
@@ -635,35 +635,34 @@ class Algorithm:
             dynamic_ncols=True,
         )
         try:
-            with subnormals_flushed(self.config.flush_denormal):
-                while self.num_timesteps < target:
-                    t0, cpu0 = time.perf_counter(), time.process_time()
-                    stats = self._run_epoch()
-                    self.num_timesteps += int(stats.pop("steps"))
-                    self.epoch += 1
-                    elapsed = time.perf_counter() - t0
-                    stats.update(
-                        {
-                            "time/epoch": float(self.epoch),
-                            "time/total_timesteps": float(self.num_timesteps),
-                            "time/epoch_seconds": elapsed,
-                            # CPU time of this process: unlike the wall clock, it stops while the run is suspended
-                            # (shared equally by the seeds stacked in this process, see pamdp.algos.stacking)
-                            "time/epoch_cpu_seconds": (time.process_time() - cpu0) / self._cpu_share(),
-                            "charts/SPS": (self.num_timesteps - start_steps) / (time.perf_counter() - start_time),
-                        }
-                    )
-                    if eval_every > 0 and self.epoch % eval_every == 0:
-                        stats.update(self._greedy_evaluation(eval_episodes))
-                    if logger is not None:
-                        logger.record(stats, self.num_timesteps)
-                        if self.epoch % checkpoint_every == 0:
-                            self.save(Path(run_dir) / CHECKPOINT)
-                    bar.update(self.num_timesteps - bar.n)
-                    if "charts/episodic_return" in stats:
-                        bar.set_postfix(ret=f"{stats['charts/episodic_return']:.3f}", epoch=self.epoch)
-                    if callback is not None and callback(self, stats) is False:
-                        break
+            while self.num_timesteps < target:
+                t0, cpu0 = time.perf_counter(), time.process_time()
+                stats = self._run_epoch()
+                self.num_timesteps += int(stats.pop("steps"))
+                self.epoch += 1
+                elapsed = time.perf_counter() - t0
+                stats.update(
+                    {
+                        "time/epoch": float(self.epoch),
+                        "time/total_timesteps": float(self.num_timesteps),
+                        "time/epoch_seconds": elapsed,
+                        # CPU time of this process: unlike the wall clock, it stops while the run is suspended
+                        # (shared equally by the seeds stacked in this process, see pamdp.algos.stacking)
+                        "time/epoch_cpu_seconds": (time.process_time() - cpu0) / self._cpu_share(),
+                        "charts/SPS": (self.num_timesteps - start_steps) / (time.perf_counter() - start_time),
+                    }
+                )
+                if eval_every > 0 and self.epoch % eval_every == 0:
+                    stats.update(self._greedy_evaluation(eval_episodes))
+                if logger is not None:
+                    logger.record(stats, self.num_timesteps)
+                    if self.epoch % checkpoint_every == 0:
+                        self.save(Path(run_dir) / CHECKPOINT)
+                bar.update(self.num_timesteps - bar.n)
+                if "charts/episodic_return" in stats:
+                    bar.set_postfix(ret=f"{stats['charts/episodic_return']:.3f}", epoch=self.epoch)
+                if callback is not None and callback(self, stats) is False:
+                    break
         finally:
             bar.close()
             if logger is not None:

@@ -416,6 +416,7 @@ class HyAR(Algorithm):
             cfg.warmup_steps,
             cfg.updates_per_step,
             self.np_rng,
+            self.config.flush_denormal,
         )
         stats["train/latent_box_width"] = float((self.actor.high - self.actor.low).mean())
         stats["train/epsilon"] = self.epsilon(self.num_timesteps + stats["steps"])

@@ -22,7 +22,7 @@ import numpy as np
 import torch
 from torch import nn
 
-from pamdp.algos.base import EpisodeTracker
+from pamdp.algos.base import EpisodeTracker, subnormals_flushed
 from pamdp.algos.replay import ReplayBuffer
 
 __all__ = [
@@ -231,8 +231,11 @@ class OffPolicyLoop:
         learning_starts: int,
         updates_per_step: float,
         np_rng: np.random.Generator,
+        flush_subnormals: bool = False,
     ) -> dict[str, float]:
-        """Collect at least ``n_samples`` valid transitions, updating as they arrive; returns the epoch's stats."""
+        """Collect at least ``n_samples`` valid transitions, updating as they arrive; returns the epoch's stats.
+
+        ``flush_subnormals``: the updates (not the env steps) flush subnormal floats to zero."""
         if self.obs is None:
             self._start(env, np_rng)
         counts = np.zeros(self.hybrid.n_actions, dtype=np.int64)
@@ -268,12 +271,13 @@ class OffPolicyLoop:
                 n_valid += n
                 if len(self.buffer) >= learning_starts:
                     self.update_credit += updates_per_step * n
-                    while self.update_credit >= 1.0:
-                        self.update_credit -= 1.0
-                        for k, v in update().items():
-                            sums[k] = sums.get(k, 0.0) + v
-                            reported[k] = reported.get(k, 0) + 1
-                        n_updates += 1
+                    with subnormals_flushed(flush_subnormals):
+                        while self.update_credit >= 1.0:
+                            self.update_credit -= 1.0
+                            for k, v in update().items():
+                                sums[k] = sums.get(k, 0.0) + v
+                                reported[k] = reported.get(k, 0) + 1
+                            n_updates += 1
             self.episode_start = ~valid
             self.prev_done = done
             self.obs = next_obs

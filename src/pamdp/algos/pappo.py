@@ -31,7 +31,18 @@ from typing import TYPE_CHECKING
 
 import torch
 
-from pamdp.algos.base import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
+from pamdp.algos.base import (
+    LAYERS,
+    NON_NEGATIVE,
+    POSITIVE,
+    AlgoConfig,
+    Check,
+    at_least,
+    interval,
+    one_of,
+    setting,
+    subnormals_flushed,
+)
 from pamdp.algos.patrpo import OnPolicyHybrid, Rollout
 from pamdp.distributions import HybridDistribution, kl_divergence
 from pamdp.policies import ACTIVATIONS, HybridPolicy, ValueNetwork
@@ -181,7 +192,8 @@ class PAPPO(OnPolicyHybrid):
 
     def _run_epoch(self) -> dict[str, float]:
         data, explained_var, tensors = self._sample_epoch()
-        stats = self._update(*tensors, torch.as_tensor(data["returns"], dtype=torch.float32))
+        with subnormals_flushed(self.config.flush_denormal):
+            stats = self._update(*tensors, torch.as_tensor(data["returns"], dtype=torch.float32))
         return self._epoch_stats(stats, data, explained_var)
 
     def _update(self, obs, a, x, adv, returns) -> dict[str, float]:

@@ -476,6 +476,7 @@ class PASVG0(Algorithm):
             cfg.learning_starts,
             cfg.updates_per_step,
             self.np_rng,
+            self.config.flush_denormal,
         )
 
     def _target_q(self, obs: torch.Tensor, a: torch.Tensor, x: torch.Tensor) -> torch.Tensor:

@@ -31,6 +31,7 @@ from pamdp.algos.base import (
     interval,
     one_of,
     setting,
+    subnormals_flushed,
 )
 from pamdp.algos.trpo import (
     FisherVectorProduct,
@@ -385,8 +386,9 @@ class PATRPO(OnPolicyHybrid):
     # -- one epoch -------------------------------------------------------------------------------
     def _run_epoch(self) -> dict[str, float]:
         data, explained_var, tensors = self._sample_epoch()
-        stats = self._update_policy(*tensors)
-        stats["losses/value_loss"] = self._fit_baseline(data["obs"], data["t"], data["returns"])
+        with subnormals_flushed(self.config.flush_denormal):
+            stats = self._update_policy(*tensors)
+            stats["losses/value_loss"] = self._fit_baseline(data["obs"], data["t"], data["returns"])
         return self._epoch_stats(stats, data, explained_var)
 
     def _fisher_vector_product(self, obs, a, x, old) -> Callable[[torch.Tensor], torch.Tensor]:

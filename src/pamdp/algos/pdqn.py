@@ -310,6 +310,7 @@ class PDQN(Algorithm):
             cfg.learning_starts,
             cfg.updates_per_step,
             self.np_rng,
+            self.config.flush_denormal,
         )
         stats["train/epsilon"] = self.epsilon(self.num_timesteps + stats["steps"])
         return stats
