@@ -1,6 +1,7 @@
 """The experiment runner end to end on tiny budgets: layout, aggregation, figures, resume, failures."""
 
 import csv
+import dataclasses
 import json
 import os
 import signal
@@ -177,6 +178,28 @@ def test_status_counts_cpu_time_where_an_epoch_logged_it(tmp_path):
     (out / "progress.csv").write_text("\n".join(rows) + "\n")
     status = run_status(spec, out)
     assert status.steps == 400 and status.train_seconds == pytest.approx(140.0)
+
+
+def test_status_paces_a_run_by_its_last_epochs(tmp_path):
+    """A run that sped up (new code, a freed core) is paced by its last RECENT_EPOCHS epochs, not its history."""
+    from pamdp.experiments.status import RECENT_EPOCHS, remaining_seconds, run_status
+
+    exp = load_experiment(write_experiment(tmp_path / "tiny.toml"))
+    spec = dataclasses.replace(exp.specs(None, 1.0, None)[0], total_steps=10_000)
+    out = tmp_path / "run"
+    out.mkdir()
+    slow, fast = 3, RECENT_EPOCHS  # epochs of 100 samples: 10 s each, then 1 s each
+    rows = ["time/total_timesteps,time/epoch_cpu_seconds"]
+    rows += [f"{100 * (i + 1)},10.0" for i in range(slow)]
+    rows += [f"{100 * (slow + i + 1)},1.0" for i in range(fast)]
+    (out / "progress.csv").write_text("\n".join(rows) + "\n")
+    status = run_status(spec, out)
+    assert status.steps == 800 and status.train_seconds == pytest.approx(35.0)
+    assert status.seconds_per_step == pytest.approx(0.01)  # the last epochs' pace, not 35 / 800
+    assert remaining_seconds([status])[0] == pytest.approx(9200 * 0.01)
+    # with fewer epochs than RECENT_EPOCHS, all of them count
+    (out / "progress.csv").write_text("\n".join(rows[:3]) + "\n")
+    assert run_status(spec, out).seconds_per_step == pytest.approx(0.1)
 
 
 def test_training_logs_the_cpu_time_of_each_epoch(tmp_path):

@@ -22,6 +22,7 @@ from pamdp.experiments.runner import RunSpec, is_finished
 __all__ = ["RunStatus", "run_status", "format_status", "remaining_seconds"]
 
 DONE, PARTIAL, NOT_STARTED = "done", "partial", "not started"
+RECENT_EPOCHS = 5  # a run's pace is taken over its last epochs: code, load and phases change it as a run goes
 
 
 @dataclasses.dataclass
@@ -39,9 +40,13 @@ class RunStatus:
     greedy_return: float | None  # the final greedy evaluation, once done
     goal_rate: float | None
     idle_seconds: float | None  # since progress.csv was last written; small while a run is training
+    recent_seconds_per_step: float | None = None  # over the last RECENT_EPOCHS epochs
 
     @property
     def seconds_per_step(self) -> float | None:
+        """The run's pace: training seconds a sample over its last epochs, else over all of them."""
+        if self.recent_seconds_per_step is not None:
+            return self.recent_seconds_per_step
         return self.train_seconds / self.steps if self.steps > 0 and self.train_seconds > 0 else None
 
 
@@ -65,7 +70,7 @@ def run_status(spec: RunSpec, out: str | Path, now: float | None = None) -> RunS
     from pamdp.algos.base import CHECKPOINT, FINAL_MODEL
 
     out = Path(out)
-    steps, seconds, last_return, idle = 0, 0.0, None, None
+    steps, seconds, last_return, idle, recent = 0, 0.0, None, None, None
     progress = out / "progress.csv"
     if progress.exists():
         with open(progress, newline="") as f:
@@ -74,6 +79,11 @@ def run_status(spec: RunSpec, out: str | Path, now: float | None = None) -> RunS
         if rows:
             steps = int(_float(rows[-1].get("time/total_timesteps")) or 0)
             last_return = _float(rows[-1].get("charts/episodic_return"))
+            last = rows[-RECENT_EPOCHS:]
+            before = rows[-RECENT_EPOCHS - 1] if len(rows) > RECENT_EPOCHS else {}
+            span = steps - int(_float(before.get("time/total_timesteps")) or 0)
+            spent = sum(epoch_seconds(row) for row in last)
+            recent = spent / span if span > 0 and spent > 0 else None
         idle = (time.time() if now is None else now) - progress.stat().st_mtime
     greedy = goal = None
     if is_finished(out, spec):
@@ -86,7 +96,18 @@ def run_status(spec: RunSpec, out: str | Path, now: float | None = None) -> RunS
     else:
         state = NOT_STARTED
     return RunStatus(
-        spec.label, spec.seed, str(out), state, steps, spec.total_steps, seconds, last_return, greedy, goal, idle
+        spec.label,
+        spec.seed,
+        str(out),
+        state,
+        steps,
+        spec.total_steps,
+        seconds,
+        last_return,
+        greedy,
+        goal,
+        idle,
+        recent,
     )
 
 
@@ -98,7 +119,8 @@ def remaining_seconds(statuses: list[RunStatus]) -> tuple[float, dict[str, int]]
     """Training time still to go over the unfinished runs that have a pace to go by, and per label (setting),
     how many unfinished runs have none.
 
-    A run's time per sample is its own if it has trained, else the median of its setting's (its label's) runs.
+    A run's time per sample is its own (over its last ``RECENT_EPOCHS`` epochs) if it has trained, else the
+    median of its setting's (its label's) runs.
     Another setting's pace is no guide (PATRPO's minutes say nothing of PASVG(0)'s hours), so a setting none of
     whose runs has trained is counted, not guessed.
     """
@@ -155,7 +177,7 @@ def format_status(name: str, statuses: list[RunStatus], workers: int = 1) -> str
         if left > 0:
             workers = max(1, workers)
             summary += (
-                f"; about {_minutes(left)} of training to go at the runs' own pace so far"
+                f"; about {_minutes(left)} of training to go at the runs' own recent pace"
                 f" (~{_minutes(left / workers)} with {workers} side by side)"
             )
         if unknown:
