@@ -75,6 +75,17 @@ def hand_notes(record: Path) -> str:
     return text[start:].strip() if start >= 0 else ""
 
 
+def write_record(lines: list[str], record: str | os.PathLike | None) -> str:
+    """Print the generated record ``lines`` and, given a ``record`` path, write them there followed by the
+    hand-written notes already in it (see :func:`hand_notes`). Returns the generated text."""
+    text = "\n".join(lines) + "\n"
+    print(text)
+    if record:
+        notes = hand_notes(Path(record))
+        Path(record).write_text(text + (f"\n{notes}\n" if notes else ""))
+    return text
+
+
 def run_and_record(
     experiment: str,
     out_root: str,

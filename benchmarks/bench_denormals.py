@@ -24,7 +24,7 @@ import time
 from pathlib import Path
 
 import torch
-from _record import hand_notes, machine
+from _record import machine, write_record
 
 # (algorithm, the epoch length for timing; None keeps the preset's)
 CASES = [("PASVG0", 1_000), ("PADDPG", 1_000), ("PATRPO", None)]
@@ -128,11 +128,7 @@ def main() -> None:
             f"| {r['algo']} | {r['preset']} | {r['samples']:,} | {r['subnormal']:.1%} | {r['off']:.3f} | "
             f"{r['on']:.3f} | {r['off'] / r['on']:.2f}x |"
         )
-    text = "\n".join(lines) + "\n"
-    print(text)
-    if args.out:
-        notes = hand_notes(Path(args.out))
-        Path(args.out).write_text(text + ("\n" + notes + "\n" if notes else ""))
+    write_record(lines, args.out)
 
 
 if __name__ == "__main__":

@@ -167,7 +167,7 @@ def main() -> None:
         print(f"{label}: {rate:.0f} member-updates/s", file=sys.stderr)
     base = next(rate for label, counts, _, rate in rows if counts == [1, 1])
     sys.path.insert(0, str(HERE))
-    from _record import hand_notes, machine
+    from _record import machine, write_record
 
     lines = [
         "# Seed batching: several seeds' networks stacked in one process (PADDPG-sized updates)",
@@ -190,11 +190,7 @@ def main() -> None:
             f"| {label} | {', '.join(map(str, counts))} | {', '.join(f'{m:.2f}' for m in ms)} | {rate:.0f} "
             f"| {rate / base:.2f}x |"
         )
-    text = "\n".join(lines) + "\n"
-    print(text)
-    if args.out:
-        notes = hand_notes(Path(args.out))  # a rerun keeps what was written about the last one
-        Path(args.out).write_text(text + (f"\n{notes}\n" if notes else ""))
+    write_record(lines, args.out)
 
 
 if __name__ == "__main__":

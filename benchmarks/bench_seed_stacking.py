@@ -103,7 +103,7 @@ def main() -> None:
                 per_process[algo, label].append([r["samples"] / r["cpu"] for r in results])
                 print(f"repeat {rep}: {algo}: {label}: {rates[algo, label][-1]:.0f} seed-samples/s", file=sys.stderr)
     sys.path.insert(0, str(HERE))
-    from _record import hand_notes, machine
+    from _record import machine, write_record
 
     command = (
         f"python benchmarks/bench_seed_stacking.py --samples {args.samples} --repeats {args.repeats} "
@@ -130,12 +130,7 @@ def main() -> None:
             each = ", ".join(f"{r:.0f}" for r in rates[algo, label])
             cpu = ", ".join(f"{statistics.median(col):.0f}" for col in zip(*per_process[algo, label]))
             lines.append(f"| {ALGOS[algo]} | {label} | {med:.0f} | {each} | {cpu} | {med / base:.2f}x |")
-    record = Path(args.out) if args.out else None
-    notes = hand_notes(record) if record else ""
-    text = "\n".join(lines) + "\n" + (f"\n{notes}\n" if notes else "")
-    if record:
-        record.write_text(text)
-    print(text)
+    write_record(lines, args.out)
 
 
 if __name__ == "__main__":
