@@ -13,7 +13,7 @@
 # per run with another run beside it:
 #   done: platform's PATRPO and PADDPG arms, PADDPG with Hausknecht & Stone's preset, step-size,
 #         kl-estimators (records and figures committed; docs/results.md has the commands)
-#   1. platform's PASVG(0) arm, paper preset, 5 x 1M, unstacked (stacking is slower for it, seed_stacking.md):
+#   1. platform's PASVG(0) arm, paper preset, 5 x 1M, unstacked (stacking gains ~1.06x, seed_stacking.md):
 #      40-45 s of CPU an epoch, ~1.2 h a run                                       ~6 core-hours
 #   2. the platform figure from all three arms                                     minutes
 #   3. soccer, as far as the sessions allow (issue 7 asks for "as far as the machine allows"): PATRPO seed 2

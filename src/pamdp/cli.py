@@ -192,7 +192,7 @@ def build_parser() -> argparse.ArgumentParser:
         type=_positive_int,
         default=1,
         help="train up to this many seeds of a setting in one process, their updates batched together "
-        "(PADDPG: 3 gives ~1.3x the seeds per hour on a 2-core CPU; PASVG(0) runs slower stacked there; "
+        "(PADDPG, PASVG(0): 3 gives 1.1x to 1.3x the seeds per hour on a 2-core CPU; "
         "default: %(default)s, each seed alone)",
     )
     rp.add_argument("--out", default="results", help="results root (default: %(default)s)")
