@@ -231,11 +231,11 @@ class OffPolicyLoop:
         learning_starts: int,
         updates_per_step: float,
         np_rng: np.random.Generator,
-        flush_subnormals: bool = False,
+        flush_denormal: bool = False,
     ) -> dict[str, float]:
         """Collect at least ``n_samples`` valid transitions, updating as they arrive; returns the epoch's stats.
 
-        ``flush_subnormals``: the updates (not the env steps) flush subnormal floats to zero."""
+        ``flush_denormal``: the updates (not the env steps) flush subnormal floats to zero."""
         if self.obs is None:
             self._start(env, np_rng)
         counts = np.zeros(self.hybrid.n_actions, dtype=np.int64)
@@ -271,7 +271,7 @@ class OffPolicyLoop:
                 n_valid += n
                 if len(self.buffer) >= learning_starts:
                     self.update_credit += updates_per_step * n
-                    with subnormals_flushed(flush_subnormals):
+                    with subnormals_flushed(flush_denormal):
                         while self.update_credit >= 1.0:
                             self.update_credit -= 1.0
                             for k, v in update().items():
