@@ -5,49 +5,24 @@ Field Offense simulation needs IEEE subnormals (``hfo_features._directions``).""
 import dataclasses
 
 import pytest
+import test_hyar
+import test_paddpg
+import test_pappo
+import test_pasvg
+import test_patrpo
+import test_pdqn
 import torch
 
 from pamdp import PADDPG, PAPPO, PASVG0, PATRPO, PDQN, HyAR
-from pamdp.algos.hyar import HyARConfig
-from pamdp.algos.paddpg import PADDPGConfig
-from pamdp.algos.pappo import PAPPOConfig
-from pamdp.algos.pasvg import PASVG0Config
-from pamdp.algos.patrpo import PATRPOConfig
-from pamdp.algos.pdqn import PDQNConfig
 
-OFF_POLICY = dict(num_envs=4, epoch_steps=200, learning_starts=100, batch_size=16, buffer_size=5_000)
-# (algorithm, a small config, the methods that make its gradient updates)
+# (algorithm, the small config of its own tests, the methods that make its gradient updates)
 CASES = {
-    "PASVG0": (PASVG0, PASVG0Config(hidden_sizes=(16, 16), **OFF_POLICY), ["_update"]),
-    "PADDPG": (PADDPG, PADDPGConfig(hidden_sizes=(16, 16), **OFF_POLICY), ["_update"]),
-    "PDQN": (PDQN, PDQNConfig(hidden_sizes=(16,), **OFF_POLICY), ["_update"]),
-    "HyAR": (
-        HyAR,
-        HyARConfig(
-            num_envs=4,
-            embed_dim=3,
-            latent_dim=2,
-            hidden_sizes=(16,),
-            vae_hidden_sizes=(16,),
-            epoch_steps=200,
-            warmup_steps=150,
-            warmup_updates=5,
-            vae_interval=50,
-            vae_updates=2,
-            batch_size=16,
-            vae_batch_size=16,
-            lsc_samples=100,
-            buffer_size=5_000,
-            updates_per_step=0.25,
-        ),  # fmt: skip
-        ["_update"],
-    ),
-    "PATRPO": (
-        PATRPO,
-        PATRPOConfig(hidden_sizes=(16,), batch_size=200, num_envs=4),
-        ["_update_policy", "_fit_baseline"],
-    ),
-    "PAPPO": (PAPPO, PAPPOConfig(hidden_sizes=(16,), batch_size=200, minibatch_size=100, num_envs=4), ["_update"]),
+    "PASVG0": (PASVG0, test_pasvg.SMALL, ["_update"]),
+    "PADDPG": (PADDPG, test_paddpg.SMALL, ["_update"]),
+    "PDQN": (PDQN, test_pdqn.SMALL, ["_update"]),
+    "HyAR": (HyAR, test_hyar.SMALL, ["_update"]),
+    "PATRPO": (PATRPO, test_patrpo.SMALL, ["_update_policy", "_fit_baseline"]),
+    "PAPPO": (PAPPO, test_pappo.SMALL, ["_update"]),
 }
 SUBNORMAL = torch.tensor(1e-39, dtype=torch.float32)  # below float32's smallest normal, 1.18e-38
 PRODUCT = float(torch.tensor(1.5e-39, dtype=torch.float32))  # SUBNORMAL * 1.5 in IEEE float32
