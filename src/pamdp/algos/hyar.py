@@ -62,7 +62,7 @@ from pamdp.algos.base import (
 )
 from pamdp.algos.offpolicy import OffPolicyLoop, clipped_step, linear_epsilon, soft_update
 from pamdp.algos.paddpg import backprop_actor
-from pamdp.algos.replay import ReplayBuffer
+from pamdp.algos.replay import ReplayBuffer, transition_fields
 from pamdp.policies import ACTIVATIONS, mlp
 from pamdp.spaces import HybridActionSpace
 
@@ -331,16 +331,11 @@ class HyAR(Algorithm):
         self.rep_optimizer = torch.optim.Adam(self.rep.parameters(), lr=cfg.vae_lr, fused=True)
         self.actor_optimizer = torch.optim.Adam(self.actor.net.parameters(), lr=cfg.actor_lr, fused=True)
         self.critic_optimizer = torch.optim.Adam(self.critic.parameters(), lr=cfg.critic_lr, fused=True)
-        d = self.obs_dim
-        fields = {
-            "obs": ((d,), np.float32),
-            "a": ((), np.int64),
-            "x": ((h.max_param_size,), np.float32),
-            "reward": ((), np.float32),
-            "next_obs": ((d,), np.float32),
-            "terminated": ((), np.bool_),
-            "latent": ((self.latent_size,), np.float32),  # the latent action that was decoded and executed
-        }
+        fields = transition_fields(
+            self.obs_dim,
+            h.max_param_size,
+            latent=((self.latent_size,), np.float32),  # the latent action that was decoded and executed
+        )
         self.replay = ReplayBuffer(cfg.buffer_size, fields)
         self.loop = OffPolicyLoop(h, self.replay, cfg.gamma)
         self.pretrained = False  # the warm-up round of representation training is done

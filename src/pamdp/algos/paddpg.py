@@ -46,7 +46,7 @@ from pamdp.algos.base import (
 )
 from pamdp.algos.dense import Dense
 from pamdp.algos.offpolicy import OffPolicyLoop, OUNoise, gradient_step, linear_epsilon, mixed_target, soft_updater
-from pamdp.algos.replay import ReplayBuffer
+from pamdp.algos.replay import ReplayBuffer, transition_fields
 from pamdp.policies import ACTIVATIONS, mlp
 from pamdp.spaces import HybridActionSpace
 
@@ -224,18 +224,12 @@ class PADDPG(Algorithm):
         # fused: one kernel per step instead of a dozen foreach passes, about 3x faster on a CPU.
         self.actor_optimizer = torch.optim.Adam(self.actor.parameters(), lr=cfg.actor_lr, betas=betas, fused=True)
         self.critic_optimizer = torch.optim.Adam(self.critic.parameters(), lr=cfg.critic_lr, betas=betas, fused=True)
-        d, m = self.obs_dim, h.max_param_size
-        fields = {
-            "obs": ((d,), np.float32),
-            "a": ((), np.int64),
-            "x": ((m,), np.float32),
-            "reward": ((), np.float32),
-            "next_obs": ((d,), np.float32),
-            "terminated": ((), np.bool_),
-            "out": ((self.out_size,), np.float32),  # the output vector the critic sees (after exploration)
-        }
-        if cfg.beta > 0:  # the loop fills it only when asked to compute Monte-Carlo returns
-            fields["mc"] = ((), np.float32)  # Monte-Carlo return-to-go, NaN until the episode ends
+        fields = transition_fields(
+            self.obs_dim,
+            h.max_param_size,
+            mc_returns=cfg.beta > 0,  # the loop fills them only when asked to compute Monte-Carlo returns
+            out=((self.out_size,), np.float32),  # the output vector the critic sees (after exploration)
+        )
         self.replay = ReplayBuffer(cfg.buffer_size, fields)
         self.loop = OffPolicyLoop(h, self.replay, cfg.gamma, mc_returns=cfg.beta > 0, tail_value=self._target_value)
         self._ou = OUNoise(cfg.ou_theta, cfg.ou_sigma)

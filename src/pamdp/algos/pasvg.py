@@ -50,7 +50,7 @@ from pamdp.algos.base import (
 )
 from pamdp.algos.dense import Dense
 from pamdp.algos.offpolicy import OffPolicyLoop, clipped_step, gradient_step, soft_update, soft_updater
-from pamdp.algos.replay import ReplayBuffer
+from pamdp.algos.replay import ReplayBuffer, transition_fields
 from pamdp.algos.stacking import clip_per_member
 from pamdp.policies import ACTIVATIONS, mlp
 from pamdp.spaces import HybridActionSpace
@@ -382,18 +382,14 @@ class PASVG0(Algorithm):
                 )
             self.entropy_weight = EntropyWeight(cfg.entropy_coef)
             self.entropy_optimizer = torch.optim.Adam(self.entropy_weight.parameters(), lr=cfg.entropy_lr)
-        K, m, d = h.n_actions, h.max_param_size, self.obs_dim
-        fields = {
-            "obs": ((d,), np.float32),
-            "a": ((), np.int64),
-            "x": ((m,), np.float32),
-            "reward": ((), np.float32),
-            "next_obs": ((d,), np.float32),
-            "terminated": ((), np.bool_),
-            "a_in": ((K,), np.float32),  # the critic's action input: one-hot, or the soft sample
-            "eta_a": ((K,), np.float32),
-            "eta_x": ((m,), np.float32),
-        }
+        K, m = h.n_actions, h.max_param_size
+        fields = transition_fields(
+            self.obs_dim,
+            m,
+            a_in=((K,), np.float32),  # the critic's action input: one-hot, or the soft sample
+            eta_a=((K,), np.float32),
+            eta_x=((m,), np.float32),
+        )
         self.replay = ReplayBuffer(cfg.buffer_size, fields)
         self.loop = OffPolicyLoop(h, self.replay, cfg.gamma)
         self._bind_networks()

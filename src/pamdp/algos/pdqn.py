@@ -51,7 +51,7 @@ from pamdp.algos.base import (
 )
 from pamdp.algos.offpolicy import OffPolicyLoop, OUNoise, clipped_step, linear_epsilon, mixed_target, soft_update
 from pamdp.algos.paddpg import BOUNDS, backprop_actor
-from pamdp.algos.replay import ReplayBuffer
+from pamdp.algos.replay import ReplayBuffer, transition_fields
 from pamdp.policies import ACTIVATIONS, mlp
 from pamdp.spaces import HybridActionSpace
 
@@ -232,18 +232,12 @@ class PDQN(Algorithm):
         self.actor_optimizer = torch.optim.Adam(self.actor.parameters(), lr=cfg.actor_lr, fused=True)
         self.q_optimizer = torch.optim.Adam(self.q_net.parameters(), lr=cfg.q_lr, fused=True)
         self.blocks = torch.as_tensor(param_blocks(h))
-        d = self.obs_dim
-        fields = {
-            "obs": ((d,), np.float32),
-            "a": ((), np.int64),
-            "x": ((h.max_param_size,), np.float32),
-            "reward": ((), np.float32),
-            "next_obs": ((d,), np.float32),
-            "terminated": ((), np.bool_),
-            "params": ((h.total_param_size,), np.float32),  # every action's, after exploration: what Q learns on
-        }
-        if cfg.beta > 0:
-            fields["mc"] = ((), np.float32)  # Monte-Carlo return-to-go, NaN until the episode ends
+        fields = transition_fields(
+            self.obs_dim,
+            h.max_param_size,
+            mc_returns=cfg.beta > 0,
+            params=((h.total_param_size,), np.float32),  # every action's, after exploration: what Q learns on
+        )
         self.replay = ReplayBuffer(cfg.buffer_size, fields)
         self.loop = OffPolicyLoop(h, self.replay, cfg.gamma, mc_returns=cfg.beta > 0, tail_value=self._target_value)
         self._ou = OUNoise(cfg.ou_theta, cfg.ou_sigma)

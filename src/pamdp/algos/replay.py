@@ -22,9 +22,30 @@ from collections.abc import Mapping
 import numpy as np
 import torch
 
-__all__ = ["ReplayBuffer"]
+__all__ = ["ReplayBuffer", "transition_fields"]
 
 FieldSpec = Mapping[str, tuple[tuple[int, ...], type | np.dtype]]
+
+
+def transition_fields(obs_dim: int, max_param_size: int, mc_returns: bool = False, **extra) -> dict:
+    """The fields every off-policy algorithm stores, ``obs, a, x, reward, next_obs, terminated``, then ``extra``.
+
+    ``x`` holds the chosen action's parameters, padded to ``max_param_size``. With ``mc_returns`` a field
+    ``"mc"`` holds the Monte-Carlo return-to-go, NaN until the episode ends (PADDPG's and P-DQN's mixed
+    targets, filled by :class:`pamdp.algos.offpolicy.OffPolicyLoop`).
+    """
+    fields = {
+        "obs": ((obs_dim,), np.float32),
+        "a": ((), np.int64),
+        "x": ((max_param_size,), np.float32),
+        "reward": ((), np.float32),
+        "next_obs": ((obs_dim,), np.float32),
+        "terminated": ((), np.bool_),
+        **extra,
+    }
+    if mc_returns:
+        fields["mc"] = ((), np.float32)
+    return fields
 
 
 class ReplayBuffer:
