@@ -78,18 +78,27 @@ def test_tiny_experiment_end_to_end(tmp_path, capsys):
     assert (out / "tiny" / "curves.png").stat().st_size < 1_000_000
     with open(out / "tiny" / "curves.csv", newline="") as f:
         agg = list(csv.DictReader(f))
-    assert {r["setting"] for r in agg} == {"small_delta"} and all(r["seeds"] == "2" for r in agg)
+    # Figures and tables name an arm by its label, not by its directory's file-name-safe form.
+    assert {r["setting"] for r in agg} == {"small delta"} and all(r["seeds"] == "2" for r in agg)
+    svg = (out / "tiny" / "curves.svg").read_text()
+    assert "small delta (2 seeds)" in svg and "small_delta" not in svg
     table = capsys.readouterr().out
-    assert "| small_delta | 2 |" in table
+    assert "| small delta | 2 |" in table
     # Each seed's greedy return is listed after the mean and std, in seed order.
     returns = [json.loads((out / "tiny" / "small_delta" / f"seed{s}" / "evaluation.json").read_text()) for s in (0, 1)]
     assert "evaluated: {:.3f}, {:.3f})".format(*(r["mean_return"] for r in returns)) in table
-    # A second call skips the finished runs.
+    # A second call skips the finished runs, and labels one recorded before run.json held labels.
+    run_json = out / "tiny" / "small_delta" / "seed0" / "run.json"
+    recorded = json.loads(run_json.read_text())
+    assert recorded.pop("label") == "small delta"
+    run_json.write_text(json.dumps(recorded))
     assert main(["reproduce", str(exp), "--out", str(out)]) == 0
     assert "already finished" in (out / "tiny" / "small_delta" / "seed0" / "stdout.log").read_text()
-    # `pamdp plot` redraws from the directories.
+    assert json.loads(run_json.read_text()) == {**recorded, "label": "small delta"}
+    assert not list(run_json.parent.glob(".run.json.*"))  # no temporary file left beside it
+    # `pamdp plot` redraws from the directories, under the same labels.
     assert main(["plot", str(out / "tiny"), "--out", str(tmp_path / "fig")]) == 0
-    assert (tmp_path / "fig" / "curves.svg").exists()
+    assert "small delta (2 seeds)" in (tmp_path / "fig" / "curves.svg").read_text()
 
 
 def test_a_failing_run_is_reported_and_the_others_finish(tmp_path, capsys):

@@ -25,7 +25,7 @@ import types
 import typing
 from collections.abc import Callable
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, ClassVar
+from typing import IO, TYPE_CHECKING, Any, ClassVar
 
 import gymnasium
 import numpy as np
@@ -409,17 +409,18 @@ def _umask() -> int:
     return mask
 
 
-def atomic_save(payload: dict, path: str | os.PathLike) -> None:
-    """``torch.save`` to a temporary file beside ``path``, fsync, then rename over it."""
+def _atomic_write(path: str | os.PathLike, write: Callable[[IO[bytes]], object], example: str) -> None:
+    """``write`` into a temporary file beside ``path``, fsync, then rename it over ``path``: a reader (or a run
+    killed mid-write) sees the old file or the new one, never a part."""
     path = Path(path)
     if path.is_dir():
-        raise ValueError(f"cannot save to {path}: it is a directory; expected a file path such as {path / 'model.pt'}")
+        raise ValueError(f"cannot save to {path}: it is a directory; expected a file path such as {path / example}")
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
-        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp's file is private (0600); the model gets what open() would give
+        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp's file is private (0600); the file gets what open() would give
         with os.fdopen(fd, "wb") as f:
-            torch.save(payload, f)
+            write(f)
             f.flush()
             os.fsync(f.fileno())
         os.replace(tmp, path)
@@ -427,6 +428,16 @@ def atomic_save(payload: dict, path: str | os.PathLike) -> None:
         if os.path.exists(tmp):
             os.remove(tmp)
         raise
+
+
+def atomic_save(payload: dict, path: str | os.PathLike) -> None:
+    """``torch.save`` to a temporary file beside ``path``, fsync, then rename over it."""
+    _atomic_write(path, lambda f: torch.save(payload, f), "model.pt")
+
+
+def atomic_write_text(path: str | os.PathLike, text: str) -> None:
+    """Write ``text`` (UTF-8) to ``path`` atomically, as :func:`atomic_save` does a checkpoint."""
+    _atomic_write(path, lambda f: f.write(text.encode()), "run.json")
 
 
 def _alone() -> float:

@@ -43,17 +43,28 @@ EXTRA_FIGURES = (
 
 
 def find_groups(roots: list[str | os.PathLike]) -> dict[str, list[Path]]:
-    """``{label: [run dirs]}`` for every directory below ``roots`` that holds a ``progress.csv``."""
+    """``{label: [run dirs]}`` for every directory below ``roots`` that holds a ``progress.csv``.
+
+    A run's label is the one its ``run.json`` records (an experiment's ``PASVG(0)``, whose directory is
+    ``PASVG_0_``), else the name of the directory holding its seeds (or its own name, for a run given alone).
+    """
     groups: dict[str, list[Path]] = {}
     for root in map(Path, roots):
         if not root.exists():
             raise FileNotFoundError(f"no such directory: {root}")
         runs = [root] if (root / "progress.csv").exists() else sorted(p.parent for p in root.rglob("progress.csv"))
         for run in runs:
-            groups.setdefault(run.parent.name if run != root else run.name, []).append(run)
+            groups.setdefault(_recorded_label(run) or (run.parent.name if run != root else run.name), []).append(run)
     if not groups:
         raise FileNotFoundError(f"no run directories (with progress.csv) under {', '.join(map(str, roots))}")
     return groups
+
+
+def _recorded_label(run: Path) -> str:
+    try:
+        return str(json.loads((run / "run.json").read_text()).get("label") or "")
+    except (OSError, ValueError, AttributeError):  # no run.json, or not a JSON object
+        return ""
 
 
 def _read_progress(run: Path, metric: str) -> tuple[np.ndarray, np.ndarray]:

@@ -109,7 +109,7 @@ def is_finished(out: str | Path, spec: RunSpec) -> bool:
 def _prepare(spec: RunSpec, out: str | os.PathLike, log=print) -> tuple[Any, dict | None]:
     """The model to train for ``spec`` in ``out`` (new or resumed) and ``None``, or ``None`` and the evaluation of
     a run already finished."""
-    from pamdp.algos.base import CHECKPOINT, FINAL_MODEL
+    from pamdp.algos.base import CHECKPOINT, FINAL_MODEL, atomic_write_text
 
     cls, preset, config = spec.config()
     out = Path(out)
@@ -121,6 +121,8 @@ def _prepare(spec: RunSpec, out: str | os.PathLike, log=print) -> tuple[Any, dic
         "total_steps": spec.total_steps,
         "config": config.to_dict(),
     }
+    if spec.label:  # what figures and tables call the run (its directory holds a file-name-safe form)
+        run_info["label"] = spec.label
     run_file, eval_file = out / "run.json", out / "evaluation.json"
     if (out / CHECKPOINT).exists() or (out / FINAL_MODEL).exists():
         recorded = json.loads(run_file.read_text()) if run_file.exists() else {}
@@ -135,13 +137,16 @@ def _prepare(spec: RunSpec, out: str | os.PathLike, log=print) -> tuple[Any, dic
             )
         if is_finished(out, spec):
             log(f"{out}: already finished")
+            if spec.label and recorded.get("label") != spec.label:  # a run recorded before run.json held labels
+                labelled = {**json.loads(run_file.read_text()), "label": spec.label}
+                atomic_write_text(run_file, json.dumps(labelled, indent=2))
             return None, json.loads(eval_file.read_text()) if eval_file.exists() else {}
         model = cls.load(out / CHECKPOINT if (out / CHECKPOINT).exists() else out / FINAL_MODEL)
         log(f"resuming {out} at step {model.num_timesteps:,} of {spec.total_steps:,}")
     else:
         out.mkdir(parents=True, exist_ok=True)
         model = cls(spec.env, config, env_kwargs=dict(spec.env_kwargs))
-    run_file.write_text(json.dumps({**run_info, "command": sys.argv}, indent=2))
+    atomic_write_text(run_file, json.dumps({**run_info, "command": sys.argv}, indent=2))
     return model, None
 
 
@@ -150,7 +155,7 @@ def _train(model, spec: RunSpec, out: str | os.PathLike, progress_bar: bool, log
 
     ``trained``: called once training is over, before saving and evaluating (a seed stack's ``leave``).
     """
-    from pamdp.algos.base import FINAL_MODEL
+    from pamdp.algos.base import FINAL_MODEL, atomic_write_text
     from pamdp.evaluation import evaluate
 
     out = Path(out)
@@ -168,7 +173,7 @@ def _train(model, spec: RunSpec, out: str | os.PathLike, progress_bar: bool, log
     if spec.eval_episodes <= 0:
         return {}
     result = evaluate(model, episodes=spec.eval_episodes, seed=10_000 + spec.seed)
-    (out / "evaluation.json").write_text(json.dumps(result, indent=2))
+    atomic_write_text(out / "evaluation.json", json.dumps(result, indent=2))
     return result
 
 
