@@ -1,4 +1,4 @@
-"""The docs stay true: the settings tables match the config dataclasses, and the Python examples run."""
+"""The docs stay true: the settings tables match the config dataclasses, the Python examples run, the links resolve."""
 
 import re
 import subprocess
@@ -40,3 +40,37 @@ def test_documented_python_examples_run(code, tmp_path, monkeypatch):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # an example that registers an env again
         exec(compile(code, "<doc example>", "exec"), {"__name__": "__doc_example__"})
+
+
+def _anchor(heading: str) -> str:
+    """GitHub's anchor for a markdown heading: lower case, punctuation dropped, spaces as hyphens."""
+    text = re.sub(r"`|\*\*|\[([^\]]*)\]\([^)]*\)", r"\1", heading.strip()).lower()
+    return re.sub(r"[^\w\- ]", "", text).replace(" ", "-")
+
+
+def _anchors(path: Path) -> set[str]:
+    text = re.sub(r"^```.*?^```", "", path.read_text(), flags=re.DOTALL | re.MULTILINE)  # no code-block "# ..."
+    found: set[str] = set()
+    for heading in re.findall(r"^#{1,6} (.+)$", text, flags=re.MULTILINE):
+        base, n = _anchor(heading), 0
+        while (anchor := base if n == 0 else f"{base}-{n}") in found:  # repeated headings get -1, -2, ...
+            n += 1
+        found.add(anchor)
+    return found
+
+
+def test_relative_links_and_their_anchors_resolve():
+    pages = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md")), *sorted((ROOT / "benchmarks").glob("*.md"))]
+    broken = []
+    for page in pages:
+        text = re.sub(r"^```.*?^```", "", page.read_text(), flags=re.DOTALL | re.MULTILINE)
+        for target in re.findall(r"\]\(([^)\s]+)\)", text):
+            if re.match(r"[a-z]+:", target):  # https:, mailto:
+                continue
+            file, _, anchor = target.partition("#")
+            dest = (page.parent / file).resolve() if file else page
+            if not dest.exists():
+                broken.append(f"{page.relative_to(ROOT)}: {target} (no such file)")
+            elif anchor and dest.suffix == ".md" and anchor not in _anchors(dest):
+                broken.append(f"{page.relative_to(ROOT)}: {target} (no such heading in {dest.name})")
+    assert not broken, "\n".join(broken)
