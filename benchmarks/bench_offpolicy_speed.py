@@ -191,8 +191,9 @@ def main(argv=None) -> int:
             lines.append("| " + " | ".join(map(str, cells)) + " |")
             print(lines[-1], flush=True)
     os.makedirs(os.path.dirname(args.out) or ".", exist_ok=True)
-    with open(args.out, "w") as f:
-        f.write("\n".join(lines) + "\n")
+    from _record import write_record  # here, not at the top: the workers may import an older pamdp
+
+    write_record(lines, args.out)  # keeps the record's hand-written notes
     print(f"wrote {args.out}")
     return 0
 
