@@ -134,6 +134,9 @@ def main(argv=None) -> int:
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--baseline", metavar="REF", help="git commit to compare with (same settings)")
     parser.add_argument("--out", default="benchmarks/offpolicy_speed.md")
+    parser.add_argument(
+        "--cases", default="", help="ALGO:LABEL,... to run only these rows (e.g. PADDPG:paper); default: all"
+    )
     parser.add_argument("--worker", nargs=2, metavar=("ALGO", "CONFIG"), help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.worker:
@@ -175,7 +178,16 @@ def main(argv=None) -> int:
     ]
     with tempfile.TemporaryDirectory() as tmp:
         sources = [None] + ([export_source(args.baseline, tmp)] if args.baseline else [])
+        wanted = {tuple(case.split(":", 1)) for case in args.cases.split(",") if case}
+        unknown = wanted - {(name, label) for name, _, _, label in CASES}
+        if unknown:
+            parser.error(
+                f"--cases {sorted(':'.join(c) for c in unknown)}: expected some of "
+                f"{[f'{name}:{label}' for name, _, _, label in CASES]}"
+            )
         for name, preset, overrides, label in CASES:
+            if wanted and (name, label) not in wanted:
+                continue
             cfg = dataclasses.replace(classes[name][1].preset(preset), **overrides)
             results = measure(name, cfg.to_dict(), args, sources)
             cells = [name, label, "-".join(map(str, cfg.hidden_sizes)), cfg.batch_size, cfg.num_envs]
