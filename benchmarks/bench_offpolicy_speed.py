@@ -141,6 +141,13 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     if args.worker:
         return worker(*args.worker, args.updates, args.samples)
+    wanted = {tuple(case.split(":", 1)) for case in args.cases.split(",") if case}
+    unknown = wanted - {(name, label) for name, _, _, label in CASES}
+    if unknown:
+        parser.error(
+            f"--cases {sorted(':'.join(c) for c in unknown)}: expected some of "
+            f"{[f'{name}:{label}' for name, _, _, label in CASES]}"
+        )
 
     import torch
 
@@ -178,13 +185,6 @@ def main(argv=None) -> int:
     ]
     with tempfile.TemporaryDirectory() as tmp:
         sources = [None] + ([export_source(args.baseline, tmp)] if args.baseline else [])
-        wanted = {tuple(case.split(":", 1)) for case in args.cases.split(",") if case}
-        unknown = wanted - {(name, label) for name, _, _, label in CASES}
-        if unknown:
-            parser.error(
-                f"--cases {sorted(':'.join(c) for c in unknown)}: expected some of "
-                f"{[f'{name}:{label}' for name, _, _, label in CASES]}"
-            )
         for name, preset, overrides, label in CASES:
             if wanted and (name, label) not in wanted:
                 continue

@@ -48,10 +48,14 @@ def _anchor(heading: str) -> str:
     return re.sub(r"[^\w\- ]", "", text).replace(" ", "-")
 
 
+def _prose(path: Path) -> str:
+    """A markdown page without its fenced code blocks (whose ``# comments`` are no headings, ``](x)`` no links)."""
+    return re.sub(r"^```.*?^```", "", path.read_text(), flags=re.DOTALL | re.MULTILINE)
+
+
 def _anchors(path: Path) -> set[str]:
-    text = re.sub(r"^```.*?^```", "", path.read_text(), flags=re.DOTALL | re.MULTILINE)  # no code-block "# ..."
     found: set[str] = set()
-    for heading in re.findall(r"^#{1,6} (.+)$", text, flags=re.MULTILINE):
+    for heading in re.findall(r"^#{1,6} (.+)$", _prose(path), flags=re.MULTILINE):
         base, n = _anchor(heading), 0
         while (anchor := base if n == 0 else f"{base}-{n}") in found:  # repeated headings get -1, -2, ...
             n += 1
@@ -63,8 +67,7 @@ def test_relative_links_and_their_anchors_resolve():
     pages = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md")), *sorted((ROOT / "benchmarks").glob("*.md"))]
     broken = []
     for page in pages:
-        text = re.sub(r"^```.*?^```", "", page.read_text(), flags=re.DOTALL | re.MULTILINE)
-        for target in re.findall(r"\]\(([^)\s]+)\)", text):
+        for target in re.findall(r"\]\(([^)\s]+)\)", _prose(page)):
             if re.match(r"[a-z]+:", target):  # https:, mailto:
                 continue
             file, _, anchor = target.partition("#")

@@ -125,7 +125,8 @@ def _prepare(spec: RunSpec, out: str | os.PathLike, log=print) -> tuple[Any, dic
         run_info["label"] = spec.label
     run_file, eval_file = out / "run.json", out / "evaluation.json"
     if (out / CHECKPOINT).exists() or (out / FINAL_MODEL).exists():
-        recorded = json.loads(run_file.read_text()) if run_file.exists() else {}
+        as_written = json.loads(run_file.read_text()) if run_file.exists() else {}
+        recorded = dict(as_written)  # compared below with the defaults of settings added since filled in
         if "config" in recorded:  # settings added since the run started count as their defaults
             recorded["config"] = cls.config_class.from_dict(recorded["config"]).to_dict()
         recorded.setdefault("env_kwargs", {})
@@ -138,8 +139,7 @@ def _prepare(spec: RunSpec, out: str | os.PathLike, log=print) -> tuple[Any, dic
         if is_finished(out, spec):
             log(f"{out}: already finished")
             if spec.label and recorded.get("label") != spec.label:  # a run recorded before run.json held labels
-                labelled = {**json.loads(run_file.read_text()), "label": spec.label}
-                atomic_write_text(run_file, json.dumps(labelled, indent=2))
+                atomic_write_text(run_file, json.dumps({**as_written, "label": spec.label}, indent=2))
             return None, json.loads(eval_file.read_text()) if eval_file.exists() else {}
         model = cls.load(out / CHECKPOINT if (out / CHECKPOINT).exists() else out / FINAL_MODEL)
         log(f"resuming {out} at step {model.num_timesteps:,} of {spec.total_steps:,}")
