@@ -1,0 +1,236 @@
+"""What pamdp's batched envs share: per-copy random streams and the Gymnasium ``VectorEnv`` shell.
+
+Every copy of a batched env draws only from its own generator, seeded as Gymnasium seeds the copies of its
+vector envs: ``reset(seed=s)`` gives copy i ``seed + i``, ``reset(seed=[s0, s1, ...])`` one seed each. A
+copy's trajectory therefore depends on its seed alone, not on how many copies run beside it, and copy i
+equals the scalar env reset with copy i's seed, step for step, noise included.
+
+Random numbers reach compiled code through :class:`RandomStreams`: each copy keeps a buffer of standard
+draws (``standard_normal`` or ``random``, one kind per domain) taken in blocks from its own generator, and
+a cursor. Drawing a block of ``k`` numbers gives the same numbers as ``k`` single draws, for NumPy's
+``Generator`` and ``RandomState`` alike, and a draw ``normal(0, s)`` is ``0.0 + s * z`` with ``z`` the
+next standard normal (``uniform(a, b)`` is ``a + (b - a) * u``), so a domain's step reads its numbers
+from the buffer in the order it needs them and consumes exactly its generator's stream. Before a step
+(or a reset that draws) Python tops up the buffers of the copies with fewer numbers left than one step can
+take; the compiled step never calls back.
+
+How a domain plugs in (``envs/platform/batched.py`` is a worked example):
+
+- The scalar env keeps ``RandomStreams(1, draw, capacity)`` and, before each step, calls
+  ``streams.follow(0, self.np_random)`` (which drops the buffer when ``np_random`` was replaced, e.g. by
+  ``numpy.random.RandomState(S)`` or by ``reset(seed=...)``), then ``streams.refill(need)``, and hands
+  ``streams.buffers[0]`` and ``streams.cursors[0]`` to the per-copy step; the step returns the new cursor.
+- The batched env subclasses :class:`BatchedVectorEnv`, sets the class attributes ``draw`` (the generator
+  method: ``"standard_normal"`` or ``"random"``), ``draws_per_step`` (the most numbers one copy can take
+  in one step, reset included) and ``buffer_size``, calls ``super().__init__(num_envs, single_env,
+  max_episode_steps, render_mode)`` and implements
+
+  * ``_reset_copies(mask, options) -> (observations, infos)``: put the copies where ``mask`` is true at
+    the start of an episode (``options`` as given to :meth:`~BatchedVectorEnv.reset`);
+  * ``_step_copies(actions, resetting) -> (observations, rewards, terminated, truncated, infos)``: check
+    the batch of ``actions``, reset the copies where ``resetting`` is true (next-step autoreset), step the
+    others with draws from ``self.streams.buffers`` / ``self.streams.cursors`` (advanced in place), and
+    return everything for every copy. The shell then zeroes the resetting copies' rewards and flags and
+    adds the time limit.
+
+The shell does the rest: argument checks, seeding, ``options={"reset_mask": mask}``, next-step autoreset
+(the step after an episode ends returns the copy's reset observation, reward 0, both flags false), the
+``max_episode_steps`` truncation, and ``np_randoms`` (the copies' generators; assigning a sequence of
+generators, or of stand-ins such as a Platform ``ZeroNoise``, replaces them and drops the buffers).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from gymnasium.utils import seeding
+from gymnasium.vector import AutoresetMode, VectorEnv
+from gymnasium.vector.utils import batch_space
+
+__all__ = ["RandomStreams", "BatchedVectorEnv", "copy_seeds"]
+
+DRAWS = ("standard_normal", "random")
+"""The generator methods a stream can draw with (both exist on ``Generator`` and ``RandomState``)."""
+
+
+def copy_seeds(seed, num_copies: int) -> list:
+    """The seed of each copy for ``reset(seed=seed)``: ``seed + i`` for an int, the list itself for a
+    list of ``num_copies`` ints (or None), ``num_copies`` Nones for None."""
+    if seed is None:
+        return [None] * num_copies
+    if isinstance(seed, (int, np.integer)) and not isinstance(seed, bool):
+        return [int(seed) + i for i in range(num_copies)]
+    if isinstance(seed, (list, tuple, np.ndarray)) and len(seed) == num_copies:
+        if all(s is None or (isinstance(s, (int, np.integer)) and not isinstance(s, bool)) for s in seed):
+            return [None if s is None else int(s) for s in seed]
+    raise ValueError(f"seed={seed!r}; expected None, an int, or a list of {num_copies} ints (or None), one per copy")
+
+
+class RandomStreams:
+    """Per-copy buffers of standard draws, each taken in blocks from its copy's own generator.
+
+    ``buffers`` is ``(num_copies, capacity)`` float64 and ``cursors`` ``(num_copies,)`` int64: copy i's
+    next number is ``buffers[i, cursors[i]]``. Code that consumes numbers advances ``cursors[i]``; it must
+    never read past ``capacity``, which :meth:`refill` ensures for up to ``need`` numbers.
+
+    Args:
+        num_copies: number of copies.
+        draw: the generator method that yields the numbers, ``"standard_normal"`` or ``"random"``.
+        capacity: numbers kept per copy; a copy is topped up when fewer than ``need`` are left, so a larger
+            capacity means fewer (but larger) draws.
+    """
+
+    def __init__(self, num_copies: int, draw: str, capacity: int):
+        if draw not in DRAWS:
+            raise ValueError(f"draw={draw!r}; expected one of {DRAWS}")
+        if not isinstance(capacity, (int, np.integer)) or capacity < 1:
+            raise ValueError(f"capacity={capacity!r}; expected a positive integer")
+        self.draw = draw
+        self.capacity = int(capacity)
+        self.buffers = np.zeros((num_copies, self.capacity))
+        self.cursors = np.full(num_copies, self.capacity, dtype=np.int64)  # empty
+        self._generators: list = [None] * num_copies
+
+    @property
+    def generators(self) -> tuple:
+        """Each copy's generator (None until it is seeded or first drawn from)."""
+        return tuple(self._generators)
+
+    def set(self, i: int, rng) -> None:
+        """Make ``rng`` copy ``i``'s generator and drop the numbers drawn from the previous one."""
+        if not callable(getattr(rng, self.draw, None)):
+            raise ValueError(f"{rng!r} has no {self.draw}() method; expected a numpy Generator or RandomState")
+        self._generators[i] = rng
+        self.cursors[i] = self.capacity
+
+    def follow(self, i: int, rng) -> None:
+        """:meth:`set` copy ``i``'s generator to ``rng`` unless it is that object already (the scalar envs'
+        ``np_random`` may be replaced at any time; the next step must then draw from the new one)."""
+        if rng is not self._generators[i]:
+            self.set(i, rng)
+
+    def seed(self, seed) -> None:
+        """Seed every copy as :func:`copy_seeds` says; a copy whose seed is None keeps its generator (or
+        gets one from fresh entropy if it has none), as a Gymnasium env does on ``reset(seed=None)``."""
+        for i, s in enumerate(copy_seeds(seed, len(self._generators))):
+            if s is not None or self._generators[i] is None:
+                self.set(i, seeding.np_random(s)[0])
+
+    def refill(self, need: int) -> None:
+        """Top up every copy that has fewer than ``need`` numbers left: the rest moves to the front and the
+        buffer is filled from the copy's generator, in the generator's order."""
+        if need > self.capacity:
+            raise ValueError(f"need={need} numbers exceed the capacity {self.capacity}")
+        for i in np.flatnonzero(self.cursors > self.capacity - need):
+            if self._generators[i] is None:
+                self.set(i, seeding.np_random(None)[0])
+            left = self.capacity - int(self.cursors[i])
+            row = self.buffers[i]
+            row[:left] = row[self.capacity - left :]
+            row[left:] = getattr(self._generators[i], self.draw)(self.capacity - left)
+            self.cursors[i] = 0
+
+
+class BatchedVectorEnv(VectorEnv):
+    """The Gymnasium ``VectorEnv`` shell of pamdp's batched envs (see the module docstring for the hooks).
+
+    Args:
+        num_envs: number of copies N.
+        single_env: a scalar env of the domain; its spaces and render modes are taken over.
+        max_episode_steps: episodes are truncated after this many agent steps (``make_vec`` passes the
+            registration's value in). ``None`` leaves truncation to the domain.
+        render_mode: ``None`` or one of the scalar env's render modes; :meth:`render` returns one frame per
+            copy.
+    """
+
+    metadata = {"render_modes": ["rgb_array"], "autoreset_mode": AutoresetMode.NEXT_STEP}
+    draw: str = "standard_normal"
+    """The generator method the domain's numbers come from (see :class:`RandomStreams`)."""
+    draws_per_step: int = 0
+    """The most numbers one copy can take in one step or reset."""
+    buffer_size: int = 1
+    """Numbers kept per copy (at least :attr:`draws_per_step`)."""
+
+    def __init__(self, num_envs: int, single_env, max_episode_steps: int | None = None, render_mode=None):
+        if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) or num_envs < 1:
+            raise ValueError(f"num_envs must be a positive integer, got {num_envs!r}")
+        if max_episode_steps is not None and (
+            isinstance(max_episode_steps, bool)
+            or not isinstance(max_episode_steps, (int, np.integer))
+            or max_episode_steps < 1
+        ):
+            raise ValueError(f"max_episode_steps must be a positive integer or None, got {max_episode_steps!r}")
+        modes = single_env.metadata["render_modes"]
+        if render_mode is not None and render_mode not in modes:
+            raise ValueError(f"render_mode={render_mode!r} is not supported; expected one of {[None, *modes]}")
+        self.metadata = {**self.metadata, "render_fps": single_env.metadata["render_fps"]}
+        self.num_envs = int(num_envs)
+        self.max_episode_steps = max_episode_steps
+        self.render_mode = render_mode
+        self.single_action_space = single_env.action_space
+        self.single_observation_space = single_env.observation_space
+        self.action_space = batch_space(self.single_action_space, self.num_envs)
+        self.observation_space = batch_space(self.single_observation_space, self.num_envs)
+        self.streams = RandomStreams(self.num_envs, self.draw, self.buffer_size)
+        self._elapsed = np.zeros(self.num_envs, dtype=np.int64)
+        self._autoreset = np.zeros(self.num_envs, dtype=bool)
+
+    # -- the copies' generators -------------------------------------------------------------------
+    @property
+    def np_randoms(self) -> tuple:
+        """Each copy's generator; assign a sequence of ``num_envs`` of them to replace them all."""
+        return self.streams.generators
+
+    @np_randoms.setter
+    def np_randoms(self, generators: Sequence) -> None:
+        if len(generators) != self.num_envs:
+            raise ValueError(f"{len(generators)} generators given; expected one per copy ({self.num_envs})")
+        for i, rng in enumerate(generators):
+            self.streams.set(i, rng)
+
+    @property
+    def np_random(self):
+        raise AttributeError("each copy has its own generator: read or assign np_randoms (one per copy)")
+
+    @np_random.setter
+    def np_random(self, value):
+        raise AttributeError("each copy has its own generator: assign np_randoms (one per copy) instead")
+
+    # -- Gymnasium API ----------------------------------------------------------------------------
+    def reset(self, *, seed=None, options: dict | None = None):
+        """Reset all copies, or with ``options={"reset_mask": mask}`` only those where ``mask`` is true.
+
+        ``seed``: None, an int (copy i gets ``seed + i``) or a list with one seed (or None) per copy.
+        """
+        self.streams.seed(seed)
+        mask = np.ones(self.num_envs, dtype=bool)
+        if options is not None and "reset_mask" in options:
+            mask = np.asarray(options["reset_mask"])
+            if mask.shape != (self.num_envs,) or mask.dtype != np.bool_:
+                raise ValueError(f"reset_mask must be a bool array of shape ({self.num_envs},), got {mask!r}")
+        self.streams.refill(self.draws_per_step)
+        obs, infos = self._reset_copies(mask, options)
+        self._elapsed[mask] = 0
+        self._autoreset[mask] = False
+        return obs, infos
+
+    def step(self, actions):
+        resetting = self._autoreset
+        self.streams.refill(self.draws_per_step)
+        obs, rewards, terminated, truncated, infos = self._step_copies(actions, resetting)
+        rewards[resetting] = 0.0
+        terminated[resetting] = truncated[resetting] = False
+        self._elapsed[resetting] = 0
+        self._elapsed[~resetting] += 1
+        if self.max_episode_steps is not None:
+            truncated |= self._elapsed >= self.max_episode_steps
+        self._autoreset = terminated | truncated
+        return obs, rewards, terminated, truncated, infos
+
+    # -- the domain's part ------------------------------------------------------------------------
+    def _reset_copies(self, mask: np.ndarray, options: dict | None):
+        raise NotImplementedError
+
+    def _step_copies(self, actions, resetting: np.ndarray):
+        raise NotImplementedError
