@@ -1,6 +1,6 @@
 """What the batched envs' Numba backends share: the choice of backend, and the kernels' on-disk cache following
 the modules whose constants they compile in (``numba_cache.py``). Each backend's numbers against its NumPy
-reference: ``test_hfo_kernel.py``, ``test_platform_kernel.py``."""
+reference: ``test_hfo_kernel.py``. (Platform has one backend, compiled: ``test_platform_vector.py``.)"""
 
 import builtins
 
@@ -9,12 +9,9 @@ import pytest
 
 import pamdp  # noqa: F401  (registers the envs)
 from pamdp.envs.hfo_vector import HalfFieldOffenseVectorEnv
-from pamdp.envs.platform_vector import PlatformVectorEnv
 
 
-@pytest.mark.parametrize(
-    "env_id, cls", [("pamdp/Platform-v0", PlatformVectorEnv), ("pamdp/HalfFieldOffense-v0", HalfFieldOffenseVectorEnv)]
-)
+@pytest.mark.parametrize("env_id, cls", [("pamdp/HalfFieldOffense-v0", HalfFieldOffenseVectorEnv)])
 def test_backend_choice_and_errors(monkeypatch, env_id, cls):
     assert cls(backend="numpy").backend == "numpy"
     venv = gymnasium.make_vec(env_id, num_envs=2, vectorization_mode="vector_entry_point", backend="numpy")
@@ -42,11 +39,6 @@ def test_backend_choice_and_errors(monkeypatch, env_id, cls):
             ["hfo_kernel._dash-145.py311.nbi", "hfo_kernel._dash-145.py311.1.nbc"],
             "hfo_vector.cpython-311.pyc",
         ),
-        (
-            "platform_kernel",
-            ["platform_kernel.run_substeps-170.py311.nbi", "platform_kernel._clip-1.py311.1.nbc"],
-            "platform_vector.cpython-311.pyc",
-        ),
     ],
 )
 def test_cached_kernels_are_dropped_when_a_module_they_compile_in_changes(tmp_path, module, cached, other):
@@ -68,7 +60,7 @@ def test_cached_kernels_are_dropped_when_a_module_they_compile_in_changes(tmp_pa
 
 
 @pytest.mark.parametrize("backend", ["numpy", "numba"])
-@pytest.mark.parametrize("env_id", ["pamdp/Platform-v0", "pamdp/HalfFieldOffense-v0"])
+@pytest.mark.parametrize("env_id", ["pamdp/HalfFieldOffense-v0"])
 def test_a_copied_batched_env_goes_on_as_the_original(env_id, backend):
     # A copy keeps the kernel (by module name) and the views of its state (HFO's rows of one matrix): it steps
     # on exactly as the original does.

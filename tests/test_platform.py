@@ -103,47 +103,46 @@ def test_scripted_policy_with_noise():
     assert np.mean(reached) >= 0.95 and np.mean(returns) >= 0.98
 
 
+# Recorded by running the PyPI port `hybrid-platform` 0.1.0 (gym_platform) on SCRIPT with
+# numpy.random.RandomState(0) as its noise source (see benchmarks/bench_platform.py, which checks
+# hundreds of episodes this way).
+REFERENCE_REWARDS = [
+    0.10369823135828755, 0.06520048209455667, 0.060728133146570884, 0.24869703498910578,
+    0.1020033474387939, 0.04449980051703331, 0.06763285024154589, 0.25223716703702515,
+    0.044497615299362164, 0.010805337877718667,
+]  # fmt: skip
+
+
 def test_replays_the_reference_under_random_state():
-    # Recorded by running the PyPI port `hybrid-platform` 0.1.0 (gym_platform) on SCRIPT with
-    # numpy.random.RandomState(0) as its noise source (see benchmarks/bench_platform.py, which checks
-    # hundreds of episodes this way).
-    rewards = [
-        0.10369823135828755, 0.06520048209455667, 0.060728133146570884, 0.24869703498910578,
-        0.1020033474387939, 0.04449980051703331, 0.06763285024154589, 0.25223716703702515,
-        0.044497615299362164, 0.010805337877718667,
-    ]  # fmt: skip
     substeps = [143, 20, 20, 140, 135, 20, 20, 144, 20, 4]
     last_obs = [1.0, 0.6930000185966492, 0.6750048995018005, 0.002003471367061138]
     env = PlatformEnv()
     env.reset()
     env.np_random = np.random.RandomState(0)
     results = play(env, SCRIPT)
-    assert [r[1] for r in results] == rewards
+    assert [r[1] for r in results] == REFERENCE_REWARDS
     assert [r[4]["substeps"] for r in results] == substeps
     assert results[-1][0][:4].astype(np.float32).tolist() == last_obs
 
 
-class RecordingNoise:
-    """Records every ``normal`` call and returns zeros."""
-
-    def __init__(self):
-        self.calls = []
-
-    def normal(self, loc=0.0, scale=1.0, size=None):
-        self.calls.append((loc, scale, size))
-        return ZeroNoise().normal(loc, scale, size)
-
-
-def test_draw_order():
+def test_a_replaced_generator_drops_the_numbers_drawn_ahead():
+    # The env draws its normals in blocks; after steps with another generator, assigning RandomState(0)
+    # must still replay the reference from RandomState(0)'s first number on.
     env = PlatformEnv()
+    env.reset(seed=1)
+    play(env, [(0, 30), (1, 300)])
     env.reset()
-    env.np_random = rec = RecordingNoise()
-    env.step(act(0, 30))
-    assert rec.calls == [(0.0, 0.025, None)] * 40  # per sub-step: player ACCEL, then the enemy
-    rec.calls.clear()
-    _, _, _, _, info = env.step(act(1, 300))
-    # Take-off: the jump's two draws first, then player and enemy as in every sub-step.
-    assert rec.calls == [(0.0, 1.0, 2)] + [(0.0, 0.025, None)] * (2 * info["substeps"])
+    env.np_random = np.random.RandomState(0)
+    assert [r[1] for r in play(env, SCRIPT)] == REFERENCE_REWARDS
+
+
+def test_reseeding_restarts_the_stream():
+    env = PlatformEnv()
+    runs = []
+    for _ in range(2):
+        env.reset(seed=7)
+        runs.append([(r[1], r[4]["substeps"]) for r in play(env, [(0, 20), (1, 500), (2, 300), (0, 10)])])
+    assert runs[0] == runs[1]
 
 
 def test_random_policy_statistics():
@@ -227,10 +226,39 @@ def test_render_shows_the_player_moving():
     assert player_column(env.render()) > player_column(before) + 20  # ~67 px at scale 0.6
 
 
+def test_render_substeps_draws_every_substep():
+    env = PlatformEnv(render_mode="rgb_array")
+    env.reset(seed=0)
+    assert env.render_substeps() == []
+    env.np_random = ZeroNoise()
+    _, _, _, _, info = env.step(act(1, 720))  # a hop from rest: 144 sub-steps, up and down again
+    frames = env.render_substeps()
+    assert len(frames) == info["substeps"] == 144
+    np.testing.assert_array_equal(frames[-1], env.render())
+    # The player's box rises and falls: its top row (in image rows, y down) is highest mid-flight.
+    tops = [np.nonzero((f[..., 2] > 200) & (f[..., 0] < 80))[0].min() for f in frames]
+    assert abs(int(np.argmin(tops)) - 72) <= 3
+    assert tops[0] > min(tops) + 30 and tops[-1] > min(tops) + 30  # peak ~63 px above: ~38 px at scale 0.6
+
+
 def test_episode_gif(tmp_path):
     from PIL import Image
 
     path, total = save_platform_gif(tmp_path / "platform.gif", seed=0)
+    env = PlatformEnv()  # the same episode again, to count its sub-steps
+    env.reset(seed=0)
+    space = gymnasium.make("pamdp/Platform-v0").action_space
+    space.seed(0)
+    substeps, done = 0, False
+    while not done:
+        _, _, terminated, truncated, info = env.step(space.sample())
+        substeps += info["substeps"]
+        done = terminated or truncated
     with Image.open(path) as gif:
-        assert gif.n_frames >= 2 and gif.size == (633, 120)
+        assert gif.size == (633, 120)
+        durations = []  # Pillow merges repeated frames into one of longer duration
+        for k in range(gif.n_frames):
+            gif.seek(k)
+            durations.append(gif.info["duration"])
+    assert sum(durations) == (1 + substeps) * 50  # one 50 ms frame per sub-step (dt = 0.05 s), and the start
     assert 0.0 <= total <= 1.0 + 1e-9

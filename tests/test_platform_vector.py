@@ -1,4 +1,7 @@
-"""The batched Platform env: equal to the scalar env step for step without noise, same statistics with."""
+"""The batched Platform env: copy i is the scalar env seeded with copy i's seed, step for step, noise on."""
+
+import copy
+import pickle
 
 import gymnasium
 import numpy as np
@@ -8,13 +11,6 @@ from gymnasium.vector import AutoresetMode, SyncVectorEnv
 import pamdp  # noqa: F401  (registers pamdp/Platform-v0)
 from pamdp.envs.platform import PlatformEnv, PlatformVectorEnv, ZeroNoise
 from pamdp.spaces import HybridActionSpace
-
-try:
-    import numba  # noqa: F401
-
-    HAVE_NUMBA = True
-except ImportError:
-    HAVE_NUMBA = False
 
 SCRIPT = [(1, 480), (0, 30), (0, 0), (1, 720), (1, 480), (0, 5), (0, 5), (1, 720), (0, 5), (0, 30)]
 
@@ -41,47 +37,75 @@ def test_make_vec_returns_the_batched_env():
     np.testing.assert_array_equal(info["substeps"], 0)
 
 
-BACKENDS = ["numpy", pytest.param("numba", marks=pytest.mark.skipif(not HAVE_NUMBA, reason="needs numba"))]
-
-
-@pytest.mark.parametrize("backend", BACKENDS)
-def test_equals_scalar_envs_without_noise(backend):
-    """Random actions in odd copies; the scripted policy then standing still (to reach the time limit) in
-    even ones. Compared with Gymnasium's SyncVectorEnv over scalar envs, so autoreset is compared too."""
-    n = 12
-    venv = gymnasium.make_vec("pamdp/Platform-v0", num_envs=n, vectorization_mode="vector_entry_point", backend=backend)
-    assert venv.backend == backend
-    ref = SyncVectorEnv([lambda: gymnasium.make("pamdp/Platform-v0") for _ in range(n)])
-    venv.reset(seed=0)
-    ref.reset(seed=0)
-    venv.np_random = ZeroNoise()
-    for env in ref.envs:
-        env.unwrapped.np_random = ZeroNoise()
+def assert_equals_scalar_envs(n, seed, steps, noise=True, max_episode_steps=200):
+    """Step the batched env and Gymnasium's SyncVectorEnv over ``n`` scalar envs (which seeds env i with
+    ``seed + i`` and auto-resets in next-step mode too) with the same actions: random ones in odd copies,
+    the scripted policy then standing still (to reach the time limit) in even ones. Every output and the
+    state must be equal after every step. Returns the numbers of terminations and truncations."""
+    venv = gymnasium.make_vec(
+        "pamdp/Platform-v0", num_envs=n, vectorization_mode="vector_entry_point", max_episode_steps=max_episode_steps
+    )
+    ref = SyncVectorEnv(
+        [lambda: gymnasium.make("pamdp/Platform-v0", max_episode_steps=max_episode_steps) for _ in range(n)]
+    )
+    venv.reset(seed=seed)
+    ref.reset(seed=seed)
+    if not noise:
+        venv.np_randoms = [ZeroNoise()] * n
+        for env in ref.envs:
+            env.unwrapped.np_random = ZeroNoise()
     venv.action_space.seed(1)
     scripted = SCRIPT[:8] + [(0, 0.0)] * 300
     odd = np.arange(n) % 2 == 1
-    saw = {"terminated": False, "truncated": False}
-    for t in range(205):
+    ended = np.zeros(2, dtype=np.int64)
+    for t in range(steps):
         a, params = venv.action_space.sample()
-        sa, sp = batch(*np.array(scripted[t]).reshape(2, 1).repeat(n, axis=1))
+        sa, sp = batch(*np.array(scripted[t % len(scripted)]).reshape(2, 1).repeat(n, axis=1))
         action = (np.where(odd, a, sa), tuple(np.where(odd[:, None], p, q) for p, q in zip(params, sp)))
         got, want = venv.step(action), ref.step(action)
         for k in range(4):
-            np.testing.assert_array_equal(got[k], want[k], err_msg=f"step {t}, output {k}")
-        np.testing.assert_array_equal(got[4]["substeps"], want[4]["substeps"], err_msg=f"step {t}")
+            np.testing.assert_array_equal(got[k], want[k], err_msg=f"N={n}, step {t}, output {k}")
+        np.testing.assert_array_equal(got[4]["substeps"], want[4]["substeps"], err_msg=f"N={n}, step {t}")
         state = venv.state
         for i, env in enumerate(ref.envs):
             np.testing.assert_array_equal(state["player"][i], env.unwrapped.state["player"])
             np.testing.assert_array_equal(state["enemies"][i], env.unwrapped.state["enemies"])
-        saw["terminated"] |= got[2].any()
-        saw["truncated"] |= got[3].any()
-    assert saw == {"terminated": True, "truncated": True}
+        ended += got[2].sum(), got[3].sum()
+    return ended
+
+
+@pytest.mark.parametrize("n, seed", [(1, 0), (2, 11), (7, 3), (40, 100)])
+def test_copy_i_equals_a_scalar_env_seeded_with_seed_plus_i_with_noise(n, seed):
+    terminated, truncated = assert_equals_scalar_envs(n, seed, steps=220, max_episode_steps=50)
+    assert terminated > 0 and truncated > 0  # episodes end both ways, so autoresets are compared too
+
+
+def test_equals_scalar_envs_without_noise():
+    terminated, truncated = assert_equals_scalar_envs(12, 0, steps=205, noise=False)
+    assert terminated > 0 and truncated > 0
+
+
+def test_a_copy_does_not_depend_on_the_others():
+    # Copy 2 of a batch of 3 seeded 10 is copy 0 of a batch of 5 seeded [12, ...], whatever the others do.
+    small, large = PlatformVectorEnv(num_envs=3), PlatformVectorEnv(num_envs=5)
+    small.reset(seed=10)
+    large.reset(seed=[12, 0, 1, 2, None])
+    rng = np.random.default_rng(0)
+    for t in range(60):
+        a = rng.integers(0, 3, 5)
+        p = rng.uniform(0, 1, 5) * np.array([30.0, 720.0, 430.0])[a]
+        got_small = small.step(batch(a[[3, 4, 0]], p[[3, 4, 0]]))
+        got_large = large.step(batch(a, p))
+        for k in range(1, 4):
+            assert got_small[k][2] == got_large[k][0], f"step {t}, output {k}"
+        np.testing.assert_array_equal(got_small[0][2], got_large[0][0])
+        assert got_small[4]["substeps"][2] == got_large[4]["substeps"][0]
 
 
 def test_next_step_autoreset():
     venv = PlatformVectorEnv(num_envs=2)
     reset_obs, _ = venv.reset(seed=0)
-    venv.np_random = ZeroNoise()
+    venv.np_randoms = [ZeroNoise()] * 2
     obs, reward, terminated, truncated, info = venv.step(batch([2, 0], [430, 30]))  # copy 0 meets enemy 1
     assert terminated.tolist() == [True, False] and reward[0] > 0
     obs, reward, terminated, truncated, info = venv.step(batch([0, 0], [30, 30]))
@@ -89,12 +113,11 @@ def test_next_step_autoreset():
     assert reward[0] == 0.0 and not terminated[0] and not truncated[0] and info["substeps"].tolist() == [0, 20]
 
 
-@pytest.mark.parametrize("backend", BACKENDS)
-def test_random_policy_statistics_with_noise(backend):
+def test_random_policy_statistics_with_noise():
     # Spec §8: mean return ~0.154 (std ~0.10), ~2.2 steps per episode, ~72 sub-steps per step. Only each
     # copy's first episode counts, so that short episodes are not over-represented.
     n = 3000
-    venv = PlatformVectorEnv(num_envs=n, backend=backend)
+    venv = PlatformVectorEnv(num_envs=n)
     venv.reset(seed=0)
     venv.action_space.seed(0)
     returns, first_done = np.zeros(n), np.zeros(n, dtype=bool)
@@ -111,15 +134,25 @@ def test_random_policy_statistics_with_noise(backend):
     assert np.mean(substeps) == pytest.approx(72, abs=3)
 
 
-def test_seeding_is_reproducible():
-    def run(seed):
-        venv = PlatformVectorEnv(num_envs=8)
+@pytest.mark.parametrize("seed", [None, 3.5, [1, 2], [1, 2, "x"], True])
+def test_bad_seeds_raise(seed):
+    venv = PlatformVectorEnv(num_envs=3)
+    if seed is None:
+        venv.reset(seed=None)  # fresh entropy for every copy: fine
+        assert all(isinstance(g, np.random.Generator) for g in venv.np_randoms)
+        return
+    with pytest.raises(ValueError, match="expected None, an int, or a list of 3 ints"):
         venv.reset(seed=seed)
-        venv.action_space.seed(0)
-        return [venv.step(venv.action_space.sample())[0] for _ in range(5)]
 
-    np.testing.assert_array_equal(run(3), run(3))
-    assert not np.array_equal(run(3), run(4))
+
+def test_np_random_points_to_the_copies_generators():
+    venv = PlatformVectorEnv(num_envs=2)
+    with pytest.raises(AttributeError, match="np_randoms"):
+        venv.np_random = ZeroNoise()
+    with pytest.raises(ValueError, match="expected one per copy"):
+        venv.np_randoms = [ZeroNoise()]
+    with pytest.raises(ValueError, match="has no standard_normal"):
+        venv.np_randoms = [ZeroNoise(), object()]
 
 
 def test_accepts_hybrid_action_space_batches():
@@ -136,6 +169,22 @@ def test_reset_mask():
     moved, *_ = venv.step(batch([0, 0], [30, 30]))
     obs, _ = venv.reset(options={"reset_mask": np.array([False, True])})
     np.testing.assert_array_equal(obs, [moved[0], reset_obs[1]])
+
+
+def test_a_copied_batched_env_goes_on_as_the_original():
+    env = PlatformVectorEnv(num_envs=3)
+    env.reset(seed=1)
+    env.action_space.seed(0)
+    for _ in range(5):
+        env.step(env.action_space.sample())
+    copies = [copy.deepcopy(env), pickle.loads(pickle.dumps(env))]
+    for _ in range(60):
+        action = env.action_space.sample()
+        obs, reward, *_ = env.step(action)
+        for other in copies:
+            obs2, reward2, *_ = other.step(action)
+            np.testing.assert_array_equal(obs2, obs)
+            np.testing.assert_array_equal(reward2, reward)
 
 
 @pytest.mark.parametrize(
@@ -158,7 +207,9 @@ def test_bad_actions_raise(action, shown):
     assert shown in str(err.value) and "expected (a, (p_run, p_hop, p_leap))" in str(err.value)
 
 
-@pytest.mark.parametrize("kwargs", [dict(num_envs=0), dict(num_envs=2.5), dict(max_episode_steps=0)])
+@pytest.mark.parametrize(
+    "kwargs", [dict(num_envs=0), dict(num_envs=2.5), dict(max_episode_steps=0), dict(max_episode_steps=True)]
+)
 def test_bad_constructor_arguments_raise(kwargs):
     with pytest.raises(ValueError, match="must be a positive integer"):
         PlatformVectorEnv(**kwargs)

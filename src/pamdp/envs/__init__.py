@@ -14,8 +14,8 @@ import gymnasium
 
 _REGISTRATIONS = {
     "pamdp/Platform-v0": dict(
-        entry_point="pamdp.envs.platform:PlatformEnv",
-        vector_entry_point="pamdp.envs.platform:PlatformVectorEnv",
+        entry_point="pamdp.envs.platform.env:PlatformEnv",
+        vector_entry_point="pamdp.envs.platform.batched:PlatformVectorEnv",
         max_episode_steps=200,
     ),
     "pamdp/HalfFieldOffense-v0": dict(

@@ -86,7 +86,9 @@ def record_episode(
 ) -> tuple[str, float]:
     """Play one episode in ``env`` (made with ``render_mode="rgb_array"``) and save it as a GIF.
 
-    ``policy`` maps an observation to an env action; ``None`` samples random actions.
+    ``policy`` maps an observation to an env action; ``None`` samples random actions. An env whose
+    agent step spans several physics sub-steps may offer ``render_substeps()``, one frame per sub-step of
+    the last step (Platform does); those frames are recorded instead of one frame per step.
     Returns the GIF's path and the episode's return.
     """
     if getattr(env, "render_mode", None) != "rgb_array":
@@ -95,12 +97,16 @@ def record_episode(
     obs, _ = env.reset(seed=seed)
     if seed is not None:
         env.action_space.seed(seed)
+    substep_frames = getattr(env.unwrapped, "render_substeps", None)
     frames, total = [env.render()], 0.0
     for _ in range(max_steps):
         action = env.action_space.sample() if policy is None else policy(obs)
         obs, reward, terminated, truncated, _ = env.step(action)
         total += float(reward)
-        frames.append(env.render())
+        if substep_frames is None:
+            frames.append(env.render())
+        else:
+            frames.extend(substep_frames())
         if terminated or truncated:
             break
     return save_gif(frames, path, fps=fps), total
