@@ -5,7 +5,7 @@ import os
 import pytest
 import torch
 
-from pamdp.algos.base import atomic_save, atomic_write_text
+from pamdp.algos.checkpoints import atomic_save, atomic_write_text
 
 
 class Interrupted(Exception):

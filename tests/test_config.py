@@ -9,13 +9,13 @@ import typing
 
 import pytest
 
-from pamdp.algos.base import LAYERS, NON_NEGATIVE, POSITIVE, at_least, interval, one_of
 from pamdp.algos.hyar import HyARConfig
 from pamdp.algos.paddpg import PADDPGConfig
 from pamdp.algos.pappo import PAPPOConfig
 from pamdp.algos.pasvg import PASVG0Config
 from pamdp.algos.patrpo import PATRPOConfig
 from pamdp.algos.pdqn import PDQNConfig
+from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, at_least, interval, one_of
 
 CONFIGS = [PATRPOConfig, PAPPOConfig, PASVG0Config, PADDPGConfig, PDQNConfig, HyARConfig]
 # Settings any value of their type suits: PATRPO's and PAPPO's initial log-std (any finite number).

@@ -8,10 +8,11 @@ import pytest
 import torch
 
 from pamdp import PATRPO
-from pamdp.algos.base import EpisodeTracker, make_vector_env
+from pamdp.algos.logger import EpisodeTracker
 from pamdp.algos.offpolicy import OffPolicyLoop
 from pamdp.algos.patrpo import PATRPOConfig
 from pamdp.algos.replay import ReplayBuffer
+from pamdp.algos.vector_env import make_vector_env
 from pamdp.envs.hfo_baseline import scripted_scorer_batch
 from pamdp.spaces import HybridActionSpace
 

@@ -10,7 +10,7 @@ from torch import nn
 
 import pamdp
 from pamdp import PADDPG
-from pamdp.algos.base import load_model
+from pamdp.algos.checkpoints import load_model
 from pamdp.algos.paddpg import Actor, Critic, PADDPGConfig, invert_gradients, zero_gradients
 from pamdp.cli import main
 from pamdp.spaces import HybridActionSpace

@@ -13,7 +13,7 @@ from numeric import finite_difference
 
 import pamdp
 from pamdp import PDQN
-from pamdp.algos.base import load_model
+from pamdp.algos.checkpoints import load_model
 from pamdp.algos.offpolicy import OUNoise
 from pamdp.algos.paddpg import backprop_actor, invert_gradients
 from pamdp.algos.pdqn import ParamActor, PDQNConfig, QNetwork, param_blocks

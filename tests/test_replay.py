@@ -124,8 +124,8 @@ def test_clipped_step_clips_the_gradient_norm_before_stepping(max_norm, expected
 
 def test_epoch_stats_average_each_figure_over_the_updates_that_computed_it():
     """A figure computed every third update (a delayed actor step) is the mean of those steps, not diluted."""
-    from pamdp.algos.base import make_vector_env
     from pamdp.algos.offpolicy import OffPolicyLoop
+    from pamdp.algos.vector_env import make_vector_env
     from pamdp.spaces import HybridActionSpace
 
     env = make_vector_env("pamdp/Platform-v0", 4)

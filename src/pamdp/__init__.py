@@ -6,11 +6,10 @@ Importing the package registers its environments with Gymnasium (``pamdp/Platfor
 
 from importlib import import_module
 
+from pamdp._version import __version__
 from pamdp.algos import MODULE_OF as _ALGOS
 from pamdp.envs import register_envs
 from pamdp.spaces import HybridActionSpace
-
-__version__ = "0.1.0"
 
 register_envs()
 

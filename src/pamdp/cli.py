@@ -334,7 +334,7 @@ def _format_evaluation(result: dict) -> str:
 
 
 def cmd_evaluate(args) -> int:
-    from pamdp.algos.base import load_model
+    from pamdp.algos.checkpoints import load_model
     from pamdp.evaluation import evaluate
 
     model = load_model(args.model)
@@ -348,7 +348,7 @@ def cmd_render(args) -> int:
     import gymnasium
 
     import pamdp  # noqa: F401  (registers the envs)
-    from pamdp.algos.base import load_model
+    from pamdp.algos.checkpoints import load_model
     from pamdp.envs.rendering import record_episode
 
     if args.source in gymnasium.registry:

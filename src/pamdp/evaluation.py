@@ -2,9 +2,14 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
-from pamdp.algos.base import Algorithm, make_vector_env
+from pamdp.algos.vector_env import make_vector_env
+
+if TYPE_CHECKING:
+    from pamdp.algos.base import Algorithm
 
 __all__ = ["evaluate"]
 

@@ -48,21 +48,11 @@ import torch
 import torch.nn.functional as F
 from torch import nn
 
-from pamdp.algos.base import (
-    LAYERS,
-    NON_NEGATIVE,
-    POSITIVE,
-    AlgoConfig,
-    Algorithm,
-    Check,
-    at_least,
-    interval,
-    one_of,
-    setting,
-)
+from pamdp.algos.base import Algorithm
 from pamdp.algos.offpolicy import OffPolicyLoop, clipped_step, linear_epsilon, soft_update
 from pamdp.algos.paddpg import backprop_actor
 from pamdp.algos.replay import ReplayBuffer, transition_fields
+from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
 from pamdp.policies import ACTIVATIONS, mlp
 from pamdp.spaces import HybridActionSpace
 

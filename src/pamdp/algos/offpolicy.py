@@ -22,8 +22,9 @@ import numpy as np
 import torch
 from torch import nn
 
-from pamdp.algos.base import EpisodeTracker, subnormals_flushed
+from pamdp.algos.logger import EpisodeTracker
 from pamdp.algos.replay import ReplayBuffer
+from pamdp.algos.subnormals import subnormals_flushed
 
 __all__ = [
     "OffPolicyLoop",

@@ -33,20 +33,11 @@ import numpy as np
 import torch
 from torch import nn
 
-from pamdp.algos.base import (
-    LAYERS,
-    NON_NEGATIVE,
-    POSITIVE,
-    AlgoConfig,
-    Algorithm,
-    at_least,
-    interval,
-    one_of,
-    setting,
-)
+from pamdp.algos.base import Algorithm
 from pamdp.algos.dense import Dense
 from pamdp.algos.offpolicy import OffPolicyLoop, OUNoise, gradient_step, linear_epsilon, mixed_target, soft_updater
 from pamdp.algos.replay import ReplayBuffer, transition_fields
+from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, at_least, interval, one_of, setting
 from pamdp.policies import ACTIVATIONS, mlp
 from pamdp.spaces import HybridActionSpace
 

@@ -31,19 +31,9 @@ from typing import TYPE_CHECKING
 
 import torch
 
-from pamdp.algos.base import (
-    LAYERS,
-    NON_NEGATIVE,
-    POSITIVE,
-    AlgoConfig,
-    Check,
-    at_least,
-    interval,
-    one_of,
-    setting,
-    subnormals_flushed,
-)
 from pamdp.algos.patrpo import OnPolicyHybrid, Rollout
+from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
+from pamdp.algos.subnormals import subnormals_flushed
 from pamdp.distributions import HybridDistribution, kl_divergence
 from pamdp.policies import ACTIVATIONS, HybridPolicy, ValueNetwork
 

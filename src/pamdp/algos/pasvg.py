@@ -36,21 +36,11 @@ import torch
 import torch.nn.functional as F
 from torch import nn
 
-from pamdp.algos.base import (
-    LAYERS,
-    NON_NEGATIVE,
-    POSITIVE,
-    AlgoConfig,
-    Algorithm,
-    Check,
-    at_least,
-    interval,
-    one_of,
-    setting,
-)
+from pamdp.algos.base import Algorithm
 from pamdp.algos.dense import Dense
 from pamdp.algos.offpolicy import OffPolicyLoop, clipped_step, gradient_step, soft_update, soft_updater
 from pamdp.algos.replay import ReplayBuffer, transition_fields
+from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
 from pamdp.algos.stacking import clip_per_member
 from pamdp.policies import ACTIVATIONS, mlp
 from pamdp.spaces import HybridActionSpace

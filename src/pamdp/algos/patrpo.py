@@ -20,19 +20,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 import torch
 
-from pamdp.algos.base import (
-    LAYERS,
-    NON_NEGATIVE,
-    POSITIVE,
-    AlgoConfig,
-    Algorithm,
-    EpisodeTracker,
-    at_least,
-    interval,
-    one_of,
-    setting,
-    subnormals_flushed,
-)
+from pamdp.algos.base import Algorithm
+from pamdp.algos.logger import EpisodeTracker
+from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, at_least, interval, one_of, setting
+from pamdp.algos.subnormals import subnormals_flushed
 from pamdp.algos.trpo import (
     FisherVectorProduct,
     GaussNewtonFVP,

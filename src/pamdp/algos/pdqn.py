@@ -38,20 +38,11 @@ import torch
 import torch.nn.functional as F
 from torch import nn
 
-from pamdp.algos.base import (
-    LAYERS,
-    NON_NEGATIVE,
-    POSITIVE,
-    AlgoConfig,
-    Algorithm,
-    at_least,
-    interval,
-    one_of,
-    setting,
-)
+from pamdp.algos.base import Algorithm
 from pamdp.algos.offpolicy import OffPolicyLoop, OUNoise, clipped_step, linear_epsilon, mixed_target, soft_update
 from pamdp.algos.paddpg import BOUNDS, backprop_actor
 from pamdp.algos.replay import ReplayBuffer, transition_fields
+from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, at_least, interval, one_of, setting
 from pamdp.policies import ACTIVATIONS, mlp
 from pamdp.spaces import HybridActionSpace
 

@@ -38,9 +38,9 @@ from typing import Any
 import torch
 from torch import nn
 
-from pamdp.algos.base import subnormals_flushed
 from pamdp.algos.dense import Dense
 from pamdp.algos.offpolicy import optimizer_step
+from pamdp.algos.subnormals import subnormals_flushed
 
 __all__ = ["SeedStack", "can_stack", "ALIGNED_STEPS", "adam_step", "step_class", "clip_per_member"]
 

@@ -92,7 +92,7 @@ def is_finished(out: str | Path, spec: RunSpec) -> bool:
     :func:`train_run` skips such a run (after checking its recorded settings); ``pamdp reproduce --status``
     counts it as done.
     """
-    from pamdp.algos.base import FINAL_MODEL
+    from pamdp.algos.checkpoints import FINAL_MODEL
 
     out = Path(out)
     if not (out / FINAL_MODEL).exists() or not (out / "run.json").exists():
@@ -109,7 +109,7 @@ def is_finished(out: str | Path, spec: RunSpec) -> bool:
 def _prepare(spec: RunSpec, out: str | os.PathLike, log=print) -> tuple[Any, dict | None]:
     """The model to train for ``spec`` in ``out`` (new or resumed) and ``None``, or ``None`` and the evaluation of
     a run already finished."""
-    from pamdp.algos.base import CHECKPOINT, FINAL_MODEL, atomic_write_text
+    from pamdp.algos.checkpoints import CHECKPOINT, FINAL_MODEL, atomic_write_text
 
     cls, preset, config = spec.config()
     out = Path(out)
@@ -155,7 +155,7 @@ def _train(model, spec: RunSpec, out: str | os.PathLike, progress_bar: bool, log
 
     ``trained``: called once training is over, before saving and evaluating (a seed stack's ``leave``).
     """
-    from pamdp.algos.base import FINAL_MODEL, atomic_write_text
+    from pamdp.algos.checkpoints import FINAL_MODEL, atomic_write_text
     from pamdp.evaluation import evaluate
 
     out = Path(out)

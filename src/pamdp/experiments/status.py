@@ -67,7 +67,7 @@ def epoch_seconds(row: dict) -> float:
 
 def run_status(spec: RunSpec, out: str | Path, now: float | None = None) -> RunStatus:
     """The state of ``spec``'s run in directory ``out``."""
-    from pamdp.algos.base import CHECKPOINT, FINAL_MODEL
+    from pamdp.algos.checkpoints import CHECKPOINT, FINAL_MODEL
 
     out = Path(out)
     steps, seconds, last_return, idle, recent = 0, 0.0, None, None, None

@@ -1,0 +1,106 @@
+"""What a run records: episode statistics while training, one CSV row and TensorBoard scalars per epoch."""
+
+from __future__ import annotations
+
+import csv
+import os
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+__all__ = ["EpisodeTracker", "Logger"]
+
+
+class EpisodeTracker:
+    """Running return and length per env copy; completed episodes are kept until :meth:`pop`.
+
+    Where the env reports an episode's outcome as ``info["status"]`` (Half Field Offense: ``"GOAL"``,
+    ``"OUT_OF_BOUNDS"``, ...), the goal rate and the mean length of scoring episodes are kept too, the training
+    counterparts of :func:`pamdp.evaluation.evaluate`'s ``goal_rate`` and ``mean_steps_to_goal``, logged as
+    ``charts/goal_rate`` and ``charts/steps_to_goal`` (over the episodes whose end came with a status).
+    """
+
+    def __init__(self, num_envs: int):
+        self.returns = np.zeros(num_envs)
+        self.lengths = np.zeros(num_envs, dtype=np.int64)
+        self.done_returns: list[float] = []
+        self.done_lengths: list[int] = []
+        self.done_goals: list[bool | None] = []  # per ended episode; None where the env reported no status
+
+    def reset(self) -> None:
+        self.returns[:] = 0.0
+        self.lengths[:] = 0
+
+    def step(self, rewards: np.ndarray, dones: np.ndarray, valid: np.ndarray, info: dict | None = None) -> None:
+        """Add one vector step; ``valid`` is false for the autoreset steps of Gymnasium's vector envs."""
+        self.returns += np.where(valid, rewards, 0.0)
+        self.lengths += valid
+        ended = dones & valid
+        self.done_returns += self.returns[ended].tolist()
+        self.done_lengths += self.lengths[ended].tolist()
+        if ended.any():
+            if info is not None and "status" in info:
+                self.done_goals += [str(s) == "GOAL" for s in np.asarray(info["status"], dtype=object)[ended]]
+            else:
+                self.done_goals += [None] * int(ended.sum())
+        self.returns[ended] = 0.0
+        self.lengths[ended] = 0
+
+    def pop(self) -> dict[str, float]:
+        """Statistics of the episodes completed since the last call (empty if none)."""
+        if not self.done_returns:
+            return {}
+        stats = {
+            "charts/episodic_return": float(np.mean(self.done_returns)),
+            "charts/episodic_length": float(np.mean(self.done_lengths)),
+            "charts/episodes": float(len(self.done_returns)),
+        }
+        known = [(n, g) for n, g in zip(self.done_lengths, self.done_goals) if g is not None]
+        if known:
+            stats["charts/goal_rate"] = float(np.mean([g for _, g in known]))
+            scoring = [n for n, g in known if g]
+            if scoring:
+                stats["charts/steps_to_goal"] = float(np.mean(scoring))
+        self.done_returns, self.done_lengths, self.done_goals = [], [], []
+        return stats
+
+
+class Logger:
+    """One CSV row and a set of TensorBoard scalars per epoch, in ``run_dir/progress.csv`` and ``run_dir/tb``.
+
+    On resume (``resume_step > 0``) rows logged after the checkpoint being resumed are dropped, so that a
+    killed and restarted run leaves one clean log.
+    """
+
+    def __init__(self, run_dir: str | os.PathLike, resume_step: int = 0):
+        from torch.utils.tensorboard import SummaryWriter
+
+        self.run_dir = Path(run_dir)
+        self.run_dir.mkdir(parents=True, exist_ok=True)
+        self.csv_path = self.run_dir / "progress.csv"
+        self.rows: list[dict[str, Any]] = []
+        if self.csv_path.exists():
+            with open(self.csv_path, newline="") as f:
+                self.rows = [r for r in csv.DictReader(f) if float(r["time/total_timesteps"]) <= resume_step]
+        if resume_step == 0:
+            self.rows = []
+        self.writer = SummaryWriter(str(self.run_dir / "tb"), purge_step=resume_step or None)
+
+    def record(self, stats: dict[str, float], step: int) -> None:
+        for key, value in stats.items():
+            self.writer.add_scalar(key, value, step)
+        self.writer.flush()
+        self.rows.append(stats)
+        columns: list[str] = []
+        for row in self.rows:
+            columns += [k for k in row if k not in columns]
+        tmp = self.csv_path.with_suffix(".csv.tmp")
+        with open(tmp, "w", newline="") as f:
+            writer = csv.DictWriter(f, fieldnames=columns)
+            writer.writeheader()
+            writer.writerows(self.rows)
+        os.replace(tmp, self.csv_path)
+
+    def close(self) -> None:
+        self.writer.close()

@@ -1,0 +1,176 @@
+"""The settings system: typed, frozen, documented configs whose values are checked when they are made.
+
+An algorithm's config subclasses :class:`AlgoConfig` and declares each setting with :func:`setting`: a
+default, a one-line help (the field's documentation, its CLI help and its row in ``docs/algorithms.md``) and a
+:class:`Check` of its valid values. A value that fails its check, a non-finite float, an unknown name or a
+value of the wrong type is a ``ValueError`` naming the setting, the value and what was expected.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import types
+import typing
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from typing_extensions import Self  # typing.Self from Python 3.11
+
+__all__ = [
+    "AlgoConfig",
+    "setting",
+    "Check",
+    "at_least",
+    "interval",
+    "one_of",
+    "POSITIVE",
+    "NON_NEGATIVE",
+    "LAYERS",
+]
+
+
+@dataclasses.dataclass(frozen=True)
+class Check:
+    """A setting's valid values: ``ok(value)`` says whether a value is one, ``expected`` says which in words
+    (the error message's "expected ..." and the settings tables' "valid" column)."""
+
+    ok: Callable[[Any], bool]
+    expected: str
+
+
+def at_least(n: int) -> Check:
+    return Check(lambda v: v >= n, f"an integer >= {n}")
+
+
+def interval(low: float, high: float, low_open: bool = False, high_open: bool = False) -> Check:
+    """Numbers between ``low`` and ``high``, each end included unless it is open."""
+    text = f"a number in {'(' if low_open else '['}{low}, {high}{')' if high_open else ']'}"
+    return Check(
+        lambda v: (low < v if low_open else low <= v) and (v < high if high_open else v <= high),
+        text,
+    )
+
+
+def one_of(choices) -> Check:
+    choices = tuple(choices)
+    return Check(lambda v: v in choices, "one of " + ", ".join(repr(c) for c in choices))
+
+
+POSITIVE = Check(lambda v: v > 0, "a positive number")
+NON_NEGATIVE = Check(lambda v: v >= 0, "a non-negative number")
+LAYERS = Check(lambda v: len(v) > 0 and all(h > 0 for h in v), "one or more positive layer sizes")
+
+
+def setting(default: Any, help: str, check: Check | None = None) -> Any:
+    """A documented dataclass field: the ``help`` text is the field's documentation and its CLI help; a
+    config rejects a value that fails ``check`` with an error naming the value and ``check.expected``."""
+    if isinstance(default, (list, dict)):
+        raise TypeError("use tuples for sequence settings, so that configs stay immutable")
+    return dataclasses.field(default=default, metadata={"help": help, "check": check})
+
+
+@dataclasses.dataclass(frozen=True)
+class AlgoConfig:
+    """Settings every algorithm has. Subclasses add their own and a ``presets()`` table."""
+
+    seed: int = setting(0, "Seeds the networks' initialisation, action sampling and the environments.", at_least(0))
+    num_envs: int = setting(
+        16, "Copies of the environment stepped together (batched when the env has a vector version).", at_least(1)
+    )
+    torch_threads: int = setting(
+        1, "Torch intra-op threads; 1 is fastest for these small networks on a laptop CPU.", at_least(1)
+    )
+    flush_denormal: bool = setting(
+        True,
+        "Flush subnormal floats to zero (x86 FTZ/DAZ) in the CPU arithmetic of the gradient updates, never while "
+        "the env steps: Adam's decaying moments can reach the subnormal range, where each operation is many times "
+        "slower (PASVG(0) trains 1.6x to 1.7x faster with it, benchmarks/denormals.md).",
+    )
+    vector_mode: str = setting(
+        "auto",
+        "How env copies are stepped: batched, sync (scalar copies in turn) or auto (batched from 2 copies with Numba "
+        "installed, from 48 without).",
+        one_of(("auto", "batched", "sync")),
+    )
+
+    def __post_init__(self):
+        """Each setting against its ``check`` (in declaration order); subclasses add checks across settings."""
+        for f in dataclasses.fields(self):
+            value = getattr(self, f.name)
+            if isinstance(value, float) and not math.isfinite(value):
+                raise ValueError(f"{type(self).__name__}.{f.name} = {value!r}; expected a finite number")
+            check = self.check_of(f.name)
+            if check is not None:
+                self._check(check.ok(value), f.name, check.expected)
+
+    @classmethod
+    def check_of(cls, name: str) -> Check | None:
+        """The check of setting ``name``: its own, or, for a setting a subclass declares again (a new default)
+        without one, the nearest base class's."""
+        for klass in cls.__mro__:
+            f = getattr(klass, "__dataclass_fields__", {}).get(name)
+            if f is not None and f.metadata.get("check") is not None:
+                return f.metadata["check"]
+        return None
+
+    def _check(self, ok: bool, name: str, expected: str) -> None:
+        if not ok:
+            raise ValueError(f"{type(self).__name__}.{name} = {getattr(self, name)!r}; expected {expected}")
+
+    @classmethod
+    def presets(cls) -> dict[str, Self]:
+        """Named settings, e.g. ``"paper"``; the first one is the default."""
+        return {"default": cls()}
+
+    @classmethod
+    def preset(cls, name: str) -> Self:
+        table = cls.presets()
+        if name not in table:
+            raise ValueError(f"unknown preset {name!r} for {cls.__name__}; expected one of {', '.join(table)}")
+        return table[name]
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            f.name: (list(v) if isinstance(v := getattr(self, f.name), tuple) else v) for f in dataclasses.fields(self)
+        }
+
+    @classmethod
+    def field_types(cls) -> dict[str, Any]:
+        return typing.get_type_hints(cls)
+
+    @classmethod
+    def from_dict(cls, values: dict[str, Any], base: Self | None = None) -> Self:
+        """Settings from plain data (a config file, a checkpoint), over ``base`` (default: the defaults).
+
+        Unknown names and values of the wrong type raise a ``ValueError`` naming them.
+        """
+        base = base if base is not None else cls()
+        names = {f.name for f in dataclasses.fields(cls)}
+        unknown = sorted(set(values) - names)
+        if unknown:
+            raise ValueError(f"unknown {cls.__name__} setting(s) {unknown}; expected some of {sorted(names)}")
+        hints = cls.field_types()
+        return dataclasses.replace(base, **{k: _coerce(k, v, hints[k]) for k, v in values.items()})
+
+
+def _coerce(name: str, value: Any, hint: Any) -> Any:
+    """Check a plain value against a field's type hint, converting lists to tuples and ints to floats."""
+    origin = typing.get_origin(hint)
+    if origin in (typing.Union, types.UnionType):
+        options = typing.get_args(hint)
+        if value is None and type(None) in options:
+            return None
+        hint = next(t for t in options if t is not type(None))
+        origin = typing.get_origin(hint)
+    if origin is tuple:
+        if not isinstance(value, (list, tuple)):
+            raise ValueError(f"setting {name!r} = {value!r}; expected a list")
+        (item,) = {a for a in typing.get_args(hint) if a is not Ellipsis}
+        return tuple(_coerce(name, v, item) for v in value)
+    if hint is float and isinstance(value, (int, float)) and not isinstance(value, bool):
+        return float(value)
+    if hint in (int, str, bool) and type(value) is not hint:
+        raise ValueError(f"setting {name!r} = {value!r}; expected {hint.__name__}")
+    return value
