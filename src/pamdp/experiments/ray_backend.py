@@ -1,13 +1,18 @@
 """Runs on a Ray cluster (``pamdp reproduce NAME --backend ray --address HOST:PORT``).
 
 Each run is one Ray task (one CPU, one torch thread). The cluster's machines need not share a filesystem:
-the task receives the run directory as it stands locally (so an interrupted run resumes from its
-checkpoint), trains in a scratch directory on whichever node Ray chose, and returns the directory's files,
-which are written back into the same layout as local runs. Needs the ``ray`` extra: ``pip install pamdp[ray]``.
+the run directories stay on the driver's machine, where one writer, an actor pinned to the driver's node,
+keeps them. A task fetches its run directory from it as it stands (so an interrupted run resumes from its
+checkpoint), trains in a scratch directory on whichever node Ray chose, and sends back what changed after
+every epoch (the new checkpoint, ``progress.csv``, ``run.json``, the new tails of the logs) and once more at
+the end. A task whose node or worker process dies is retried (``retries`` times) and resumes from the last
+checkpoint that reached the driver; the resumed run drops the rows of ``progress.csv`` logged after it, so no
+epoch is counted twice. Needs the ``ray`` extra: ``pip install pamdp[ray]``.
 """
 
 from __future__ import annotations
 
+import os
 import tempfile
 import time
 import traceback
@@ -15,57 +20,161 @@ from pathlib import Path
 
 from pamdp.experiments.runner import RunOutcome, RunSpec, _describe, _worker
 
-__all__ = ["run_all_ray"]
+__all__ = ["run_all_ray", "RETRIES"]
+
+RETRIES = 3
+"""How many times a run is started again after its node or worker process died (Ray's ``max_retries``)."""
+
+# Files written only by appending (TensorBoard event files, the run's log): after the first send, only what
+# was appended since goes to the driver. Every other file of a run directory is replaced whole on each
+# write (atomically), so it goes whole when it changed.
+_APPENDED = ("tb/", "stdout.log")
+_LAST = "checkpoint.pt"  # written last of a batch: a torn batch leaves a log newer than the checkpoint
+
+
+def _appended(rel: str) -> bool:
+    return rel.startswith(_APPENDED[0]) or rel == _APPENDED[1]
+
+
+def _files(directory: Path) -> list[tuple[str, Path]]:
+    """A run directory's files by relative path, less hidden ones (a lock file, a write's temporary file)."""
+    found = []
+    for path in sorted(directory.rglob("*")):
+        rel = path.relative_to(directory)
+        if path.is_file() and not any(part.startswith(".") for part in rel.parts):
+            found.append((rel.as_posix(), path))
+    return found
 
 
 def _pack(directory: Path) -> dict[str, bytes]:
-    if not directory.exists():
-        return {}
-    return {str(p.relative_to(directory)): p.read_bytes() for p in directory.rglob("*") if p.is_file()}
+    return {rel: path.read_bytes() for rel, path in _files(directory)}
 
 
-def _unpack(files: dict[str, bytes], directory: Path) -> None:
-    for rel, data in files.items():
-        target = directory / rel
-        target.parent.mkdir(parents=True, exist_ok=True)
+def _write(target: Path, offset: int, data: bytes) -> None:
+    """Put ``data`` at ``offset`` of ``target``: a whole new file (atomically) at 0, an appended tail past it."""
+    target.parent.mkdir(parents=True, exist_ok=True)
+    if offset == 0:
         tmp = target.with_name(f".{target.name}.tmp")
         tmp.write_bytes(data)
         tmp.replace(target)
+        return
+    size = target.stat().st_size if target.exists() else 0
+    if size < offset:
+        raise ValueError(f"{target} holds {size} bytes; expected at least {offset} to append at that offset")
+    with open(target, "r+b") as f:
+        f.seek(offset)
+        f.write(data)
+        f.truncate()
 
 
-def _remote_run(spec: RunSpec, files: dict[str, bytes]) -> tuple[dict | None, str | None, dict[str, bytes]]:
+class _Inbox:
+    """The one writer of the run directories, an actor on the driver's node.
+
+    Each attempt at a run opens it and gets a token; a write with an older attempt's token (from a worker
+    that Ray gave up on but that still runs) is refused, so a run directory has one writer at a time.
+    """
+
+    def __init__(self):
+        self.attempts: dict[str, int] = {}
+
+    def open(self, out: str) -> tuple[int, dict[str, bytes]]:
+        self.attempts[out] = self.attempts.get(out, 0) + 1
+        return self.attempts[out], _pack(Path(out))
+
+    def write(self, out: str, attempt: int, changes: list[tuple[str, int, bytes]]) -> bool:
+        if self.attempts.get(out) != attempt:
+            return False
+        for rel, offset, data in sorted(changes, key=lambda c: c[0] == _LAST):
+            _write(Path(out) / rel, offset, data)
+        return True
+
+
+class _Mirror:
+    """A task's side of its run directory: sends the driver what changed in ``run_dir`` since the last send."""
+
+    def __init__(self, inbox, out: str, attempt: int, run_dir: Path):
+        self.inbox, self.out, self.attempt, self.run_dir = inbox, out, attempt, run_dir
+        self.sent: dict[str, tuple[tuple[int, int, int], int]] = {}  # file: (its stat when sent, bytes sent)
+        self._scan()  # what the driver already holds, as restored into run_dir
+
+    def _scan(self) -> list[tuple[str, int, bytes]]:
+        changes = []
+        for rel, path in _files(self.run_dir):
+            st = path.stat()
+            key = (st.st_ino, st.st_size, st.st_mtime_ns)
+            previous_key, sent = self.sent.get(rel, (None, 0))
+            if key == previous_key:
+                continue
+            offset = sent if _appended(rel) and st.st_size >= sent else 0
+            with open(path, "rb") as f:
+                f.seek(offset)
+                data = f.read()
+            changes.append((rel, offset, data))
+            self.sent[rel] = (key, offset + len(data))
+        return changes
+
+    def send(self, *_epoch) -> None:
+        """Send the changes and wait until the driver holds them (also a ``learn`` callback: after each epoch)."""
+        import ray
+
+        changes = self._scan()
+        if changes and not ray.get(self.inbox.write.remote(self.out, self.attempt, changes)):
+            raise RuntimeError(f"{self.out}: a later attempt at this run has taken over; this one stops")
+
+
+def _remote_run(spec: RunSpec, out: str, inbox) -> tuple[dict | None, str | None]:
+    import ray
+
+    attempt, files = ray.get(inbox.open.remote(out))
     with tempfile.TemporaryDirectory(prefix="pamdp-ray-") as scratch:
         run_dir = Path(scratch) / "run"
-        _unpack(files, run_dir)
+        run_dir.mkdir()
+        for rel, data in files.items():
+            _write(run_dir / rel, 0, data)
+        mirror = _Mirror(inbox, out, attempt, run_dir)
+        with open(run_dir / "stdout.log", "a") as f:
+            node = ray.get_runtime_context().get_node_id()
+            print(f"attempt {attempt} on Ray node {node} ({ray.util.get_node_ip_address()})", file=f)
         try:
-            result, error = _worker(spec, str(run_dir)), None
+            result, error = _worker(spec, str(run_dir), callback=mirror.send), None
         except Exception:
             result, error = None, traceback.format_exc()
-        return result, error, _pack(run_dir)
+        mirror.send()
+        return result, error
 
 
-def run_all_ray(jobs: list[tuple[RunSpec, str]], address: str | None = None, log=print) -> list[RunOutcome]:
-    """Run ``(spec, out_dir)`` jobs as Ray tasks on the cluster at ``address`` (``None``: a local Ray)."""
+def run_all_ray(
+    jobs: list[tuple[RunSpec, str]], address: str | None = None, log=print, retries: int = RETRIES
+) -> list[RunOutcome]:
+    """Run ``(spec, out_dir)`` jobs as Ray tasks on the cluster at ``address`` (``None``: a local Ray).
+
+    ``retries``: how many times a run whose node or worker process died starts again, from the last
+    checkpoint it sent.
+    """
     try:
         import ray
+        from ray.util.scheduling_strategies import NodeAffinitySchedulingStrategy
     except ModuleNotFoundError as exc:
         raise ValueError("the Ray backend needs Ray: pip install 'pamdp[ray]'") from exc
+    if isinstance(retries, bool) or not isinstance(retries, int) or retries < 0:
+        raise ValueError(f"retries = {retries!r}; expected an integer >= 0")
     started_here = not ray.is_initialized()
     if started_here:
         extra = {} if address else {"include_dashboard": False}
         ray.init(address=address, log_to_driver=False, **extra)
     try:
-        task = ray.remote(num_cpus=1, max_retries=0)(_remote_run)
+        here = NodeAffinitySchedulingStrategy(ray.get_runtime_context().get_node_id(), soft=False)
+        inbox = ray.remote(_Inbox).options(num_cpus=0, scheduling_strategy=here).remote()
+        task = ray.remote(num_cpus=1, max_retries=retries)(_remote_run)
         pending = {}
         for spec, out in jobs:
-            pending[task.remote(spec, _pack(Path(out)))] = (spec, out, time.time())
+            pending[task.remote(spec, os.path.abspath(out), inbox)] = (spec, out, time.time())
         outcomes: list[RunOutcome] = []
         while pending:
             (ref,), _ = ray.wait(list(pending), num_returns=1)
             spec, out, t0 = pending.pop(ref)
             try:
-                result, error, files = ray.get(ref)
-                _unpack(files, Path(out))
+                result, error = ray.get(ref)
             except Exception:
                 result, error = None, traceback.format_exc()
             outcomes.append(RunOutcome(spec, out, result, error, time.time() - t0))

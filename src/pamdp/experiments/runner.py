@@ -150,10 +150,13 @@ def _prepare(spec: RunSpec, out: str | os.PathLike, log=print) -> tuple[Any, dic
     return model, None
 
 
-def _train(model, spec: RunSpec, out: str | os.PathLike, progress_bar: bool, log=print, trained=None) -> dict:
+def _train(
+    model, spec: RunSpec, out: str | os.PathLike, progress_bar: bool, log=print, trained=None, callback=None
+) -> dict:
     """Train a prepared model to ``spec``'s budget, save its final model and evaluate it.
 
     ``trained``: called once training is over, before saving and evaluating (a seed stack's ``leave``).
+    ``callback``: ``learn``'s, called after every epoch (and its checkpoint).
     """
     from pamdp.algos.checkpoints import FINAL_MODEL, atomic_write_text
     from pamdp.evaluation import evaluate
@@ -165,6 +168,7 @@ def _train(model, spec: RunSpec, out: str | os.PathLike, progress_bar: bool, log
         progress_bar=progress_bar,
         run_dir=out,
         eval_every=spec.eval_every,
+        callback=callback,
     )
     if trained is not None:
         trained()
@@ -177,10 +181,13 @@ def _train(model, spec: RunSpec, out: str | os.PathLike, progress_bar: bool, log
     return result
 
 
-def train_run(spec: RunSpec, out: str | os.PathLike, progress_bar: bool = True, log=print) -> dict:
-    """Train (or resume, or skip) one run in ``out``; returns its evaluation (or ``{}`` without one)."""
+def train_run(spec: RunSpec, out: str | os.PathLike, progress_bar: bool = True, log=print, callback=None) -> dict:
+    """Train (or resume, or skip) one run in ``out``; returns its evaluation (or ``{}`` without one).
+
+    ``callback``: called after every epoch (and its checkpoint) with the model and the epoch's statistics.
+    """
     model, done = _prepare(spec, out, log)
-    return done if model is None else _train(model, spec, out, progress_bar, log)
+    return done if model is None else _train(model, spec, out, progress_bar, log, callback=callback)
 
 
 def stack_key(spec: RunSpec):
@@ -266,7 +273,7 @@ def train_stack(specs: list[RunSpec], outs: list[str | os.PathLike], logs: list)
     return results
 
 
-def _worker(spec: RunSpec, out: str) -> dict:
+def _worker(spec: RunSpec, out: str, callback=None) -> dict:
     import torch
 
     from pamdp._memory import keep_freed_memory
@@ -276,7 +283,9 @@ def _worker(spec: RunSpec, out: str) -> dict:
     log_file = Path(out) / "stdout.log"
     Path(out).mkdir(parents=True, exist_ok=True)
     with open(log_file, "a") as f:
-        return train_run(spec, out, progress_bar=False, log=lambda msg: print(msg, file=f, flush=True))
+        return train_run(
+            spec, out, progress_bar=False, log=lambda msg: print(msg, file=f, flush=True), callback=callback
+        )
 
 
 def _stack_worker(specs: list[RunSpec], outs: list[str]) -> list[Any]:
