@@ -1,4 +1,5 @@
-"""The HFO env's interface: spaces, features, reward, seeding, reset options, errors, rendering, baseline."""
+"""The HFO env's interface: spaces, features, reward, outcomes, seeding, reset options, errors, rendering,
+baseline."""
 
 from __future__ import annotations
 
@@ -10,9 +11,8 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 import pamdp  # noqa: F401  (registers the envs)
-from pamdp.envs import hfo_features as feat
-from pamdp.envs.hfo import HalfFieldOffenseEnv
-from pamdp.envs.hfo_baseline import scripted_scorer
+from pamdp.envs.hfo import HalfFieldOffenseEnv, scripted_scorer
+from pamdp.envs.hfo import dynamics as dyn
 from pamdp.envs.rendering import record_episode
 
 TURN0 = (1, (np.zeros(2, np.float32), np.zeros(1, np.float32), np.zeros(2, np.float32)))
@@ -52,16 +52,16 @@ def test_reward_feature_indices_mean_what_the_reward_assumes():
     obs, _ = env.reset(options={"player": player, "ball": ball, "body": 90.0})
     dmax = math.hypot(52.5, 34.0)
     d_ball, d_goal = math.dist(player, ball), math.dist(player, (52.5, 0.0))
-    assert obs[feat.BALL_PROXIMITY] == pytest.approx(1 - 2 * d_ball / dmax, abs=1e-6)
-    assert obs[feat.GOAL_PROXIMITY] == pytest.approx(1 - 2 * d_goal / dmax, abs=1e-6)
+    assert obs[dyn.BALL_PROXIMITY] == pytest.approx(1 - 2 * d_ball / dmax, abs=1e-6)
+    assert obs[dyn.GOAL_PROXIMITY] == pytest.approx(1 - 2 * d_goal / dmax, abs=1e-6)
     ball_bearing = math.degrees(math.atan2(ball[1] - player[1], ball[0] - player[0])) - 90.0
-    assert math.degrees(math.atan2(obs[feat.BALL_SIN], obs[feat.BALL_COS])) == pytest.approx(ball_bearing, abs=1e-4)
+    assert math.degrees(math.atan2(obs[dyn.BALL_SIN], obs[dyn.BALL_COS])) == pytest.approx(ball_bearing, abs=1e-4)
     goal_bearing = math.degrees(math.atan2(-player[1], 52.5 - player[0])) - 90.0
-    assert math.degrees(math.atan2(obs[feat.GOAL_SIN], obs[feat.GOAL_COS])) == pytest.approx(goal_bearing, abs=1e-4)
-    assert obs[feat.KICKABLE] == -1.0
-    assert feat.ball_to_goal(obs[None].astype(float))[0] == pytest.approx(2 * math.dist(ball, (52.5, 0)) / dmax)
+    assert math.degrees(math.atan2(obs[dyn.GOAL_SIN], obs[dyn.GOAL_COS])) == pytest.approx(goal_bearing, abs=1e-4)
+    assert obs[dyn.KICKABLE] == -1.0
+    assert dyn.ball_to_goal(obs.astype(float)) == pytest.approx(2 * math.dist(ball, (52.5, 0)) / dmax)
     obs, _ = env.reset(options={"player": (29.5, 4.0), "ball": ball})
-    assert obs[feat.KICKABLE] == 1.0
+    assert obs[dyn.KICKABLE] == 1.0
 
 
 def test_reward_scale_is_2_over_dmax_per_metre():
@@ -103,10 +103,10 @@ def test_terminal_observation_is_the_true_terminal_state():
         obs, _, terminated, truncated, info = env.step(scripted_scorer(obs))
         if terminated or truncated:
             break
-    g = env.game
-    assert g.bx > 52.5  # the ball is in the goal in the state returned with GOAL
-    distance = math.dist((g.px, g.py), (g.bx, g.by))
-    assert obs[feat.BALL_PROXIMITY] == pytest.approx(1 - 2 * distance / math.hypot(52.5, 34), abs=1e-5)
+    s = env.state
+    assert s[dyn.BX] > 52.5  # the ball is in the goal in the state returned with GOAL
+    distance = math.dist((s[dyn.PX], s[dyn.PY]), (s[dyn.BX], s[dyn.BY]))
+    assert obs[dyn.BALL_PROXIMITY] == pytest.approx(1 - 2 * distance / math.hypot(52.5, 34), abs=1e-5)
 
 
 def test_seeded_episodes_are_reproducible_with_noise():
@@ -133,37 +133,39 @@ def test_noise_is_on_unless_deterministic():
         env = HalfFieldOffenseEnv(deterministic=deterministic)
         env.reset(seed=0, options={"player": (10.0, 0.0), "ball": (30.0, 0.0), "body": 0.0})
         env.step(dash())
-        results.append(env.game.px)
+        results.append(env.state[dyn.PX])
     assert results[0] == pytest.approx(10.6) and results[1] != pytest.approx(10.6, abs=1e-6)
 
 
 def test_reset_distribution_and_body_carry_over():
     env = HalfFieldOffenseEnv()
+    s = env.state
     env.reset(seed=0)
-    assert env.game.body == 0.0  # the first episode faces the goal
+    assert s[dyn.BODY] == 0.0  # the first episode faces the goal
     distances = []
     for _ in range(300):
-        env.step(TURN0 if env.game.cycles % 2 else (1, (np.zeros(2), np.array([37.0]), np.zeros(2))))
-        body = env.game.body
+        env.step(TURN0 if s[dyn.CYCLES] % 2 else (1, (np.zeros(2), np.array([37.0]), np.zeros(2))))
+        body = s[dyn.BODY]
         env.reset()
-        g = env.game
-        assert g.body == body  # carried over
-        assert 0.0 <= g.bx <= 10.5 and abs(g.by) <= 27.2 + 1e-9 and -0.1 <= g.px <= 52.5 and abs(g.py) <= 27.2 + 1e-9
-        distances.append(math.dist((g.px, g.py), (g.bx, g.by)))
+        assert s[dyn.BODY] == body  # carried over
+        bx, by, px, py = s[dyn.BX], s[dyn.BY], s[dyn.PX], s[dyn.PY]
+        m = dyn.TOUCH_DISTANCE / 2 + 1e-6  # a player placed on the ball is pushed off it, each by at most m
+        assert -m <= bx <= 10.5 + m and abs(by) <= 27.2 + m and -0.1 - m <= px <= 52.5 + m and abs(py) <= 27.2 + m
+        distances.append(math.dist((px, py), (bx, by)))
     assert 15.0 < np.mean(distances) < 24.0  # spec 2.7: mean 19.5 m
     env = HalfFieldOffenseEnv(body_reset="uniform")
-    bodies = {env.reset(seed=s)[1]["step"] or env.game.body for s in range(20)}
+    bodies = {env.reset(seed=seed)[1]["step"] or env.state[dyn.BODY] for seed in range(20)}
     assert len(bodies) == 20
 
 
 def test_reset_options_place_ball_player_and_body():
     env = HalfFieldOffenseEnv()
     env.reset(seed=0, options={"ball": (40.0, -5.0), "player": (35.0, 3.0), "body": 270.0})
-    g = env.game
-    assert (g.bx, g.by, g.px, g.py, g.body) == (40.0, -5.0, 35.0, 3.0, -90.0)
-    assert (g.pvx, g.bvx, g.stamina) == (0.0, 0.0, 8000.0)
+    s = env.state
+    assert tuple(s[[dyn.BX, dyn.BY, dyn.PX, dyn.PY, dyn.BODY]]) == (40.0, -5.0, 35.0, 3.0, -90.0)
+    assert tuple(s[[dyn.PVX, dyn.BVX, dyn.STAMINA]]) == (0.0, 0.0, 8000.0)
     env.reset(seed=0, options={"ball": (1.0, 2.0)})
-    assert (env.game.bx, env.game.by) == (1.0, 2.0)
+    assert tuple(s[[dyn.BX, dyn.BY]]) == (1.0, 2.0)
 
 
 @pytest.mark.parametrize(
@@ -211,7 +213,7 @@ def test_out_of_box_parameters_are_clamped_as_hfo_does():
     env = HalfFieldOffenseEnv(deterministic=True)
     env.reset(options={"player": (10.0, 0.0), "ball": (30.0, 0.0), "body": 0.0})
     env.step(dash(power=500.0, direction=10.0))
-    assert env.game.px == pytest.approx(10.6)
+    assert env.state[dyn.PX] == pytest.approx(10.6)
 
 
 def test_bad_constructor_arguments():
@@ -247,6 +249,8 @@ def test_scripted_scorer_scores_usually():
         while True:
             obs, _, terminated, truncated, info = env.step(scripted_scorer(obs))
             if terminated or truncated:
-                goals += info["status"] == "GOAL"
+                assert info["is_success"] == (info["status"] == "GOAL")
+                goals += info["is_success"]
                 break
+            assert "is_success" not in info  # only at the end of an episode
     assert goals >= 8

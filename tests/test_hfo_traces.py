@@ -4,7 +4,7 @@
 status, the 59 features and the agent's world model). The recording comes from HFO master, whose
 features use the ``hfo2019`` normalisers. Features recorded with a terminal status belong to the next
 episode (HFO steps three NOOP cycles first), so only statuses are compared there. The replay itself is
-``pamdp.envs.hfo_trace.replay_episode``.
+``tests/hfo_trace.py``'s ``replay_episode``.
 
 Three replays:
 
@@ -31,9 +31,9 @@ import pathlib
 
 import numpy as np
 import pytest
+from hfo_trace import PLACEMENT_NAMES, load_trace, placement, replay_episode, rounding_box
 
 from pamdp.envs.hfo import HalfFieldOffenseEnv
-from pamdp.envs.hfo_trace import PLACEMENT_NAMES, load_trace, placement, replay_episode, rounding_box
 
 DATA = pathlib.Path(__file__).parent / "data"
 TOLERANCE = 2e-3

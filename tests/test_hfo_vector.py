@@ -1,6 +1,10 @@
-"""The batched HFO env: registration, next-step autoreset, equality with the scalar env, errors."""
+"""The batched HFO env: registration, per-copy random streams (copy i is the scalar env with copy i's seed,
+noise on), next-step autoreset, reset options and masks, errors, copies, rendering."""
 
 from __future__ import annotations
+
+import copy
+import pickle
 
 import gymnasium
 import numpy as np
@@ -8,17 +12,22 @@ import pytest
 from gymnasium.vector import AutoresetMode
 
 import pamdp  # noqa: F401  (registers the envs)
-from pamdp.envs.hfo import HalfFieldOffenseEnv, HalfFieldOffenseVectorEnv
-from pamdp.envs.hfo_baseline import scripted_scorer_batch
+from pamdp.envs.hfo import HalfFieldOffenseEnv, HalfFieldOffenseVectorEnv, scripted_scorer_batch
+from pamdp.envs.hfo import dynamics as dyn
 
 
-def mixed_actions(obs, rng, space):
-    """The scorer's actions, with a third of the games acting at random (kicks, turns, odd dashes)."""
-    a, (dash, turn, kick) = scripted_scorer_batch(obs)
-    random = space.sample()
-    pick = rng.random(len(a)) < 0.33
-    a = np.where(pick, random[0], a)
-    return a, tuple(np.where(pick[:, None], r, s) for r, s in zip(random[1], (dash, turn, kick)))
+def mixed_actions(obs, rng):
+    """The scripted scorer's actions (kicks, goals, hence autoresets) with a third of the copies replaced by
+    random actions whose parameters overshoot the action space (backward dashes, clipped turns and kicks)."""
+    a, params = scripted_scorer_batch(obs)
+    a = np.array(a)
+    dash, turn, kick = (np.array(p, dtype=np.float64) for p in params)
+    i = np.flatnonzero(rng.random(a.shape[0]) < 1 / 3)
+    a[i] = rng.integers(0, 3, i.size)
+    dash[i] = rng.uniform(-150.0, 150.0, (i.size, 2))
+    turn[i] = rng.uniform(-200.0, 200.0, (i.size, 1))
+    kick[i] = rng.uniform(-20.0, 150.0, (i.size, 2))
+    return a, (dash, turn, kick)
 
 
 def test_make_vec_returns_the_batched_env():
@@ -30,71 +39,98 @@ def test_make_vec_returns_the_batched_env():
     assert obs.shape == (3, 59) and list(info["status"]) == ["IN_GAME"] * 3
 
 
-@pytest.mark.parametrize("body_reset", ["carry", "uniform"])
-def test_one_game_equals_the_scalar_env_across_episodes(body_reset):
-    kwargs = dict(deterministic=True, body_reset=body_reset)
-    scalar, batched = HalfFieldOffenseEnv(**kwargs), HalfFieldOffenseVectorEnv(num_envs=1, **kwargs)
-    obs, _ = scalar.reset(seed=7)
-    batch_obs, _ = batched.reset(seed=7)
-    rng, space = np.random.default_rng(0), batched.action_space
-    space.seed(0)
-    episodes = 0
-    for _ in range(700):
-        np.testing.assert_array_equal(batch_obs[0], obs)
-        actions = mixed_actions(batch_obs, rng, space)
-        obs, reward, terminated, truncated, info = scalar.step((int(actions[0][0]), tuple(p[0] for p in actions[1])))
-        batch_obs, b_reward, b_terminated, b_truncated, b_info = batched.step(actions)
-        np.testing.assert_array_equal(batch_obs[0], obs)
-        assert (b_reward[0], b_terminated[0], b_truncated[0]) == (reward, terminated, truncated)
-        assert (b_info["status"][0], b_info["step"][0]) == (info["status"], info["step"])
-        if terminated or truncated:
-            episodes += 1
-            obs, _ = scalar.reset()
-            batch_obs, b_reward, b_terminated, b_truncated, b_info = batched.step(actions)  # autoreset step
-            assert (b_reward[0], b_terminated[0], b_truncated[0], b_info["step"][0]) == (0.0, False, False, 0)
-    assert episodes >= 5
+@pytest.mark.parametrize(
+    "kwargs, seed, options",
+    [
+        ({}, 7, None),
+        ({"body_reset": "uniform"}, [40, 3, 17, 3, 8, 100], None),
+        ({"profile": "hfo2016", "deterministic": True}, 5, {"body": np.linspace(-170.0, 170.0, 6)}),
+        (
+            {"profile": "hfo2019", "timeout_terminal": True, "first_step_reward": True, "terminal_deltas": True},
+            2,
+            {"ball": (30.0, 5.0), "player": np.tile((29.8, 5.0), (6, 1)), "body": 45.0},
+        ),
+    ],
+)
+def test_copy_i_equals_the_scalar_env_with_its_seed(kwargs, seed, options):
+    """Per-copy random streams: each copy of a batch of 6 follows a scalar env reset with that copy's seed
+    (``seed + i``, or the list's entry) and options, step for step, with the actuator noise on, across
+    autoresets: observations, rewards, flags, statuses and outcomes are equal, not close."""
+    n, steps = 6, 400
+    batched = HalfFieldOffenseVectorEnv(num_envs=n, **kwargs)
+    scalars = [HalfFieldOffenseEnv(**kwargs) for _ in range(n)]
+    seeds = seed if isinstance(seed, list) else [seed + i for i in range(n)]
 
+    def copy_options(i):
+        if options is None:
+            return None
+        return {k: (v[i] if np.ndim(v) == (1 if k == "body" else 2) else v) for k, v in options.items()}
 
-def test_many_games_equal_scalar_envs_placed_alike():
-    """As above for 16 games; NumPy's SIMD sin/cos on long arrays may differ from libm in the last bit."""
-    n = 16
-    batched = HalfFieldOffenseVectorEnv(num_envs=n, deterministic=True)
-    scalars = [HalfFieldOffenseEnv(deterministic=True) for _ in range(n)]
-    batch_obs, _ = batched.reset(seed=1)
-
-    def place(i):
-        options = {"ball": (batched.bx[i], batched.by[i]), "player": (batched.px[i], batched.py[i])}
-        scalars[i].game.body = batched.body[i]
-        return scalars[i].reset(options=options)[0]
-
-    obs = [place(i) for i in range(n)]
-    rng, space = np.random.default_rng(1), batched.action_space
-    space.seed(1)
-    ended, boundaries = np.zeros(n, dtype=bool), 0
-    for _ in range(400):
-        actions = mixed_actions(batch_obs, rng, space)
+    batch_obs, _ = batched.reset(seed=seed, options=options)
+    obs = [scalars[i].reset(seed=seeds[i], options=copy_options(i))[0] for i in range(n)]
+    rng = np.random.default_rng(0)
+    ended, endings, goals = np.zeros(n, dtype=bool), 0, 0
+    for t in range(steps):
+        for i in range(n):
+            np.testing.assert_array_equal(batch_obs[i], obs[i], err_msg=f"step {t}, copy {i}")
+        actions = mixed_actions(batch_obs, rng)
         batch_obs, reward, terminated, truncated, info = batched.step(actions)
         for i in range(n):
-            if ended[i]:  # this step reset game i: copy the new placement into its scalar twin
-                obs[i] = place(i)
-                boundaries += 1
-            else:
-                obs[i], r, te, tr, inf = scalars[i].step((int(actions[0][i]), tuple(p[i] for p in actions[1])))
-                assert (terminated[i], truncated[i], info["status"][i]) == (te, tr, inf["status"])
-                assert reward[i] == pytest.approx(r, rel=1e-9, abs=1e-12)
-            np.testing.assert_allclose(batch_obs[i], obs[i], atol=1e-6)
+            if ended[i]:  # the next-step autoreset: the scalar env is reset by hand
+                obs[i], _ = scalars[i].reset()
+                assert (reward[i], terminated[i], truncated[i], info["step"][i]) == (0.0, False, False, 0)
+                assert not info["_is_success"][i]
+                continue
+            obs[i], r, te, tr, inf = scalars[i].step((int(actions[0][i]), tuple(p[i] for p in actions[1])))
+            assert (reward[i], terminated[i], truncated[i]) == (r, te, tr), f"step {t}, copy {i}"
+            assert (info["status"][i], info["step"][i]) == (inf["status"], inf["step"])
+            assert info["_is_success"][i] == ("is_success" in inf)
+            if te or tr:
+                assert info["is_success"][i] == inf["is_success"] == (inf["status"] == "GOAL")
+                endings += 1
+                goals += inf["is_success"]
         ended = terminated | truncated
-    assert boundaries >= 10
+    np.testing.assert_array_equal(batch_obs, np.stack(obs))
+    assert endings >= 2 * n and goals >= n  # several episodes per copy, goals among them
 
 
-def test_reset_options_per_game_and_broadcast():
+def test_a_copy_does_not_depend_on_the_number_of_copies():
+    small, large = HalfFieldOffenseVectorEnv(num_envs=2), HalfFieldOffenseVectorEnv(num_envs=9)
+    obs_small, _ = small.reset(seed=3)
+    obs_large, _ = large.reset(seed=3)
+    rng = np.random.default_rng(1)
+    for _ in range(150):
+        a, params = mixed_actions(obs_large, rng)
+        obs_large, reward_large, *_ = large.step((a, params))
+        obs_small, reward_small, *_ = small.step((a[:2], tuple(p[:2] for p in params)))
+        np.testing.assert_array_equal(obs_small, obs_large[:2])
+        np.testing.assert_array_equal(reward_small, reward_large[:2])
+
+
+def test_reset_mask_resets_only_the_masked_copies():
+    env = HalfFieldOffenseVectorEnv(num_envs=3)
+    env.reset(seed=0)
+    turn = (np.ones(3, int), (np.zeros((3, 2)), np.full((3, 1), 30.0), np.zeros((3, 2))))
+    for _ in range(5):
+        env.step(turn)
+    before = env.states.copy()
+    obs, info = env.reset(options={"reset_mask": np.array([False, True, False]), "ball": (20.0, 1.0)})
+    np.testing.assert_array_equal(env.states[[0, 2]], before[[0, 2]])
+    assert (env.states[1, dyn.BX], env.states[1, dyn.BY], env.states[1, dyn.STEPS]) == (20.0, 1.0, 0.0)
+    assert env.states[1, dyn.BODY] == before[1, dyn.BODY]  # no seed: the body angle carries over
+    assert obs.shape == (3, 59) and list(info["step"]) == [5, 0, 5]
+
+
+def test_reset_options_per_copy_and_broadcast():
     env = HalfFieldOffenseVectorEnv(num_envs=2)
     env.reset(seed=0, options={"ball": [(1.0, 2.0), (3.0, 4.0)], "body": 90.0})
-    assert env.bx.tolist() == [1.0, 3.0] and env.body.tolist() == [90.0, 90.0]
-    with pytest.raises(ValueError, match="outside"):
+    assert env.states[:, dyn.BX].tolist() == [1.0, 3.0] and env.states[:, dyn.BODY].tolist() == [90.0, 90.0]
+    with pytest.raises(ValueError, match=r"ball=\(99.0, 4.0\) is outside"):
         env.reset(options={"ball": [(1.0, 2.0), (99.0, 4.0)]})
     with pytest.raises(ValueError, match="body"):
         env.reset(options={"body": "x"})
+    with pytest.raises(ValueError, match="seed=2.5"):
+        env.reset(seed=2.5)
 
 
 @pytest.mark.parametrize(
@@ -115,10 +151,26 @@ def test_bad_batched_actions_raise_clear_errors(make, words):
     assert all(w in str(error.value) for w in words), str(error.value)
 
 
+def test_a_copied_batched_env_goes_on_as_the_original():
+    env = HalfFieldOffenseVectorEnv(num_envs=3)
+    env.reset(seed=1)
+    env.action_space.seed(0)
+    for _ in range(5):
+        env.step(env.action_space.sample())
+    copies = [copy.deepcopy(env), pickle.loads(pickle.dumps(env))]
+    for _ in range(60):
+        action = env.action_space.sample()
+        obs, reward, *_ = env.step(action)
+        for other in copies:
+            obs2, reward2, *_ = other.step(action)
+            np.testing.assert_array_equal(obs2, obs)
+            np.testing.assert_array_equal(reward2, reward)
+
+
 def test_noise_and_render():
     env = HalfFieldOffenseVectorEnv(num_envs=2, render_mode="rgb_array")
     env.reset(seed=0, options={"player": (10.0, 0.0), "ball": (30.0, 0.0), "body": 0.0})
     env.step((np.zeros(2, int), (np.tile([100.0, 0.0], (2, 1)), np.zeros((2, 1)), np.zeros((2, 2)))))
-    assert env.px[0] != env.px[1]  # independent actuator noise
+    assert env.states[0, dyn.PX] != env.states[1, dyn.PX]  # independent actuator noise
     frames = env.render()
     assert len(frames) == 2 and frames[0].dtype == np.uint8

@@ -20,14 +20,17 @@ from __future__ import annotations
 import argparse
 import json
 import pathlib
+import sys
 import time
 
 import numpy as np
 
 from pamdp.envs.hfo import HalfFieldOffenseEnv
-from pamdp.envs.hfo_trace import PLACEMENT_NAMES, load_trace, placement, replay_episode, rounding_box
 
 HERE = pathlib.Path(__file__).parent
+sys.path.insert(0, str(HERE.parent))  # the replay lives beside its tests
+from hfo_trace import PLACEMENT_NAMES, load_trace, placement, replay_episode, rounding_box  # noqa: E402
+
 TRACE = HERE / "hfo_traces_seed42.json.gz"
 OUT = HERE / "hfo_trace_placements.json"
 

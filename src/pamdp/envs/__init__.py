@@ -1,7 +1,7 @@
 """Parameterized-action domains, registered with Gymnasium on ``import pamdp``.
 
 - ``pamdp/Platform-v0``: Masson, Ranchod & Konidaris' Platform (``platform.py``).
-- ``pamdp/HalfFieldOffense-v0``: Half Field Offense 1v0, empty goal (``hfo.py``).
+- ``pamdp/HalfFieldOffense-v0``: Half Field Offense 1v0, empty goal (``hfo/``).
 
 Each has a scalar ``gymnasium.Env`` and a batched NumPy ``gymnasium.vector.VectorEnv`` registered as
 its ``vector_entry_point``, so ``gymnasium.make_vec(id, num_envs=N,
@@ -19,8 +19,8 @@ _REGISTRATIONS = {
         max_episode_steps=200,
     ),
     "pamdp/HalfFieldOffense-v0": dict(
-        entry_point="pamdp.envs.hfo:HalfFieldOffenseEnv",
-        vector_entry_point="pamdp.envs.hfo:HalfFieldOffenseVectorEnv",
+        entry_point="pamdp.envs.hfo.env:HalfFieldOffenseEnv",
+        vector_entry_point="pamdp.envs.hfo.batched:HalfFieldOffenseVectorEnv",
     ),
 }
 

@@ -12,7 +12,8 @@ to within half a unit of its last digit (:func:`rounding_box`). A few episodes a
 running into a ball one millimetre away pushes it off in a direction set by the last 1e-5 m, and a chain
 of kicks, whose power depends on the ball's distance, multiplies a small error at every kick.
 :func:`replay_episode` therefore accepts an ``initial`` placement inside that box; see
-``tests/test_hfo_traces.py`` for how the test uses it.
+``tests/test_hfo_traces.py`` for how the test uses it; ``tests/data/refine_hfo_trace_placements.py`` is its
+other user.
 """
 
 from __future__ import annotations
@@ -25,7 +26,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["EpisodeReplay", "load_trace", "placement", "replay_episode", "rounding_box", "set_state"]
+from pamdp.envs.hfo.dynamics import BODY, BVX, BVY, BX, BY, PREV_BX, PREV_BY, PVX, PVY, PX, PY, STAMINA, sense
 
 ACTION_IDS = {"DASH": 0, "TURN": 1, "KICK": 2}
 #: ``initial_wm`` indices of the placement a reset takes: player x, y, body angle, ball x, y.
@@ -87,10 +88,11 @@ def rounding_box(values: np.ndarray, digits: int = 6) -> np.ndarray:
 
 def set_state(env, wm: list[float]) -> None:
     """Put the simulator in a recorded world-model state (positions, velocities, body, stamina)."""
-    g = env.unwrapped.game
-    g.px, g.py, g.pvx, g.pvy, g.body, g.stamina, g.bx, g.by, g.bvx, g.bvy = map(float, wm[1:11])
-    g.prev_bx, g.prev_by = g.bx, g.by
-    g.sense()
+    s = env.unwrapped.state
+    for k, value in zip((PX, PY, PVX, PVY, BODY, STAMINA, BX, BY, BVX, BVY), wm[1:11]):
+        s[k] = float(value)
+    s[PREV_BX], s[PREV_BY] = s[BX], s[BY]
+    sense(s)
 
 
 def replay_episode(

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pamdp.envs.hfo_features import BALL_COS, BALL_SIN, GOAL_COS, GOAL_SIN, KICKABLE
+from pamdp.envs.hfo.dynamics import BALL_COS, BALL_SIN, GOAL_COS, GOAL_SIN, KICKABLE
 
 TURN_THRESHOLD = 10.0
 """Degrees off the body beyond which the scorer turns to the ball instead of dashing."""

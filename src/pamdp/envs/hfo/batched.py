@@ -1,0 +1,94 @@
+"""N copies of HFO 1v0 stepped at once: ``gymnasium.make_vec("pamdp/HalfFieldOffense-v0", num_envs=N)``.
+
+The copies run ``dynamics.step_copy``, the scalar env's step, in one compiled loop
+(``dynamics.step_batch``); each copy draws from its own generator (``pamdp.envs.vector``), so copy i
+follows a scalar env reset with copy i's seed step for step, noise included.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from pamdp.envs.hfo import dynamics as dyn
+from pamdp.envs.hfo.env import BUFFER_SIZE, HalfFieldOffenseEnv
+from pamdp.envs.hfo.interface import draw_half_field, parse_actions, reset_options
+from pamdp.envs.vector import BatchedVectorEnv, copy_seeds
+
+_STATUS_NAMES = np.array(dyn.STATUS_NAMES)
+
+
+class HalfFieldOffenseVectorEnv(BatchedVectorEnv):
+    """``num_envs`` HFO 1v0 games, with Gymnasium's next-step autoreset.
+
+    Takes the keyword arguments of :class:`pamdp.envs.hfo.HalfFieldOffenseEnv`. Actions are the
+    ``batch_space`` of the scalar action space: ``(a[N], (dash[N, 2], turn[N, 1], kick[N, 2]))``. A copy
+    that ended on the previous step is reset instead of stepped (its action is ignored) and returns its
+    first observation with reward 0. ``infos`` holds ``status`` (strings) and ``step`` per copy, and
+    ``is_success`` (a goal) for the copies whose episode ended (``_is_success``). ``reset(options=...)``
+    takes the scalar env's options, each once for every copy or per copy (a leading axis of size N),
+    and the shell's ``reset_mask``.
+
+    Seeding: ``reset(seed=s)`` seeds copy i with ``s + i`` (or ``reset(seed=[...])`` one seed each) and,
+    as in the scalar env, turns its player to face the goal. ``states`` holds one state vector per copy
+    (indices in ``dynamics``).
+    """
+
+    draw = "random"
+    draws_per_step = dyn.MAX_DRAWS_PER_STEP
+    buffer_size = BUFFER_SIZE
+
+    def __init__(
+        self,
+        num_envs: int = 1,
+        render_mode: str | None = None,
+        profile: str = "hfo2017",
+        deterministic: bool = False,
+        timeout_terminal: bool = False,
+        body_reset: str = "carry",
+        first_step_reward: bool = False,
+        terminal_deltas: bool = False,
+        max_episode_steps: int | None = None,
+    ):
+        single = HalfFieldOffenseEnv(
+            render_mode, profile, deterministic, timeout_terminal, body_reset, first_step_reward, terminal_deltas
+        )
+        super().__init__(num_envs, single, max_episode_steps, render_mode)
+        self.profile, self.settings = single.profile, single.settings
+        self.states = np.zeros((self.num_envs, dyn.STATE_SIZE))
+        self._seeded = np.zeros(self.num_envs, dtype=bool)
+
+    def reset(self, *, seed=None, options: dict | None = None):
+        self._seeded = np.array([s is not None for s in copy_seeds(seed, self.num_envs)])
+        return super().reset(seed=seed, options=options)
+
+    def render(self):
+        if self.render_mode != "rgb_array":
+            return None
+        return tuple(draw_half_field(s) for s in self.states)
+
+    def _reset_copies(self, mask, options):
+        placements = reset_options(options, self.num_envs, shell_keys=("reset_mask",))
+        self.states[mask & self._seeded, dyn.BODY] = 0.0  # a new server run faces the goal
+        obs = np.empty((self.num_envs, self.profile.n_features), dtype=np.float32)
+        dyn.reset_batch(self.states, self.streams.buffers, self.streams.cursors, mask, self.settings, placements, obs)
+        return obs, self._infos()
+
+    def _step_copies(self, actions, resetting):
+        n = self.num_envs
+        a, dash, turn, kick = parse_actions(actions, n)
+        obs = np.empty((n, self.profile.n_features), dtype=np.float32)
+        reward, status = np.empty(n), np.empty(n, dtype=np.int64)
+        terminated, truncated = np.empty(n, dtype=bool), np.empty(n, dtype=bool)
+        dyn.step_batch(
+            self.states, self.streams.buffers, self.streams.cursors, a, dash, turn, kick, resetting, self.settings,
+            obs, reward, status, terminated, truncated,
+        )  # fmt: skip
+        infos = self._infos(status)
+        infos["is_success"], infos["_is_success"] = status == dyn.GOAL, terminated | truncated
+        return obs, reward, terminated, truncated, infos
+
+    def _infos(self, status=None) -> dict:
+        every = np.ones(self.num_envs, dtype=bool)
+        names = _STATUS_NAMES[status] if status is not None else np.full(self.num_envs, "IN_GAME")
+        steps = self.states[:, dyn.STEPS].astype(np.int64)
+        return {"status": names, "_status": every, "step": steps, "_step": every}

@@ -1,0 +1,201 @@
+"""What the scalar and the batched HFO env share at their boundary: the action space and the checks of
+actions, settings and reset options, and the top-down drawing for ``render_mode="rgb_array"``."""
+
+from __future__ import annotations
+
+import functools
+import math
+
+import numpy as np
+from gymnasium import spaces
+
+from pamdp.envs.hfo import dynamics as dyn
+from pamdp.envs.rendering import Canvas
+
+ACTION_NAMES = ("DASH", "TURN", "KICK")
+PARAM_SIZES = (2, 1, 2)
+PARAM_LOW = (np.array([0.0, -180.0]), np.array([-180.0]), np.array([0.0, -180.0]))
+PARAM_HIGH = (np.array([100.0, 180.0]), np.array([180.0]), np.array([100.0, 180.0]))
+ACTION_FORM = "(a, (dash[power, direction], turn[direction], kick[power, direction])) with a in {0, 1, 2}"
+#: Order of the reset options in the vector the compiled reset reads (NaN where not given).
+OPTION_SLOTS = {"ball": slice(0, 2), "player": slice(2, 4), "body": slice(4, 5)}
+
+
+def hfo_action_space() -> spaces.Tuple:
+    """``Tuple(Discrete(3), Tuple(Box(2), Box(1), Box(2)))`` in HFO's units (powers 0-100, degrees)."""
+    boxes = tuple(
+        spaces.Box(lo.astype(np.float32), hi.astype(np.float32), dtype=np.float32)
+        for lo, hi in zip(PARAM_LOW, PARAM_HIGH)
+    )
+    return spaces.Tuple((spaces.Discrete(3), spaces.Tuple(boxes)))
+
+
+def check_settings(profile: str, body_reset: str, render_mode) -> None:
+    """Raise ``ValueError`` for an unknown feature profile, body-reset rule or render mode."""
+    if profile not in dyn.PROFILES:
+        raise ValueError(f"profile={profile!r} is not one of {sorted(dyn.PROFILES)}")
+    if body_reset not in ("carry", "uniform"):
+        raise ValueError(f"body_reset={body_reset!r}; expected 'carry' (HFO's behaviour) or 'uniform'")
+    if render_mode not in (None, "rgb_array"):
+        raise ValueError(f"render_mode={render_mode!r}; expected None or 'rgb_array'")
+
+
+def parse_action(action) -> tuple[int, float, float]:
+    """``(a, first parameter, second parameter)`` of one action; ranges are clamped later, as HFO does."""
+    try:
+        a_raw, params = action
+        a = int(a_raw)
+    except (TypeError, ValueError):
+        raise ValueError(f"action {action!r} is malformed; expected {ACTION_FORM}") from None
+    if a != a_raw or not 0 <= a <= 2:
+        raise ValueError(f"discrete action {a_raw!r} is not 0 (DASH), 1 (TURN) or 2 (KICK)")
+    try:
+        p = params[a] if len(params) == 3 else None
+        x = p.tolist() if isinstance(p, np.ndarray) else list(p)
+    except (TypeError, ValueError, IndexError):
+        x = None
+    if not isinstance(x, list) or len(x) != PARAM_SIZES[a]:
+        raise ValueError(
+            f"parameters {params!r} are malformed for {ACTION_NAMES[a]}; expected {ACTION_FORM}, "
+            f"{ACTION_NAMES[a]}'s entry holding {PARAM_SIZES[a]} number(s)"
+        )
+    try:
+        x0, x1 = float(x[0]), float(x[-1])
+    except (TypeError, ValueError):
+        x0 = x1 = math.nan
+    if not (math.isfinite(x0) and math.isfinite(x1)):
+        raise ValueError(f"{ACTION_NAMES[a]} parameters {x} must be finite numbers")
+    return a, x0, x1
+
+
+def parse_actions(actions, n: int):
+    """A batch of actions as ``(a, dash, turn, kick)``: int64 (N,) and float64 (N, 2), (N, 1), (N, 2);
+    ``ValueError`` if malformed, or if a copy's chosen action has non-finite parameters."""
+    expected = f"{ACTION_FORM}, batched: (a[{n}], (dash[{n}, 2], turn[{n}, 1], kick[{n}, 2]))"
+    try:
+        a_raw, params = actions
+        a = np.asarray(a_raw)
+        boxes = [np.ascontiguousarray(p, dtype=np.float64) for p in params]
+    except (TypeError, ValueError):
+        raise ValueError(f"actions are malformed; expected {expected}") from None
+    if a.shape != (n,) or len(boxes) != 3 or any(b.shape != (n, m) for b, m in zip(boxes, PARAM_SIZES)):
+        shapes = (a.shape, tuple(b.shape for b in boxes)) if len(boxes) == 3 else a.shape
+        raise ValueError(f"actions have shapes {shapes}; expected {expected}")
+    if not (a.dtype.kind in "iu" or np.all(a == np.round(a))) or np.count_nonzero((a < 0) | (a > 2)):
+        raise ValueError(f"discrete actions {a.tolist()} must be integers 0 (DASH), 1 (TURN) or 2 (KICK)")
+    a = a.astype(np.int64, copy=False)
+    dash, turn, kick = boxes
+    # A finite sum means every parameter is finite (an overflow only sends us to the exact check).
+    if not np.isfinite(dash.sum() + turn.sum() + kick.sum()):
+        x0 = np.choose(a, (dash[:, 0], turn[:, 0], kick[:, 0]))
+        x1 = np.choose(a, (dash[:, 1], turn[:, 0], kick[:, 1]))
+        bad = np.flatnonzero(~(np.isfinite(x0) & np.isfinite(x1)))
+        if bad.size:
+            i = int(bad[0])
+            raise ValueError(f"copy {i}: action {int(a[i])} has non-finite parameters ({x0[i]}, {x1[i]})")
+    return a, dash, turn, kick
+
+
+def reset_options(options, n: int, shell_keys: tuple[str, ...] = ()) -> np.ndarray:
+    """``reset(options=...)`` as an ``(n, 5)`` array (ball x, y, player x, y, body; NaN where not given).
+
+    Any of ``ball`` (x, y), ``player`` (x, y), ``body`` (degrees), each once for every copy or one per copy
+    (a leading axis of size n). The ball must lie in HFO's play area (0 <= x <= 52.5, |y| <= 34), the
+    player on the pitch (|x| <= 52.5, |y| <= 34). ``shell_keys`` (the batched env's ``reset_mask``) are
+    let through for the caller.
+    """
+    out = np.full((n, 5), np.nan)
+    if options is None:
+        return out
+    if not isinstance(options, dict):
+        raise ValueError(f"reset options must be a dict, got {type(options).__name__}")
+    unknown = set(options) - {*OPTION_SLOTS, *shell_keys}
+    if unknown:
+        raise ValueError(f"unknown reset option(s) {sorted(unknown)}; expected any of 'ball', 'player', 'body'")
+    for key, slots in OPTION_SLOTS.items():
+        if key in options:
+            out[:, slots] = _option(key, options[key], n).reshape(-1, slots.stop - slots.start)
+    return out
+
+
+def _option(key: str, value, n: int) -> np.ndarray:
+    """One reset option, checked, as an array of shape (2,) or () or, given per copy, (n, 2) or (n,)."""
+    point = key != "body"
+    try:
+        arr = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        arr = None
+    shapes = ((2,), (n, 2)) if point else ((), (n,))
+    if arr is None or arr.shape not in shapes or not np.all(np.isfinite(arr)):
+        if point:
+            raise ValueError(f"reset option {key}={value!r}; expected a pair of finite numbers (x, y) in metres")
+        raise ValueError(f"reset option body={value!r}; expected one finite angle in degrees")
+    if point:
+        x_lo = 0.0 if key == "ball" else -dyn.PITCH_HALF_LENGTH
+        for x, y in arr.reshape(-1, 2):
+            if not (x_lo <= x <= dyn.PITCH_HALF_LENGTH and abs(y) <= dyn.PITCH_HALF_WIDTH):
+                raise ValueError(
+                    f"reset option {key}={(float(x), float(y))} is outside the allowed area "
+                    f"{x_lo} <= x <= {dyn.PITCH_HALF_LENGTH}, |y| <= {dyn.PITCH_HALF_WIDTH}"
+                )
+    return arr
+
+
+# --- drawing -----------------------------------------------------------------------------------
+_PX_PER_M = 6.0
+_X_MIN, _X_MAX, _Y_MAX = -3.0, 56.0, 37.0
+_GRASS, _LINE, _GOAL, _BALL, _PLAYER = (60, 140, 60), (240, 240, 240), (200, 200, 200), (250, 250, 250), (30, 80, 220)
+
+
+def _to_px(x: float, y: float) -> tuple[float, float]:
+    return (x - _X_MIN) * _PX_PER_M, (y + _Y_MAX) * _PX_PER_M
+
+
+@functools.lru_cache(maxsize=1)
+def _field_image() -> np.ndarray:
+    """The static part of every frame: grass, touch and goal lines, penalty box, goal and posts."""
+    canvas = Canvas(int((_X_MAX - _X_MIN) * _PX_PER_M), int(2 * _Y_MAX * _PX_PER_M), _GRASS)
+
+    def hline(x0, x1, y, width=1.6):
+        (a, b), (c, _) = _to_px(x0, y), _to_px(x1, y)
+        canvas.rect(a, b - width / 2, c, b + width / 2, _LINE)
+
+    def vline(x, y0, y1, width=1.6):
+        (a, b), (_, d) = _to_px(x, y0), _to_px(x, y1)
+        canvas.rect(a - width / 2, b, a + width / 2, d, _LINE)
+
+    L, W = dyn.PITCH_HALF_LENGTH, dyn.PITCH_HALF_WIDTH
+    gw = dyn.GOAL_HALF_WIDTH
+    canvas.rect(*_to_px(L, -gw), *_to_px(L + 2.44, gw), _GOAL)
+    hline(0, L, -W, 2.0)
+    hline(0, L, W, 2.0)
+    vline(0, -W, W, 2.0)
+    vline(L, -W, W, 2.0)
+    pa_x, pa_w = dyn.PENALTY_AREA_X, dyn.PENALTY_AREA_HALF_WIDTH
+    vline(pa_x, -pa_w, pa_w)
+    hline(pa_x, L, -pa_w)
+    hline(pa_x, L, pa_w)
+    for sy in (-1.0, 1.0):
+        canvas.circle(*_to_px(dyn.POST_X, sy * dyn.POST_Y), 2.0, (20, 20, 20))
+    canvas.image.flags.writeable = False
+    return canvas.image
+
+
+def draw_half_field(state: np.ndarray) -> np.ndarray:
+    """An ``(H, W, 3)`` uint8 top view of the attacked half of one copy's ``state``: lines, goal, posts,
+    penalty box, ball, player.
+
+    The player is a blue disc with a white line along its body direction; y grows downwards as in the
+    server's frame.
+    """
+    px, py, body, bx, by = (float(state[k]) for k in (dyn.PX, dyn.PY, dyn.BODY, dyn.BX, dyn.BY))
+    field = _field_image()
+    canvas = Canvas(field.shape[1], field.shape[0])
+    canvas.image[:] = field
+    radius = max(dyn.BALL_SIZE * _PX_PER_M, 2.5)
+    canvas.circle(*_to_px(bx, by), radius, _BALL)
+    canvas.circle(*_to_px(bx, by), radius, (0, 0, 0), outline=1.0)
+    canvas.circle(*_to_px(px, py), max(dyn.PLAYER_SIZE * _PX_PER_M, 4.0), _PLAYER)
+    theta = math.radians(body)
+    canvas.line(*_to_px(px, py), *_to_px(px + 1.2 * math.cos(theta), py + 1.2 * math.sin(theta)), _LINE, 2.0)
+    return canvas.image
