@@ -6,6 +6,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from pamdp.algos.logger import success_summary, successes
 from pamdp.algos.vector_env import make_vector_env
 
 if TYPE_CHECKING:
@@ -27,8 +28,8 @@ def evaluate(
 
     Each of the ``num_envs`` copies plays a fixed share of the episodes, so that short episodes are not
     over-represented. Returns ``mean_return``, ``std_return``, ``mean_length`` and ``episodes``; when the
-    env reports ``info["status"]`` (Half Field Offense), also ``goal_rate`` and ``mean_steps_to_goal``
-    (``None`` when no goal was scored).
+    env reports ``info["is_success"]`` at an episode's end (Half Field Offense: a goal), also ``goal_rate``
+    and ``mean_steps_to_goal`` (``None`` when no episode succeeded), over the episodes that reported it.
     """
     if episodes < 1:
         raise ValueError(f"episodes = {episodes!r}; expected an integer >= 1")
@@ -40,7 +41,7 @@ def evaluate(
     quota = np.array([episodes // num_envs + (i < episodes % num_envs) for i in range(num_envs)])
     returns: list[float] = []
     lengths: list[int] = []
-    statuses: list[str] = []
+    succeeded: list[bool | None] = []
     ep_return, ep_length = np.zeros(num_envs), np.zeros(num_envs, dtype=np.int64)
     done_count = np.zeros(num_envs, dtype=np.int64)
     prev_done = np.zeros(num_envs, dtype=bool)
@@ -53,12 +54,11 @@ def evaluate(
             ep_return += np.where(valid, reward, 0.0)
             ep_length += valid
             done = (terminated | truncated) & valid
-            for i in np.flatnonzero(done):
+            for i, success in zip(np.flatnonzero(done), successes(info, done)):
                 if done_count[i] < quota[i]:
                     returns.append(float(ep_return[i]))
                     lengths.append(int(ep_length[i]))
-                    if "status" in info:
-                        statuses.append(str(info["status"][i]))
+                    succeeded.append(success)
                     done_count[i] += 1
             ep_return[done], ep_length[done] = 0.0, 0
             prev_done = done
@@ -70,8 +70,7 @@ def evaluate(
         "mean_length": float(np.mean(lengths)),
         "episodes": len(returns),
     }
-    if statuses:
-        goals = np.array([s == "GOAL" for s in statuses])
-        result["goal_rate"] = float(goals.mean())
-        result["mean_steps_to_goal"] = float(np.mean(np.array(lengths)[goals])) if goals.any() else None
+    summary = success_summary(lengths, succeeded)
+    if summary is not None:
+        result["goal_rate"], result["mean_steps_to_goal"] = summary
     return result

@@ -159,8 +159,8 @@ class Algorithm:
             run_dir: where to write ``progress.csv``, TensorBoard logs (``tb/``) and ``checkpoint.pt``.
             checkpoint_every: epochs between checkpoints (with ``run_dir``).
             eval_every: epochs between greedy evaluations (0: none), logged as ``eval/mean_return`` (and
-                ``eval/goal_rate`` on Half Field Offense). They play ``eval_episodes`` episodes on separate
-                env copies seeded ``10_000 + seed`` and draw nothing from the training's random streams.
+                ``eval/goal_rate`` where the env reports ``is_success``). They play ``eval_episodes`` episodes on
+                separate env copies seeded ``10_000 + seed`` and draw nothing from the training's random streams.
         """
         from tqdm.auto import tqdm
 

@@ -9,16 +9,37 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["EpisodeTracker", "Logger"]
+__all__ = ["EpisodeTracker", "Logger", "successes", "success_summary"]
+
+
+def successes(info: dict | None, ended: np.ndarray) -> list[bool | None]:
+    """``info["is_success"]`` of the copies where ``ended``, from a vector env's step: ``None`` for a copy
+    that did not report it (Gymnasium's mask ``info["_is_success"]`` false, or no such key at all)."""
+    if info is None or "is_success" not in info:
+        return [None] * int(np.sum(ended))
+    success = np.asarray(info["is_success"], dtype=bool)
+    reported = np.asarray(info.get("_is_success", np.ones(len(success), dtype=bool)), dtype=bool)
+    return [bool(s) if r else None for s, r in zip(success[ended], reported[ended])]
+
+
+def success_summary(lengths: list[int], succeeded: list[bool | None]) -> tuple[float, float | None] | None:
+    """``(success rate, mean length of the successful episodes)`` over the episodes that reported success
+    (``None`` for the length when none succeeded); ``None`` when no episode reported it."""
+    known = [(n, s) for n, s in zip(lengths, succeeded) if s is not None]
+    if not known:
+        return None
+    steps = [n for n, s in known if s]
+    return float(np.mean([s for _, s in known])), (float(np.mean(steps)) if steps else None)
 
 
 class EpisodeTracker:
     """Running return and length per env copy; completed episodes are kept until :meth:`pop`.
 
-    Where the env reports an episode's outcome as ``info["status"]`` (Half Field Offense: ``"GOAL"``,
-    ``"OUT_OF_BOUNDS"``, ...), the goal rate and the mean length of scoring episodes are kept too, the training
-    counterparts of :func:`pamdp.evaluation.evaluate`'s ``goal_rate`` and ``mean_steps_to_goal``, logged as
-    ``charts/goal_rate`` and ``charts/steps_to_goal`` (over the episodes whose end came with a status).
+    Where the env says whether an episode succeeded (``info["is_success"]`` at its end, the Gymnasium and SB3
+    convention; a goal on Half Field Offense), the success rate and the mean length of the successful episodes
+    are kept too, over the episodes whose end reported it: the training counterparts of
+    :func:`pamdp.evaluation.evaluate`'s ``goal_rate`` and ``mean_steps_to_goal``, logged as ``charts/goal_rate``
+    and ``charts/steps_to_goal`` (the names of the recorded runs, all on soccer).
     """
 
     def __init__(self, num_envs: int):
@@ -26,7 +47,7 @@ class EpisodeTracker:
         self.lengths = np.zeros(num_envs, dtype=np.int64)
         self.done_returns: list[float] = []
         self.done_lengths: list[int] = []
-        self.done_goals: list[bool | None] = []  # per ended episode; None where the env reported no status
+        self.done_goals: list[bool | None] = []  # per ended episode; None where the env reported no success
 
     def reset(self) -> None:
         self.returns[:] = 0.0
@@ -40,10 +61,7 @@ class EpisodeTracker:
         self.done_returns += self.returns[ended].tolist()
         self.done_lengths += self.lengths[ended].tolist()
         if ended.any():
-            if info is not None and "status" in info:
-                self.done_goals += [str(s) == "GOAL" for s in np.asarray(info["status"], dtype=object)[ended]]
-            else:
-                self.done_goals += [None] * int(ended.sum())
+            self.done_goals += successes(info, ended)
         self.returns[ended] = 0.0
         self.lengths[ended] = 0
 
@@ -56,12 +74,11 @@ class EpisodeTracker:
             "charts/episodic_length": float(np.mean(self.done_lengths)),
             "charts/episodes": float(len(self.done_returns)),
         }
-        known = [(n, g) for n, g in zip(self.done_lengths, self.done_goals) if g is not None]
-        if known:
-            stats["charts/goal_rate"] = float(np.mean([g for _, g in known]))
-            scoring = [n for n, g in known if g]
-            if scoring:
-                stats["charts/steps_to_goal"] = float(np.mean(scoring))
+        summary = success_summary(self.done_lengths, self.done_goals)
+        if summary is not None:
+            stats["charts/goal_rate"] = summary[0]
+            if summary[1] is not None:
+                stats["charts/steps_to_goal"] = summary[1]
         self.done_returns, self.done_lengths, self.done_goals = [], [], []
         return stats
 
