@@ -1,8 +1,5 @@
 """The batched Platform env: copy i is the scalar env seeded with copy i's seed, step for step, noise on."""
 
-import copy
-import pickle
-
 import gymnasium
 import numpy as np
 import pytest
@@ -169,22 +166,6 @@ def test_reset_mask():
     moved, *_ = venv.step(batch([0, 0], [30, 30]))
     obs, _ = venv.reset(options={"reset_mask": np.array([False, True])})
     np.testing.assert_array_equal(obs, [moved[0], reset_obs[1]])
-
-
-def test_a_copied_batched_env_goes_on_as_the_original():
-    env = PlatformVectorEnv(num_envs=3)
-    env.reset(seed=1)
-    env.action_space.seed(0)
-    for _ in range(5):
-        env.step(env.action_space.sample())
-    copies = [copy.deepcopy(env), pickle.loads(pickle.dumps(env))]
-    for _ in range(60):
-        action = env.action_space.sample()
-        obs, reward, *_ = env.step(action)
-        for other in copies:
-            obs2, reward2, *_ = other.step(action)
-            np.testing.assert_array_equal(obs2, obs)
-            np.testing.assert_array_equal(reward2, reward)
 
 
 @pytest.mark.parametrize(
