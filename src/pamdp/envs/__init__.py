@@ -1,11 +1,12 @@
 """Parameterized-action domains, registered with Gymnasium on ``import pamdp``.
 
-- ``pamdp/Platform-v0``: Masson, Ranchod & Konidaris' Platform (``platform.py``).
+- ``pamdp/Platform-v0``: Masson, Ranchod & Konidaris' Platform (``platform/``).
 - ``pamdp/HalfFieldOffense-v0``: Half Field Offense 1v0, empty goal (``hfo/``).
 
-Each has a scalar ``gymnasium.Env`` and a batched NumPy ``gymnasium.vector.VectorEnv`` registered as
-its ``vector_entry_point``, so ``gymnasium.make_vec(id, num_envs=N,
-vectorization_mode="vector_entry_point")`` returns the batched version.
+Each domain's folder holds its dynamics (compiled by Numba), its scalar ``gymnasium.Env`` and its batched
+``gymnasium.vector.VectorEnv``, registered as its ``vector_entry_point``, so ``gymnasium.make_vec(id,
+num_envs=N, vectorization_mode="vector_entry_point")`` returns the batched version. What the batched envs
+share is ``vector.py``; ``rendering.py`` has the drawing primitives and episode-to-GIF recording.
 """
 
 from __future__ import annotations
