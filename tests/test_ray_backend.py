@@ -122,7 +122,6 @@ def test_a_sweep_survives_the_loss_of_a_worker_node_and_its_run_resumes_from_its
     pytest.importorskip("ray")
     done = run_on_local_cluster(NODE_LOSS, tmp_path, timeout=240)
     assert done.returncode == 0, done.stdout + done.stderr
-    print(done.stdout)
     assert json.loads((tmp_path / "errors.json").read_text()) == [None, None]
     killed = json.loads((tmp_path / "killed.json").read_text())
     for seed in (0, 1):

@@ -25,15 +25,14 @@ __all__ = ["run_all_ray", "RETRIES"]
 RETRIES = 3
 """How many times a run is started again after its node or worker process died (Ray's ``max_retries``)."""
 
-# Files written only by appending (TensorBoard event files, the run's log): after the first send, only what
-# was appended since goes to the driver. Every other file of a run directory is replaced whole on each
-# write (atomically), so it goes whole when it changed.
-_APPENDED = ("tb/", "stdout.log")
 _LAST = "checkpoint.pt"  # written last of a batch: a torn batch leaves a log newer than the checkpoint
 
 
 def _appended(rel: str) -> bool:
-    return rel.startswith(_APPENDED[0]) or rel == _APPENDED[1]
+    """Whether a run directory's file grows only by appending (TensorBoard's event files, the run's log): after
+    its first send, only the tail appended since goes. Every other file is replaced whole (atomically) on each
+    write, so it goes whole when it changed."""
+    return rel.startswith("tb/") or rel == "stdout.log"
 
 
 def _files(directory: Path) -> list[tuple[str, Path]]:
@@ -95,7 +94,7 @@ class _Mirror:
     def __init__(self, inbox, out: str, attempt: int, run_dir: Path):
         self.inbox, self.out, self.attempt, self.run_dir = inbox, out, attempt, run_dir
         self.sent: dict[str, tuple[tuple[int, int, int], int]] = {}  # file: (its stat when sent, bytes sent)
-        self._scan()  # what the driver already holds, as restored into run_dir
+        self._scan()  # run_dir holds what the driver holds: marked as sent
 
     def _scan(self) -> list[tuple[str, int, bytes]]:
         changes = []
