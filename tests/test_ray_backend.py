@@ -123,6 +123,7 @@ def test_a_sweep_survives_the_loss_of_a_worker_node_and_its_run_resumes_from_its
     done = run_on_local_cluster(NODE_LOSS, tmp_path, timeout=240)
     assert done.returncode == 0, done.stdout + done.stderr
     assert json.loads((tmp_path / "errors.json").read_text()) == [None, None]
+    assert (tmp_path / "killed.json").exists(), "the worker node's run ended before its node could be killed"
     killed = json.loads((tmp_path / "killed.json").read_text())
     for seed in (0, 1):
         run = tmp_path / f"seed{seed}"
