@@ -3,13 +3,14 @@
 The script starts its cluster itself (``ray.cluster_utils.Cluster``: a head and worker nodes, each its own
 raylet process, which the script may kill). ``RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER=0`` makes Ray take the
 loopback address as every node's own, so no traffic leaves 127.0.0.1; ``RAY_TMPDIR`` gives the cluster a
-directory of its own, short enough for Ray's socket paths (107 bytes at most). Every process that carries
-that directory in its environment is the script's or its cluster's: all of them are killed at the end, however
-the script ended.
+directory of its own, short enough for Ray's socket paths (107 bytes at most). Every process that holds a
+file of that directory open (or names it in its environment), or that is still in the script's process group,
+is the script's or its cluster's: all of them are killed at the end, however the script ended.
 """
 
 from __future__ import annotations
 
+import contextlib
 import os
 import shutil
 import signal
@@ -20,17 +21,22 @@ import time
 from pathlib import Path
 
 
-def _processes_with(variable: str) -> list[int]:
-    """The ids of the processes whose environment holds ``variable`` (``NAME=value``) exactly."""
+def _processes_using(directory: str) -> list[int]:
+    """The ids of the processes that hold a file under ``directory`` open or have it in their environment.
+
+    Ray's processes keep their logs there open; the environment alone is not enough, since a process that
+    renames itself (``ray::DashboardAgent``) may overwrite it.
+    """
     found = []
     for entry in Path("/proc").iterdir():
         if not entry.name.isdigit() or int(entry.name) == os.getpid():
             continue
         try:
-            environ = (entry / "environ").read_bytes().split(b"\0")
+            marks = [os.readlink(fd) for fd in (entry / "fd").iterdir()]
+            marks += (entry / "environ").read_bytes().decode(errors="replace").split("\0")
         except OSError:  # gone meanwhile, or not ours to read
             continue
-        if variable.encode() in environ:
+        if any(directory in mark for mark in marks):
             found.append(int(entry.name))
     return found
 
@@ -46,19 +52,26 @@ def run_on_local_cluster(script: str, workdir: Path, timeout: float) -> subproce
     }
     path = workdir / "cluster_script.py"
     path.write_text(script)
-    try:
-        return subprocess.run(
-            [sys.executable, str(path), str(workdir)], env=env, capture_output=True, text=True, timeout=timeout
-        )
-    finally:
-        for _ in range(50):  # again until none is left: a raylet may start a worker while the others go
-            pids = _processes_with(f"RAY_TMPDIR={ray_tmp}")
-            if not pids:
-                break
-            for pid in pids:
-                try:
-                    os.kill(pid, signal.SIGKILL)
-                except ProcessLookupError:
-                    pass
-            time.sleep(0.1)
-        shutil.rmtree(ray_tmp, ignore_errors=True)
+    with subprocess.Popen(
+        [sys.executable, str(path), str(workdir)],
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,  # its own process group, which Ray's processes stay in
+    ) as script_process:
+        try:
+            stdout, stderr = script_process.communicate(timeout=timeout)
+        finally:
+            with contextlib.suppress(ProcessLookupError):
+                os.killpg(script_process.pid, signal.SIGKILL)
+            for _ in range(50):  # again until none is left: a raylet may start a worker while the others go
+                pids = _processes_using(ray_tmp)
+                if not pids:
+                    break
+                for pid in pids:
+                    with contextlib.suppress(ProcessLookupError):
+                        os.kill(pid, signal.SIGKILL)
+                time.sleep(0.1)
+            shutil.rmtree(ray_tmp, ignore_errors=True)
+    return subprocess.CompletedProcess(script_process.args, script_process.returncode, stdout, stderr)
