@@ -4,9 +4,11 @@ For each case (the Platform and soccer experiments' PATRPO settings), one epoch 
 collected, then the policy update (``_update_policy``: the surrogate's gradient, the Fisher-vector product's
 set-up, ``cg_iters`` conjugate-gradient products, the line search) runs ``--repeats`` times per method from
 the same parameters, the methods alternating so that both see the same load. Also timed: one product alone.
-Both methods must end at the same parameters (they are the same matrix); the script checks it.
+Both methods must end at the same parameters (they are the same matrix); the script reports the gap.
+Times are CPU seconds of this process (``time.process_time``), which a shared machine's other processes do not
+inflate as they do the wall clock; pin it to one core for steadier figures:
 
-    python benchmarks/bench_fvp_speed.py --repeats 5 --out benchmarks/fvp_speed.md
+    taskset -c 0 python benchmarks/bench_fvp_speed.py --repeats 5 --out benchmarks/fvp_speed.md
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ from pathlib import Path
 
 import torch
 
+from pamdp.algos.onpolicy import advantage_batch, update_tensors
 from pamdp.algos.patrpo import PATRPO, PATRPOConfig
 
 sys.path.insert(0, str(Path(__file__).parent))
@@ -42,7 +45,10 @@ def measure(env_id: str, settings: dict, repeats: int, batch_scale: float) -> di
     cfg = dataclasses.replace(PATRPOConfig(), **settings)
     cfg = dataclasses.replace(cfg, batch_size=max(1000, int(cfg.batch_size * batch_scale)))
     model = PATRPO(env_id, cfg)
-    _, _, tensors = model._sample_epoch()
+    batch = model.rollout.collect(
+        model.vec_env, model.policy, model.hybrid, cfg.batch_size, model.np_rng, model.torch_gen
+    )
+    tensors = update_tensors(advantage_batch(batch, model._values, cfg.gamma, cfg.gae_lambda, True)[0])
     obs, a, x, _ = tensors
     start = {k: v.clone() for k, v in model.policy.state_dict().items()}
     update, product, end = {m: [] for m in METHODS}, {m: [] for m in METHODS}, {}
@@ -50,18 +56,18 @@ def measure(env_id: str, settings: dict, repeats: int, batch_scale: float) -> di
         for method in METHODS:
             model.policy.load_state_dict(start)
             model.config = dataclasses.replace(cfg, fvp=method)
-            t = time.perf_counter()
+            t = time.process_time()
             model._update_policy(*tensors)
-            update[method].append(time.perf_counter() - t)
+            update[method].append(time.process_time() - t)
             end[method] = torch.cat([p.detach().flatten() for p in model.policy.parameters()])
             model.policy.load_state_dict(start)
             with torch.no_grad():
                 old = model.policy(obs).detach()
             fvp = model._fisher_vector_product(obs, a, x, old)
             v = torch.randn(end[method].numel())
-            t = time.perf_counter()
+            t = time.process_time()
             fvp(v)
-            product[method].append(time.perf_counter() - t)
+            product[method].append(time.process_time() - t)
     model.policy.load_state_dict(start)
     theta = torch.cat([p.detach().flatten() for p in model.policy.parameters()])
     step = end["double_backprop"] - theta
@@ -92,19 +98,20 @@ def main(argv=None) -> None:
             f"| {p['double_backprop'] / p['gauss_newton']:.2f}x | {r['gap']:.1e} |"
         )
         print(rows[-1], flush=True)
-    command = "python benchmarks/bench_fvp_speed.py " + " ".join(argv if argv is not None else sys.argv[1:])
+    args_text = " ".join(argv if argv is not None else sys.argv[1:])
+    command = f"taskset -c 0 python benchmarks/bench_fvp_speed.py {args_text}"
     text = "\n".join(
         [
             "# PATRPO's Fisher-vector products: Gauss-Newton vs double back-propagation",
             "",
             f"- command: `{command.strip()}`",
             f"- date: {dt.datetime.now().isoformat(timespec='seconds')}",
-            f"- machine: {machine()}; torch threads 1",
+            f"- machine: {machine()}; torch threads 1, pinned to one core, CPU seconds of the process",
             f"- medians of {args.repeats} repeats per method, alternating; the paper preset with the experiment's"
             " settings, KL estimator chain_analytic, 10 conjugate-gradient iterations, one epoch of real samples",
             "",
-            "| case | hidden layers | batch | update s (double backprop) | update s (Gauss-Newton) | speed-up "
-            "| product s (double backprop) | product s (Gauss-Newton) | speed-up | parameter gap |",
+            "| case | hidden layers | batch | update CPU s (double backprop) | update CPU s (Gauss-Newton) | speed-up "
+            "| product CPU s (double backprop) | product CPU s (Gauss-Newton) | speed-up | parameter gap |",
             "|---|---|---|---|---|---|---|---|---|---|",
             *rows,
             "",

@@ -1,8 +1,8 @@
 """PAPPO: Proximal Policy Optimization of the hierarchical policy, H-PPO style (Fan et al., IJCAI 2019).
 
-The policy, the sampling and the advantages are PATRPO's (``pi(a,x|s) = pi_d(a|s) pi_c(x|s,a)``,
-:class:`~pamdp.algos.patrpo.Rollout`, :func:`~pamdp.algos.patrpo.advantage_batch`); PPO's clipped
-surrogate (Schulman et al. 2017, eq. 7) replaces the trust-region step. One epoch:
+The policy, the sampling and the advantages are PATRPO's (``pi(a,x|s) = pi_d(a|s) pi_c(x|s,a)``, and the
+on-policy family's :class:`~pamdp.algos.onpolicy.Rollout` and :func:`~pamdp.algos.onpolicy.advantage_batch`);
+PPO's clipped surrogate (Schulman et al. 2017, eq. 7) replaces the trust-region step. One epoch:
 
 1. Sample ``batch_size`` steps with ``(a, x) ~ pi_d(a|s) pi_c(x|s,a)`` from the batched env.
 2. Advantages ``A`` by GAE(``gamma``, ``gae_lambda``) from the value network ``V(s)``; the returns
@@ -29,9 +29,11 @@ from __future__ import annotations
 import dataclasses
 from typing import TYPE_CHECKING
 
+import numpy as np
 import torch
 
-from pamdp.algos.patrpo import OnPolicyHybrid, Rollout
+from pamdp.algos.base import Algorithm
+from pamdp.algos.onpolicy import Rollout, advantage_batch, network_values, update_tensors
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
 from pamdp.algos.subnormals import subnormals_flushed
 from pamdp.distributions import HybridDistribution, kl_divergence
@@ -161,7 +163,7 @@ def ppo_loss(
     return loss, {k: v.detach() for k, v in parts.items()}
 
 
-class PAPPO(OnPolicyHybrid):
+class PAPPO(Algorithm):
     """PPO of the hierarchical policy. See the module docstring for the update and :class:`PAPPOConfig`."""
 
     config_class = PAPPOConfig
@@ -180,11 +182,23 @@ class PAPPO(OnPolicyHybrid):
     def _optimizers(self):
         return {"adam": self.optimizer}
 
+    def _act(self, obs, deterministic):
+        dist = self.policy(obs)
+        return dist.mode() if deterministic else dist.sample(self.torch_gen)
+
+    def _values(self, obs: np.ndarray, t: np.ndarray) -> np.ndarray:
+        return network_values(self.value, obs)
+
     def _run_epoch(self) -> dict[str, float]:
-        data, explained_var, tensors = self._sample_epoch()
-        with subnormals_flushed(self.config.flush_denormal):
-            stats = self._update(*tensors, torch.as_tensor(data["returns"], dtype=torch.float32))
-        return self._epoch_stats(stats, data, explained_var)
+        cfg = self.config
+        batch = self.rollout.collect(
+            self.vec_env, self.policy, self.hybrid, cfg.batch_size, self.np_rng, self.torch_gen
+        )
+        data, explained_var = advantage_batch(batch, self._values, cfg.gamma, cfg.gae_lambda, cfg.normalize_advantages)
+        with subnormals_flushed(cfg.flush_denormal):
+            stats = self._update(*update_tensors(data), torch.as_tensor(data["returns"], dtype=torch.float32))
+        stats.update(self.rollout.epoch_stats(data["a"], self.hybrid.n_actions, explained_var))
+        return stats
 
     def _update(self, obs, a, x, adv, returns) -> dict[str, float]:
         """``n_epochs`` passes of minibatch Adam steps on the joint loss, stopped early by ``target_kl``."""

@@ -7,8 +7,16 @@ One epoch, as section "Parameterized Actions TRPO" of the paper reads:
    end of the epoch) bootstraps from the baseline, a true termination does not. Then refit the baseline.
 3. Maximise the surrogate ``E[pi(a,x|s) / pi_old(a,x|s) * A]`` subject to ``mean KL(pi_old || pi) <= delta``,
    the joint KL estimated by ``kl_estimator`` (the chain rule splits it into the discrete KL plus the
-   parameter policy's KL): natural-gradient direction by conjugate gradient on the Fisher-vector product,
-   step length ``sqrt(2 delta / (d^T H d))``, backtracking line search.
+   parameter policy's KL): natural-gradient direction ``H^-1 g`` by conjugate gradient, where each product
+   ``H v`` with the KL's Hessian is one more back-propagation of ``grad(KL) . v`` (Hessian-free, as TRPO's;
+   :class:`~pamdp.algos.trpo.FisherVectorProduct`); step length ``sqrt(2 delta / (d^T H d))``, backtracking
+   line search.
+
+Steps 1 and 2 are the on-policy family's (:mod:`pamdp.algos.onpolicy`). For the chain estimators the KL's
+Hessian in the distribution's own parameters has a closed form, and ``fvp="gauss_newton"`` (the default
+through ``auto``) computes the same product from it with fewer matrix products
+(:func:`~pamdp.algos.trpo.hybrid_gauss_newton_fvp`; the measured gain: ``benchmarks/fvp_speed.md``; a test
+checks that both take the same step).
 """
 
 from __future__ import annotations
@@ -21,24 +29,23 @@ import numpy as np
 import torch
 
 from pamdp.algos.base import Algorithm
-from pamdp.algos.logger import EpisodeTracker
+from pamdp.algos.onpolicy import LinearFeatureBaseline, Rollout, advantage_batch, network_values, update_tensors
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, at_least, interval, one_of, setting
 from pamdp.algos.subnormals import subnormals_flushed
 from pamdp.algos.trpo import (
     FisherVectorProduct,
-    GaussNewtonFVP,
     backtracking_line_search,
     conjugate_gradient,
     flat_grad,
+    hybrid_gauss_newton_fvp,
 )
 from pamdp.distributions import KL_ESTIMATORS, kl_divergence
 from pamdp.policies import ACTIVATIONS, HybridPolicy, ValueNetwork
-from pamdp.spaces import HybridActionSpace
 
 if TYPE_CHECKING:
     from typing_extensions import Self
 
-__all__ = ["PATRPO", "PATRPOConfig", "LinearFeatureBaseline", "OnPolicyHybrid", "Rollout", "advantage_batch", "gae"]
+__all__ = ["PATRPO", "PATRPOConfig"]
 
 
 FVP_METHODS = ("auto", "gauss_newton", "double_backprop")
@@ -82,8 +89,9 @@ class PATRPOConfig(AlgoConfig):
     )
     fvp: str = setting(
         "auto",
-        "How Fisher-vector products are computed: gauss_newton (closed-form KL Hessian, 1.4-1.7x faster; exact "
-        "for the chain estimators), double_backprop (any estimator), or auto (gauss_newton where it is exact).",
+        "How Fisher-vector products are computed: double_backprop (the paper's, any estimator), gauss_newton "
+        "(the same matrix from the KL's closed-form Hessian, faster: benchmarks/fvp_speed.md; the chain "
+        "estimators only), or auto (gauss_newton where it applies).",
         one_of(FVP_METHODS),
     )
     cg_damping: float = setting(
@@ -139,188 +147,7 @@ class PATRPOConfig(AlgoConfig):
         }
 
 
-def gae(
-    rewards: np.ndarray,
-    values: np.ndarray,
-    next_values: np.ndarray,
-    terminated: np.ndarray,
-    done: np.ndarray,
-    gamma: float,
-    lam: float,
-) -> np.ndarray:
-    """Generalised advantage estimates over ``(T, N)`` arrays of ``N`` env copies stepped ``T`` times.
-
-    ``next_values[t]`` is the value of the observation returned by step ``t``: it is bootstrapped unless the
-    step ``terminated``; ``done`` (terminated or truncated) cuts the sum. The last row is always cut (the end
-    of the epoch acts as a truncation).
-    """
-    adv = np.zeros_like(rewards, dtype=np.float64)
-    last = np.zeros(rewards.shape[1])
-    for t in range(rewards.shape[0] - 1, -1, -1):
-        delta = rewards[t] + gamma * (1.0 - terminated[t]) * next_values[t] - values[t]
-        last = delta + gamma * lam * (1.0 - done[t]) * last
-        adv[t] = last
-    return adv
-
-
-class Rollout:
-    """On-policy sampling of a :class:`~pamdp.policies.HybridPolicy` in a vector env (PATRPO's and PAPPO's).
-
-    Episodes run on across epochs (an epoch's last step bootstraps from the value function), so no partial
-    episode is thrown away; a new ``Rollout`` (as after loading a model) starts new episodes. Gymnasium's
-    vector envs reset a finished copy on the *next* step, ignoring its action: those autoreset steps are
-    marked invalid and carry no sample.
-    """
-
-    KEYS = ("obs", "a", "x", "reward", "terminated", "done", "valid", "next_obs", "t")
-
-    def __init__(self):
-        # (observation, autoreset pending, step within episode) of every env copy between epochs
-        self.state: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
-        self.tracker: EpisodeTracker | None = None
-
-    def collect(
-        self,
-        env,
-        policy: HybridPolicy,
-        hybrid: HybridActionSpace,
-        n_samples: int,
-        np_rng: np.random.Generator,
-        torch_gen: torch.Generator,
-    ) -> dict[str, np.ndarray]:
-        """Step ``env`` with ``(a, x) ~ policy`` until ``n_samples`` valid samples; ``(T, N, ...)`` arrays of
-        :attr:`KEYS` (``t``: the step within the episode; ``terminated`` and ``done`` are false when not valid).
-        """
-        n = env.num_envs
-        if self.state is None:
-            obs, _ = env.reset(seed=int(np_rng.integers(2**31 - 1)))
-            self.state = (obs, np.zeros(n, dtype=bool), np.zeros(n, dtype=np.int64))
-            self.tracker = EpisodeTracker(n)
-        obs, prev_done, t_ep = self.state
-        rows: dict[str, list] = {k: [] for k in self.KEYS}
-        n_valid = 0
-        while n_valid < n_samples:
-            with torch.no_grad():
-                a, x = policy(torch.as_tensor(np.asarray(obs, dtype=np.float32))).sample(torch_gen)
-            next_obs, reward, terminated, truncated, info = env.step(hybrid.to_env_batch(a.numpy(), x.numpy()))
-            valid = ~prev_done
-            done = (terminated | truncated) & valid
-            row = (obs, a.numpy(), x.numpy(), reward, terminated & valid, done, valid, next_obs, t_ep)
-            for k, v in zip(self.KEYS, row):
-                rows[k].append(np.array(v))
-            self.tracker.step(np.asarray(reward, dtype=np.float64), done, valid, info)
-            n_valid += int(valid.sum())
-            t_ep = np.where(valid, t_ep + 1, 0)
-            prev_done, obs = done, next_obs
-        self.state = (obs, prev_done, t_ep)
-        return {k: np.stack(v) for k, v in rows.items()}
-
-    def epoch_stats(self, a: np.ndarray, n_actions: int) -> dict[str, float]:
-        """The discrete actions' frequencies, the episodes completed since the last call, and ``steps``."""
-        freq = np.bincount(a, minlength=n_actions) / len(a)
-        stats = {f"train/action_freq_{k}": float(f) for k, f in enumerate(freq)}
-        stats.update(self.tracker.pop())
-        stats["steps"] = len(a)
-        return stats
-
-
-def advantage_batch(
-    batch: dict[str, np.ndarray],
-    values_fn: Callable[[np.ndarray, np.ndarray], np.ndarray],
-    gamma: float,
-    lam: float,
-    normalize: bool,
-) -> tuple[dict[str, np.ndarray], float]:
-    """GAE over a :meth:`Rollout.collect` batch, flattened to its valid samples.
-
-    ``values_fn(obs, t)`` is the baseline's value ``(B,)`` of observations at step ``t`` of their episodes.
-    Returns the valid samples' ``obs, t, a, x``, ``adv`` (standardised within the batch when ``normalize``),
-    ``returns`` (``adv + values``, the baseline's regression target) and ``values``, with the fraction of
-    the returns' variance the values explain.
-    """
-    T, N = batch["reward"].shape
-    flat = lambda arr: arr.reshape(T * N, *arr.shape[2:])  # noqa: E731
-    values = values_fn(flat(batch["obs"]), flat(batch["t"])).reshape(T, N)
-    next_values = values_fn(flat(batch["next_obs"]), flat(batch["t"]) + 1).reshape(T, N)
-    adv = gae(batch["reward"], values, next_values, batch["terminated"], batch["done"], gamma, lam)
-    returns = adv + values
-
-    valid = flat(batch["valid"])
-    data = {k: flat(batch[k])[valid] for k in ("obs", "t", "a", "x")}
-    data.update(adv=flat(adv)[valid], returns=flat(returns)[valid], values=flat(values)[valid])
-    var_ret = np.var(data["returns"])
-    explained_var = float(1 - np.var(data["returns"] - data["values"]) / var_ret) if var_ret > 0 else float("nan")
-    if normalize:
-        data["adv"] = (data["adv"] - data["adv"].mean()) / (data["adv"].std() + 1e-8)
-    return data, explained_var
-
-
-class OnPolicyHybrid(Algorithm):
-    """What PATRPO and PAPPO share: pi_d pi_c sampled by a :class:`Rollout` (``self.rollout``), advantages by
-    :func:`advantage_batch` from ``self._values``, and the greedy or sampled action of ``self.policy``. Their
-    configs name ``batch_size``, ``gamma``, ``gae_lambda`` and ``normalize_advantages`` alike."""
-
-    def _act(self, obs, deterministic):
-        dist = self.policy(obs)
-        return dist.mode() if deterministic else dist.sample(self.torch_gen)
-
-    def _values(self, obs: np.ndarray, t: np.ndarray) -> np.ndarray:
-        """The baseline ``V(s)`` of observations at step ``t`` of their episodes: here ``self.value``'s."""
-        with torch.no_grad():
-            return self.value(self._obs_tensor(obs)).double().numpy()
-
-    def _sample_epoch(self) -> tuple[dict[str, np.ndarray], float, tuple[torch.Tensor, ...]]:
-        """One epoch's valid samples with their advantages (:func:`advantage_batch`'s ``data`` and explained
-        variance) and the policy update's tensors ``(obs, a, x, adv)``."""
-        cfg = self.config
-        batch = self.rollout.collect(
-            self.vec_env, self.policy, self.hybrid, cfg.batch_size, self.np_rng, self.torch_gen
-        )
-        data, explained_var = advantage_batch(batch, self._values, cfg.gamma, cfg.gae_lambda, cfg.normalize_advantages)
-        tensors = (
-            self._obs_tensor(data["obs"]),
-            torch.as_tensor(data["a"]),
-            torch.as_tensor(data["x"]),
-            torch.as_tensor(data["adv"], dtype=torch.float32),
-        )
-        return data, explained_var, tensors
-
-    def _epoch_stats(self, stats: dict[str, float], data: dict[str, np.ndarray], explained_var: float):
-        """``stats`` with the explained variance, the action frequencies and the finished episodes added."""
-        stats["train/explained_variance"] = explained_var
-        stats.update(self.rollout.epoch_stats(data["a"], self.hybrid.n_actions))
-        return stats
-
-
-class LinearFeatureBaseline:
-    """rllab's baseline: ridge regression of returns on ``[clip(s), s^2, t/100, (t/100)^2, (t/100)^3, 1]``."""
-
-    def __init__(self, obs_dim: int, reg: float = 1e-5):
-        self.coef = np.zeros(2 * obs_dim + 4)
-        self.reg = reg
-
-    @staticmethod
-    def features(obs: np.ndarray, t: np.ndarray) -> np.ndarray:
-        s = np.clip(obs, -10, 10)
-        tt = (np.asarray(t, dtype=np.float64) / 100.0)[:, None]
-        return np.concatenate([s, s**2, tt, tt**2, tt**3, np.ones_like(tt)], axis=1)
-
-    def predict(self, obs: np.ndarray, t: np.ndarray) -> np.ndarray:
-        return self.features(obs, t) @ self.coef
-
-    def fit(self, obs: np.ndarray, t: np.ndarray, returns: np.ndarray) -> float:
-        f = self.features(obs, t)
-        reg = self.reg
-        for _ in range(5):  # rllab raises the ridge term until the solve is finite
-            coef = np.linalg.lstsq(f.T @ f + reg * np.eye(f.shape[1]), f.T @ returns, rcond=None)[0]
-            if np.all(np.isfinite(coef)):
-                self.coef = coef
-                break
-            reg *= 10
-        return float(np.mean((self.predict(obs, t) - returns) ** 2))
-
-
-class PATRPO(OnPolicyHybrid):
+class PATRPO(Algorithm):
     """Parameterized Actions TRPO. See the module docstring for the update and :class:`PATRPOConfig`."""
 
     config_class = PATRPOConfig
@@ -351,59 +178,22 @@ class PATRPO(OnPolicyHybrid):
         if self.config.baseline == "linear":
             self.linear_baseline.coef = state["linear_baseline"].numpy()
 
-    # -- baseline --------------------------------------------------------------------------------
-    def _values(self, obs: np.ndarray, t: np.ndarray) -> np.ndarray:
-        if self.config.baseline == "linear":
-            return self.linear_baseline.predict(obs, t)
-        return super()._values(obs, t)
-
-    def _fit_baseline(self, obs: np.ndarray, t: np.ndarray, returns: np.ndarray) -> float:
-        cfg = self.config
-        if cfg.baseline == "linear":
-            return self.linear_baseline.fit(obs, t, returns)
-        obs_t, ret_t = self._obs_tensor(obs), torch.as_tensor(returns, dtype=torch.float32)
-        n = len(ret_t)
-        for _ in range(cfg.vf_epochs):
-            perm = torch.randperm(n, generator=self.torch_gen)
-            for start in range(0, n, cfg.vf_batch_size):
-                idx = perm[start : start + cfg.vf_batch_size]
-                loss = (self.value(obs_t[idx]) - ret_t[idx]).pow(2).mean()
-                self.vf_optimizer.zero_grad()
-                loss.backward()
-                self.vf_optimizer.step()
-        with torch.no_grad():
-            return float((self.value(obs_t) - ret_t).pow(2).mean())
+    def _act(self, obs, deterministic):
+        dist = self.policy(obs)
+        return dist.mode() if deterministic else dist.sample(self.torch_gen)
 
     # -- one epoch -------------------------------------------------------------------------------
     def _run_epoch(self) -> dict[str, float]:
-        data, explained_var, tensors = self._sample_epoch()
-        with subnormals_flushed(self.config.flush_denormal):
-            stats = self._update_policy(*tensors)
-            stats["losses/value_loss"] = self._fit_baseline(data["obs"], data["t"], data["returns"])
-        return self._epoch_stats(stats, data, explained_var)
-
-    def _fisher_vector_product(self, obs, a, x, old) -> Callable[[torch.Tensor], torch.Tensor]:
-        """The damped Fisher-vector product of the KL estimator, on ``fvp_subsample`` of the batch."""
         cfg = self.config
-        n_fvp = max(1, int(round(cfg.fvp_subsample * len(obs))))
-        if n_fvp < len(obs):
-            sub = torch.randperm(len(obs), generator=self.torch_gen)[:n_fvp]
-            obs, a, x, old = obs[sub], a[sub], x[sub], old[sub]
-        named = [(n, p) for n, p in self.policy.named_parameters() if p.requires_grad]
-        names, params = [n for n, _ in named], [p for _, p in named]
-        method = cfg.fvp
-        if method == "auto":
-            method = "double_backprop" if cfg.kl_estimator == "joint_sample" else "gauss_newton"
-        if method == "double_backprop":
-            kl = kl_divergence(old, self.policy(obs), cfg.kl_estimator, a, x).mean()
-            return FisherVectorProduct(kl, params, cfg.cg_damping)
-        new, jvp = self.policy.linearize(obs)
-
-        def metric(d_logits, d_means, d_log_std):
-            return old.kl_hessian_product(d_logits, d_means, d_log_std, cfg.kl_estimator, a)
-
-        outputs = (new.logits, new.means, self.policy.log_std)
-        return GaussNewtonFVP(outputs, params, lambda ts: jvp(dict(zip(names, ts))), metric, cfg.cg_damping)
+        batch = self.rollout.collect(
+            self.vec_env, self.policy, self.hybrid, cfg.batch_size, self.np_rng, self.torch_gen
+        )
+        data, explained_var = advantage_batch(batch, self._values, cfg.gamma, cfg.gae_lambda, cfg.normalize_advantages)
+        with subnormals_flushed(cfg.flush_denormal):
+            stats = self._update_policy(*update_tensors(data))
+            stats["losses/value_loss"] = self._fit_baseline(data["obs"], data["t"], data["returns"])
+        stats.update(self.rollout.epoch_stats(data["a"], self.hybrid.n_actions, explained_var))
+        return stats
 
     def _update_policy(self, obs, a, x, adv) -> dict[str, float]:
         """One natural-gradient step with line search on the surrogate (the paper's PATRPO update)."""
@@ -457,3 +247,43 @@ class PATRPO(OnPolicyHybrid):
             }
         )
         return stats
+
+    def _fisher_vector_product(self, obs, a, x, old) -> Callable[[torch.Tensor], torch.Tensor]:
+        """The damped Fisher-vector product of the KL estimator, on ``fvp_subsample`` of the batch."""
+        cfg = self.config
+        n_fvp = max(1, int(round(cfg.fvp_subsample * len(obs))))
+        if n_fvp < len(obs):
+            sub = torch.randperm(len(obs), generator=self.torch_gen)[:n_fvp]
+            obs, a, x, old = obs[sub], a[sub], x[sub], old[sub]
+        method = cfg.fvp
+        if method == "auto":
+            method = "double_backprop" if cfg.kl_estimator == "joint_sample" else "gauss_newton"
+        if method == "double_backprop":
+            params = [p for p in self.policy.parameters() if p.requires_grad]
+            kl = kl_divergence(old, self.policy(obs), cfg.kl_estimator, a, x).mean()
+            return FisherVectorProduct(kl, params, cfg.cg_damping)
+        return hybrid_gauss_newton_fvp(self.policy, old, obs, a, cfg.kl_estimator, cfg.cg_damping)
+
+    # -- baseline --------------------------------------------------------------------------------
+    def _values(self, obs: np.ndarray, t: np.ndarray) -> np.ndarray:
+        """The baseline ``V(s)`` of observations at step ``t`` of their episodes."""
+        if self.config.baseline == "linear":
+            return self.linear_baseline.predict(obs, t)
+        return network_values(self.value, obs)
+
+    def _fit_baseline(self, obs: np.ndarray, t: np.ndarray, returns: np.ndarray) -> float:
+        cfg = self.config
+        if cfg.baseline == "linear":
+            return self.linear_baseline.fit(obs, t, returns)
+        obs_t, ret_t = self._obs_tensor(obs), torch.as_tensor(returns, dtype=torch.float32)
+        n = len(ret_t)
+        for _ in range(cfg.vf_epochs):
+            perm = torch.randperm(n, generator=self.torch_gen)
+            for start in range(0, n, cfg.vf_batch_size):
+                idx = perm[start : start + cfg.vf_batch_size]
+                loss = (self.value(obs_t[idx]) - ret_t[idx]).pow(2).mean()
+                self.vf_optimizer.zero_grad()
+                loss.backward()
+                self.vf_optimizer.step()
+        with torch.no_grad():
+            return float((self.value(obs_t) - ret_t).pow(2).mean())

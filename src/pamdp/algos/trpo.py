@@ -1,15 +1,22 @@
 """Trust-region machinery shared by the TRPO-family algorithms (Schulman et al. 2015, appendix C).
 
 Each piece is a small function with its own unit test: flat parameter vectors, the Fisher-vector product
-by double back-propagation of the KL, conjugate gradient, and the backtracking line search.
+by double back-propagation of the KL (TRPO's, and the paper's), the same product in Gauss-Newton form for a
+KL whose Hessian is known in closed form (faster: ``benchmarks/fvp_speed.md``), conjugate gradient, and the
+backtracking line search.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import torch
+
+if TYPE_CHECKING:
+    from pamdp.distributions import HybridDistribution
+    from pamdp.policies import HybridPolicy
 
 __all__ = [
     "flat_params",
@@ -18,6 +25,7 @@ __all__ = [
     "flat_grad",
     "FisherVectorProduct",
     "GaussNewtonFVP",
+    "hybrid_gauss_newton_fvp",
     "conjugate_gradient",
     "LineSearchResult",
     "backtracking_line_search",
@@ -88,8 +96,7 @@ class GaussNewtonFVP:
     the network's parameters is exactly ``J^T M J`` (``J``: the Jacobian of the distribution's parameters in
     the network's). Each product is then one Jacobian-vector product (forward mode), ``M`` applied, and one
     backward pass through the retained forward graph: about half the matrix products of double
-    back-propagation (1.4x to 1.7x faster as measured in benchmarks/fvp_speed.md), with the same result up to
-    rounding.
+    back-propagation (the measured gain: ``benchmarks/fvp_speed.md``), with the same result up to rounding.
 
     Args:
         outputs: the distribution's parameters, computed from ``params`` with their autograd graph.
@@ -115,6 +122,24 @@ class GaussNewtonFVP:
     def __call__(self, v: torch.Tensor) -> torch.Tensor:
         cotangents = self.metric(*self.jvp(split_flat(v, self.params)))
         return flat_grad(self.outputs, self.params, retain_graph=True, grad_outputs=cotangents) + self.damping * v
+
+
+def hybrid_gauss_newton_fvp(
+    policy: HybridPolicy, old: HybridDistribution, obs: torch.Tensor, a: torch.Tensor, estimator: str, damping: float
+) -> GaussNewtonFVP:
+    """:class:`GaussNewtonFVP` of the mean ``kl_divergence(old, policy(obs), estimator, a)`` (a chain estimator):
+    the product :class:`FisherVectorProduct` gives for that KL, from the policy's hand-linearised forward pass
+    (:meth:`~pamdp.policies.HybridPolicy.linearize`) and the KL's closed-form Hessian in the distribution's
+    parameters (:meth:`~pamdp.distributions.HybridDistribution.kl_hessian_product`)."""
+    named = [(n, p) for n, p in policy.named_parameters() if p.requires_grad]
+    names, params = [n for n, _ in named], [p for _, p in named]
+    new, jvp = policy.linearize(obs)
+
+    def metric(d_logits, d_means, d_log_std):
+        return old.kl_hessian_product(d_logits, d_means, d_log_std, estimator, a)
+
+    outputs = (new.logits, new.means, policy.log_std)
+    return GaussNewtonFVP(outputs, params, lambda ts: jvp(dict(zip(names, ts))), metric, damping)
 
 
 def conjugate_gradient(

@@ -79,19 +79,10 @@ def describe_env(env, env_kwargs: dict | None = None) -> tuple[str | None, dict,
         # "module:Name-v0" keeps its module, so that a loaded model imports it again to make its env
         return (env if ":" in env else spec.id), {}, obs_space, act_space
     if isinstance(env, gymnasium.vector.VectorEnv):
-        spec = env.spec
-        return (
-            (spec.id if spec else None),
-            dict(spec.kwargs if spec else {}),
-            env.single_observation_space,
-            env.single_action_space,
-        )
-    if isinstance(env, gymnasium.Env):
-        spec = env.spec
-        return (
-            (spec.id if spec else None),
-            dict(spec.kwargs if spec else {}),
-            env.observation_space,
-            env.action_space,
-        )
-    raise ValueError(f"env must be a registered env id, a gymnasium.Env or a VectorEnv; got {env!r}")
+        spaces_of = (env.single_observation_space, env.single_action_space)
+    elif isinstance(env, gymnasium.Env):
+        spaces_of = (env.observation_space, env.action_space)
+    else:
+        raise ValueError(f"env must be a registered env id, a gymnasium.Env or a VectorEnv; got {env!r}")
+    spec = env.spec
+    return (spec.id if spec else None), dict(spec.kwargs if spec else {}), *spaces_of

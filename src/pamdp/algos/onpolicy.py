@@ -1,0 +1,184 @@
+"""What the on-policy algorithms (PATRPO, PAPPO) share: sampling the hierarchical policy, GAE, the baselines.
+
+An epoch of either algorithm starts the same way: :meth:`Rollout.collect` steps the vector env with
+``(a, x) ~ pi_d(a|s) pi_c(x|s,a)`` until ``batch_size`` valid samples, then :func:`advantage_batch` computes
+the advantages by GAE from a baseline ``V(s)`` (a value network, or rllab's :class:`LinearFeatureBaseline`)
+and flattens the batch to its valid samples. What differs, the policy update, lives in each algorithm's file.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+import torch
+
+from pamdp.algos.logger import EpisodeTracker
+from pamdp.policies import HybridPolicy
+from pamdp.spaces import HybridActionSpace
+
+__all__ = ["Rollout", "gae", "advantage_batch", "update_tensors", "network_values", "LinearFeatureBaseline"]
+
+
+def gae(
+    rewards: np.ndarray,
+    values: np.ndarray,
+    next_values: np.ndarray,
+    terminated: np.ndarray,
+    done: np.ndarray,
+    gamma: float,
+    lam: float,
+) -> np.ndarray:
+    """Generalised advantage estimates over ``(T, N)`` arrays of ``N`` env copies stepped ``T`` times.
+
+    ``next_values[t]`` is the value of the observation returned by step ``t``: it is bootstrapped unless the
+    step ``terminated``; ``done`` (terminated or truncated) cuts the sum. The last row is always cut (the end
+    of the epoch acts as a truncation).
+    """
+    adv = np.zeros_like(rewards, dtype=np.float64)
+    last = np.zeros(rewards.shape[1])
+    for t in range(rewards.shape[0] - 1, -1, -1):
+        delta = rewards[t] + gamma * (1.0 - terminated[t]) * next_values[t] - values[t]
+        last = delta + gamma * lam * (1.0 - done[t]) * last
+        adv[t] = last
+    return adv
+
+
+class Rollout:
+    """On-policy sampling of a :class:`~pamdp.policies.HybridPolicy` in a vector env.
+
+    Episodes run on across epochs (an epoch's last step bootstraps from the baseline), so no partial
+    episode is thrown away; a new ``Rollout`` (as after loading a model) starts new episodes. Gymnasium's
+    vector envs reset a finished copy on the *next* step, ignoring its action: those autoreset steps are
+    marked invalid and carry no sample.
+    """
+
+    KEYS = ("obs", "a", "x", "reward", "terminated", "done", "valid", "next_obs", "t")
+
+    def __init__(self):
+        # (observation, autoreset pending, step within episode) of every env copy between epochs
+        self.state: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+        self.tracker: EpisodeTracker | None = None
+
+    def collect(
+        self,
+        env,
+        policy: HybridPolicy,
+        hybrid: HybridActionSpace,
+        n_samples: int,
+        np_rng: np.random.Generator,
+        torch_gen: torch.Generator,
+    ) -> dict[str, np.ndarray]:
+        """Step ``env`` with ``(a, x) ~ policy`` until ``n_samples`` valid samples; ``(T, N, ...)`` arrays of
+        :attr:`KEYS` (``t``: the step within the episode; ``terminated`` and ``done`` are false when not valid).
+        """
+        n = env.num_envs
+        if self.state is None:
+            obs, _ = env.reset(seed=int(np_rng.integers(2**31 - 1)))
+            self.state = (obs, np.zeros(n, dtype=bool), np.zeros(n, dtype=np.int64))
+            self.tracker = EpisodeTracker(n)
+        obs, prev_done, t_ep = self.state
+        rows: dict[str, list] = {k: [] for k in self.KEYS}
+        n_valid = 0
+        while n_valid < n_samples:
+            with torch.no_grad():
+                a, x = policy(torch.as_tensor(np.asarray(obs, dtype=np.float32))).sample(torch_gen)
+            next_obs, reward, terminated, truncated, info = env.step(hybrid.to_env_batch(a.numpy(), x.numpy()))
+            valid = ~prev_done
+            done = (terminated | truncated) & valid
+            row = (obs, a.numpy(), x.numpy(), reward, terminated & valid, done, valid, next_obs, t_ep)
+            for k, v in zip(self.KEYS, row):
+                rows[k].append(np.array(v))
+            self.tracker.step(np.asarray(reward, dtype=np.float64), done, valid, info)
+            n_valid += int(valid.sum())
+            t_ep = np.where(valid, t_ep + 1, 0)
+            prev_done, obs = done, next_obs
+        self.state = (obs, prev_done, t_ep)
+        return {k: np.stack(v) for k, v in rows.items()}
+
+    def epoch_stats(self, a: np.ndarray, n_actions: int, explained_var: float) -> dict[str, float]:
+        """The baseline's explained variance, the discrete actions' frequencies, the episodes completed since
+        the last call, and ``steps``."""
+        freq = np.bincount(a, minlength=n_actions) / len(a)
+        stats = {"train/explained_variance": explained_var}
+        stats.update({f"train/action_freq_{k}": float(f) for k, f in enumerate(freq)})
+        stats.update(self.tracker.pop())
+        stats["steps"] = len(a)
+        return stats
+
+
+def advantage_batch(
+    batch: dict[str, np.ndarray],
+    values_fn: Callable[[np.ndarray, np.ndarray], np.ndarray],
+    gamma: float,
+    lam: float,
+    normalize: bool,
+) -> tuple[dict[str, np.ndarray], float]:
+    """GAE over a :meth:`Rollout.collect` batch, flattened to its valid samples.
+
+    ``values_fn(obs, t)`` is the baseline's value ``(B,)`` of observations at step ``t`` of their episodes.
+    Returns the valid samples' ``obs, t, a, x``, ``adv`` (standardised within the batch when ``normalize``),
+    ``returns`` (``adv + values``, the baseline's regression target) and ``values``, with the fraction of
+    the returns' variance the values explain.
+    """
+    T, N = batch["reward"].shape
+    flat = lambda arr: arr.reshape(T * N, *arr.shape[2:])  # noqa: E731
+    values = values_fn(flat(batch["obs"]), flat(batch["t"])).reshape(T, N)
+    next_values = values_fn(flat(batch["next_obs"]), flat(batch["t"]) + 1).reshape(T, N)
+    adv = gae(batch["reward"], values, next_values, batch["terminated"], batch["done"], gamma, lam)
+    returns = adv + values
+
+    valid = flat(batch["valid"])
+    data = {k: flat(batch[k])[valid] for k in ("obs", "t", "a", "x")}
+    data.update(adv=flat(adv)[valid], returns=flat(returns)[valid], values=flat(values)[valid])
+    var_ret = np.var(data["returns"])
+    explained_var = float(1 - np.var(data["returns"] - data["values"]) / var_ret) if var_ret > 0 else float("nan")
+    if normalize:
+        data["adv"] = (data["adv"] - data["adv"].mean()) / (data["adv"].std() + 1e-8)
+    return data, explained_var
+
+
+def update_tensors(data: dict[str, np.ndarray]) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
+    """The policy update's tensors ``(obs, a, x, adv)`` of an :func:`advantage_batch` (observations and
+    advantages in float32, the networks' precision)."""
+    return (
+        torch.as_tensor(np.asarray(data["obs"], dtype=np.float32)),
+        torch.as_tensor(data["a"]),
+        torch.as_tensor(data["x"]),
+        torch.as_tensor(data["adv"], dtype=torch.float32),
+    )
+
+
+def network_values(value: torch.nn.Module, obs: np.ndarray) -> np.ndarray:
+    """A value network's ``V(s)`` of a batch of observations, as float64 for GAE."""
+    with torch.no_grad():
+        return value(torch.as_tensor(np.asarray(obs, dtype=np.float32))).double().numpy()
+
+
+class LinearFeatureBaseline:
+    """rllab's baseline: ridge regression of returns on ``[clip(s), s^2, t/100, (t/100)^2, (t/100)^3, 1]``."""
+
+    def __init__(self, obs_dim: int, reg: float = 1e-5):
+        self.coef = np.zeros(2 * obs_dim + 4)
+        self.reg = reg
+
+    @staticmethod
+    def features(obs: np.ndarray, t: np.ndarray) -> np.ndarray:
+        s = np.clip(obs, -10, 10)
+        tt = (np.asarray(t, dtype=np.float64) / 100.0)[:, None]
+        return np.concatenate([s, s**2, tt, tt**2, tt**3, np.ones_like(tt)], axis=1)
+
+    def predict(self, obs: np.ndarray, t: np.ndarray) -> np.ndarray:
+        return self.features(obs, t) @ self.coef
+
+    def fit(self, obs: np.ndarray, t: np.ndarray, returns: np.ndarray) -> float:
+        """Fit the coefficients to ``returns``; the mean squared error after the fit."""
+        f = self.features(obs, t)
+        reg = self.reg
+        for _ in range(5):  # rllab raises the ridge term until the solve is finite
+            coef = np.linalg.lstsq(f.T @ f + reg * np.eye(f.shape[1]), f.T @ returns, rcond=None)[0]
+            if np.all(np.isfinite(coef)):
+                self.coef = coef
+                break
+            reg *= 10
+        return float(np.mean((self.predict(obs, t) - returns) ** 2))
