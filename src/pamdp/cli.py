@@ -22,23 +22,6 @@ from pamdp import __version__
 from pamdp._memory import keep_freed_memory
 from pamdp.experiments.runner import ALGORITHMS, RunSpec, algorithm_class, default_preset, train_run
 
-DEFAULT_TOTAL_STEPS = {
-    "patrpo": 500_000,
-    "pappo": 300_000,
-    "pasvg0": 1_000_000,
-    "paddpg": 1_000_000,
-    "pdqn": 200_000,
-    "hyar": 200_000,
-}
-ALGO_HELP = {
-    "patrpo": "PATRPO: TRPO of the hierarchical policy with the chain-rule KL",
-    "pappo": "PAPPO: PPO's clipped surrogate on the hierarchical policy (H-PPO style)",
-    "pasvg0": "PASVG(0): Gumbel-Softmax stochastic value gradients with replay",
-    "paddpg": "PADDPG: Hausknecht & Stone's parameterized-action DDPG (the baseline)",
-    "pdqn": "P-DQN (Xiong et al.); with --multi-pass true, MP-DQN (Bester et al.)",
-    "hyar": "HyAR-TD3 (Li et al.): TD3 in a learned latent space of hybrid actions",
-}
-
 
 def _parse_value(text: str, hint):
     """A command-line string as a value of the config field's type (tuples as comma-separated lists)."""
@@ -140,7 +123,7 @@ def build_parser() -> argparse.ArgumentParser:
         cls = algorithm_class(name)
         if cls is None:
             continue
-        p = algos.add_parser(name, help=ALGO_HELP.get(name, name))
+        p = algos.add_parser(name, help=ALGORITHMS[name].help)
         p.add_argument("--env", default="pamdp/Platform-v0", help="registered env id (default: %(default)s)")
         p.add_argument("--env-kwargs", type=_json_object, default=None, help="JSON object of env constructor arguments")
         p.add_argument("--seed", type=int, default=None, help="random seed (default: the config file's, else 0)")
@@ -148,7 +131,7 @@ def build_parser() -> argparse.ArgumentParser:
             "--total-steps",
             type=int,
             default=None,
-            help=f"environment steps (default: {DEFAULT_TOTAL_STEPS[name]:,})",
+            help=f"environment steps (default: {ALGORITHMS[name].total_steps:,})",
         )
         p.add_argument(
             "--out", default=None, help="run directory (default: runs/ALGO-ENV-seedN-TIME); reuse it to resume"
@@ -233,7 +216,7 @@ def _train_spec(args, cls) -> RunSpec:
     seed = args.seed if args.seed is not None else int(file_values.pop("seed", 0))
     file_values.pop("seed", None)
     flags = {k[4:]: v for k, v in vars(args).items() if k.startswith("cfg_") and v is not None}
-    total = args.total_steps if args.total_steps is not None else DEFAULT_TOTAL_STEPS[args.algo]
+    total = args.total_steps if args.total_steps is not None else ALGORITHMS[args.algo].total_steps
     if total < 0:
         raise ValueError(f"--total-steps {total}; expected a non-negative number of steps")
     if args.eval_every < 0:

@@ -23,7 +23,7 @@ import traceback
 from pathlib import Path
 from typing import Any
 
-from pamdp.algos import ALGORITHMS
+from pamdp.algos import ALGORITHMS, DEFAULT_PRESET, algorithm_class, default_preset
 
 __all__ = [
     "RunSpec",
@@ -37,29 +37,6 @@ __all__ = [
     "ALGORITHMS",
     "DEFAULT_PRESET",
 ]
-
-DEFAULT_PRESET = "tuned"
-
-
-def algorithm_class(name: str):
-    """The class behind an algorithm's command-line name, or ``None`` if this install lacks it."""
-    from importlib import import_module
-
-    if name not in ALGORITHMS:
-        raise ValueError(f"unknown algorithm {name!r}; expected one of {', '.join(ALGORITHMS)}")
-    module, _, cls = ALGORITHMS[name].partition(":")
-    try:
-        return getattr(import_module(module), cls)
-    except ModuleNotFoundError as exc:
-        if exc.name == module:
-            return None
-        raise
-
-
-def default_preset(config_class) -> str:
-    """The preset a run gets when none is named: ``tuned`` where the algorithm has one, else its first."""
-    presets = config_class.presets()
-    return DEFAULT_PRESET if DEFAULT_PRESET in presets else next(iter(presets))
 
 
 @dataclasses.dataclass(frozen=True)
