@@ -54,7 +54,10 @@ class PlatformVectorEnv(BatchedVectorEnv):
     def state(self) -> dict[str, np.ndarray]:
         """A copy of the state, batched like the scalar env's: ``player`` (N, 4), ``enemies`` (N, 2, 2)."""
         s = self._states
-        return {"player": s[:, physics.X : physics.VY + 1].copy(), "enemies": s[:, physics.E1X :].reshape(-1, 2, 2)}
+        return {
+            "player": s[:, physics.X : physics.VY + 1].copy(),
+            "enemies": s[:, physics.E1X :].reshape(-1, 2, 2).copy(),
+        }
 
     def render(self):
         if self.render_mode != "rgb_array":
