@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pamdp.envs.platform import physics
+import pamdp.envs.platform.physics as physics
 from pamdp.envs.platform.env import BUFFER_SIZE, PlatformEnv
 from pamdp.envs.platform.render import draw_platform
 from pamdp.envs.vector import BatchedVectorEnv

@@ -31,7 +31,7 @@ import gymnasium
 import numpy as np
 from gymnasium import spaces
 
-from pamdp.envs.platform import physics
+import pamdp.envs.platform.physics as physics
 from pamdp.envs.platform.render import RENDER_FPS, draw_platform
 from pamdp.envs.vector import RandomStreams
 
