@@ -1,16 +1,14 @@
 """Half Field Offense: environment steps per second and the scripted scorer's goal rate.
 
-Run ``.venv/bin/python benchmarks/bench_hfo.py`` (about a minute); it rewrites ``benchmarks/hfo_speed.md``.
-Actions are sampled before timing, so the figures are the env's own cost. Each figure is the median
-over repeats of steps per CPU-second of this process (``time.process_time``): another process may be
-using the machine's cores, and CPU time does not count the time spent waiting for one. The load
-average is recorded too.
+Run ``.venv/bin/python benchmarks/bench_hfo.py`` (a few minutes); it rewrites ``benchmarks/hfo_speed.md``,
+keeping the record's section ``## Notes (written by hand)`` as it is. Actions are sampled before timing,
+so the figures are the env's own cost. Each figure is the median over repeats of steps per CPU-second of
+this process (``time.process_time``): another process may be using the machine's cores, and CPU time does
+not count the time spent waiting for one. The load average is recorded too.
 
-``--baseline COMMIT`` also times the HFO modules of that git commit (exported to a temporary
-directory), interleaved repeat by repeat with the working tree's, so that both see the same load.
-``--cpu 0`` pins the process to one core (as ``taskset -c 0``). ``--backends`` chooses the batched env's
-step: NumPy and, if it imports, the fused Numba kernels (one row each; a baseline without backends is
-timed once per size, its figure beside each row).
+``--baseline COMMIT`` also times the HFO envs of that git commit (its ``src/pamdp/envs`` exported to a
+temporary directory and imported as a package of its own), interleaved repeat by repeat with the working
+tree's, so that both see the same load. ``--cpu 0`` pins the process to one core (as ``taskset -c 0``).
 """
 
 from __future__ import annotations
@@ -18,46 +16,48 @@ from __future__ import annotations
 import argparse
 import datetime
 import importlib
+import io
 import os
 import pathlib
 import platform
 import statistics
 import subprocess
 import sys
+import tarfile
 import tempfile
 import time
 
 import gymnasium
+import numba
 import numpy as np
 
 import pamdp  # noqa: F401  (registers the envs)
 from pamdp.envs import hfo
-from pamdp.envs.hfo_baseline import scripted_scorer_batch
+from pamdp.envs.hfo import scripted_scorer_batch
 
-HFO_MODULES = ("hfo", "hfo_physics", "hfo_features", "hfo_vector", "hfo_interface", "hfo_kernel")
 #: Batched steps before timing: the games, all placed at once, first time out together near step 100.
 BATCHED_WARMUP = 200
 #: Fewest env steps (batched steps times games) per timed repeat of a batched env.
 BATCHED_ENV_STEPS = 20_000
-BACKEND_NAMES = {"numpy": "NumPy", "numba": "Numba kernels"}
+NOTES = "## Notes (written by hand)"
 
 
 def import_baseline(commit: str):
-    """The ``hfo`` module of ``commit``, imported from a temporary copy as package ``hfo_at_baseline``."""
+    """The ``hfo`` module (or package) of ``commit``: its ``src/pamdp/envs`` exported to a temporary directory
+    as package ``envs_at_baseline``, every ``pamdp.envs`` import pointed there."""
     repo = pathlib.Path(__file__).resolve().parents[1]
-    package = pathlib.Path(tempfile.mkdtemp()) / "hfo_at_baseline"
-    package.mkdir()
-    (package / "__init__.py").write_text("")
-    for name in HFO_MODULES:
-        shown = subprocess.run(
-            ["git", "show", f"{commit}:src/pamdp/envs/{name}.py"], cwd=repo, capture_output=True, text=True
-        )
-        if shown.returncode:  # a module the commit does not have yet (hfo_kernel before its backend)
-            continue
-        source = shown.stdout.replace("from pamdp.envs import ", "from hfo_at_baseline import ")
-        (package / f"{name}.py").write_text(source.replace("from pamdp.envs.hfo", "from hfo_at_baseline.hfo"))
-    sys.path.insert(0, str(package.parent))
-    return importlib.import_module("hfo_at_baseline.hfo")
+    archive = subprocess.run(
+        ["git", "archive", commit, "src/pamdp/envs"], cwd=repo, capture_output=True, check=True
+    ).stdout
+    root = pathlib.Path(tempfile.mkdtemp())
+    with tarfile.open(fileobj=io.BytesIO(archive)) as tar:
+        tar.extractall(root, filter="data")
+    package = root / "envs_at_baseline"
+    (root / "src" / "pamdp" / "envs").rename(package)
+    for path in package.rglob("*.py"):
+        path.write_text(path.read_text().replace("pamdp.envs", "envs_at_baseline"))
+    sys.path.insert(0, str(root))
+    return importlib.import_module("envs_at_baseline.hfo")
 
 
 def scalar_rate(env, actions, steps: int) -> float:
@@ -78,19 +78,9 @@ def batched_rate(env, actions, steps: int) -> float:
     return steps * env.num_envs / (time.process_time() - start)
 
 
-def available_backends(requested) -> list[str]:
-    """The batched env's backends among ``requested`` that this Python has (Numba is optional)."""
-    try:
-        import numba  # noqa: F401
-    except ImportError:
-        return [b for b in requested if b != "numba"]
-    return list(requested)
-
-
 def speeds(modules: dict, args) -> dict:
     """Median steps/s of each module's scalar env, scalar env via ``gymnasium.make`` (current only) and
-    batched env at each of ``args.num_envs`` sizes (for the current code, keyed ``(n, backend)``, one per
-    backend), repeats interleaved across modules."""
+    batched env at each of ``args.num_envs`` sizes, repeats interleaved across modules."""
     space = hfo.HalfFieldOffenseEnv().action_space
     space.seed(0)
     scalar_actions = [space.sample() for _ in range(2000)]
@@ -104,12 +94,10 @@ def speeds(modules: dict, args) -> dict:
         envs[name] = {"scalar": module.HalfFieldOffenseEnv()}
         envs[name]["scalar"].reset(seed=0)
         for n in args.num_envs:
-            for backend in args.backends if name == "current" else [None]:
-                kwargs = {} if backend is None else {"backend": backend}
-                batched = module.HalfFieldOffenseVectorEnv(num_envs=n, **kwargs)
-                batched.reset(seed=0)
-                batched_rate(batched, batched_actions[n], BATCHED_WARMUP)  # includes Numba's compilation
-                envs[name][n if backend is None else (n, backend)] = batched
+            batched = module.HalfFieldOffenseVectorEnv(num_envs=n)
+            batched.reset(seed=0)
+            batched_rate(batched, batched_actions[n], BATCHED_WARMUP)  # includes Numba's compilation
+            envs[name][n] = batched
     envs["current"]["made"] = gymnasium.make("pamdp/HalfFieldOffense-v0")
     envs["current"]["made"].reset(seed=0)
     rates = {name: {kind: [] for kind in kinds} for name, kinds in envs.items()}
@@ -117,10 +105,9 @@ def speeds(modules: dict, args) -> dict:
         for name, kinds in envs.items():
             for kind, env in kinds.items():
                 if kind not in ("scalar", "made"):
-                    n = kind if isinstance(kind, int) else kind[0]
                     # small batches take more steps, so that each repeat times enough env steps
-                    steps = max(args.batched_steps, BATCHED_ENV_STEPS // n)
-                    rates[name][kind].append(batched_rate(env, batched_actions[n], steps))
+                    steps = max(args.batched_steps, BATCHED_ENV_STEPS // kind)
+                    rates[name][kind].append(batched_rate(env, batched_actions[kind], steps))
                 else:
                     rates[name][kind].append(scalar_rate(env, scalar_actions, args.scalar_steps))
     return {name: {kind: statistics.median(r) for kind, r in kinds.items()} for name, kinds in rates.items()}
@@ -143,14 +130,6 @@ def scorer_results(episodes: int, num_envs: int = 250, seed: int = 0) -> tuple[f
     return outcomes.get("GOAL", 0) / episodes, float(np.mean(goal_steps)), outcomes
 
 
-def numba_version() -> str:
-    try:
-        import numba
-    except ImportError:
-        return ""
-    return f", Numba {numba.__version__}"
-
-
 def cpu_model() -> str:
     try:
         for line in pathlib.Path("/proc/cpuinfo").read_text().splitlines():
@@ -170,17 +149,12 @@ def main() -> None:
         "--num-envs", type=int, nargs="+", default=[1024], help="games in the batched env (several: one row each)"
     )
     parser.add_argument("--episodes", type=int, default=1000, help="scripted-scorer episodes")
-    parser.add_argument(
-        "--backends", nargs="+", choices=["numpy", "numba"], default=["numpy", "numba"],
-        help="the batched env's backends to time (numba only if it imports)",
-    )  # fmt: skip
     parser.add_argument("--baseline", metavar="COMMIT", help="also time this commit's HFO envs, interleaved")
     parser.add_argument("--cpu", type=int, help="pin the process to this core")
     parser.add_argument("--out", default=str(pathlib.Path(__file__).with_name("hfo_speed.md")))
     args = parser.parse_args()
     if args.cpu is not None:
         os.sched_setaffinity(0, {args.cpu})
-    args.backends = available_backends(args.backends)
 
     modules = {"current": hfo}
     if args.baseline:
@@ -193,7 +167,7 @@ def main() -> None:
     def result(kind) -> str:
         text = f"{rates['current'][kind]:,.0f} steps/s"
         if args.baseline:
-            before = rates["baseline"][kind if isinstance(kind, str) else kind[0]]
+            before = rates["baseline"][kind]
             text += f" (baseline {before:,.0f}, x{rates['current'][kind] / before:.2f})"
         return text
 
@@ -202,13 +176,8 @@ def main() -> None:
         ("scalar `HalfFieldOffenseEnv`, random actions", result("scalar"), ">= 20 000"),
         ("scalar via `gymnasium.make` (wrappers)", f"{rates['current']['made']:,.0f} steps/s", ""),
         *(
-            (
-                f"batched `HalfFieldOffenseVectorEnv`, N = {n}, {BACKEND_NAMES[backend]}",
-                result((n, backend)),
-                ">= 1 000 000" if n == 1024 else "",
-            )
+            (f"batched `HalfFieldOffenseVectorEnv`, N = {n}", result(n), ">= 1 000 000" if n == 1024 else "")
             for n in args.num_envs
-            for backend in args.backends
         ),
         (
             f"scripted scorer, {args.episodes} episodes (noise on)",
@@ -225,7 +194,7 @@ def main() -> None:
         f"Command: `{command.strip()}`  ",
         f"Date: {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M UTC}  ",
         f"Machine: {cpu_model()}, {os.cpu_count()} cores; Python {platform.python_version()}, "
-        f"NumPy {np.__version__}, Gymnasium {gymnasium.__version__}{numba_version()}  ",
+        f"NumPy {np.__version__}, Gymnasium {gymnasium.__version__}, Numba {numba.__version__}  ",
         f"Load average (1 min) before / after: {load_before:.2f} / {load_after:.2f} (other engineers' jobs "
         "may share the cores; figures are env steps per CPU-second of the process, medians of "
         f"{args.repeats} repeats; batched after {BATCHED_WARMUP} warm-up steps, so autoresets are included)  ",
@@ -238,7 +207,11 @@ def main() -> None:
         f"Scorer outcomes: {outcomes}.",
         "",
     ]
-    pathlib.Path(args.out).write_text("\n".join(text))
+    out = pathlib.Path(args.out)
+    old = out.read_text() if out.exists() else ""
+    if NOTES in old:
+        text += [old[old.index(NOTES) :].rstrip("\n"), ""]
+    out.write_text("\n".join(text))
     print("\n".join(text))
 
 

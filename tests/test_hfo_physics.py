@@ -19,15 +19,16 @@ class Game:
     def __init__(self, ball=(20.0, 10.0), player=(10.0, 0.0), body=0.0):
         self.s = np.zeros(dyn.STATE_SIZE)
         self.s[dyn.BODY] = body
-        self.draws = np.random.default_rng(0).random(64)
+        self.rng = np.zeros(4, dtype=np.uint64)
+        dyn.seed_stream(self.rng, np.random.default_rng(0).random(4))
         self.settings = dyn.settings(dyn.PROFILES["hfo2017"], True, False, False, False, False)
-        dyn.place(self.s, self.draws, *ball, *player)
+        dyn.place(self.s, self.rng, *ball, *player)
 
     def __getattr__(self, name):
         return self.s[getattr(dyn, name.upper())]
 
     def step(self, action: int, x0: float, x1: float = 0.0) -> int:
-        return dyn.simulate(self.s, self.draws, action, x0, x1, self.settings)
+        return dyn.simulate(self.s, self.rng, action, x0, x1, self.settings)
 
     def advance(self) -> int:
         """A server cycle after TURN(0), which changes nothing at rest or in motion."""

@@ -4,7 +4,7 @@ The one writing of ``shared/specs/hfo.md`` section 2 (cited below as "spec 2.x")
 movement, kick, dash, turn, stamina and collisions, the agent-side processing that HFO's C++ agent
 (librcsc) applies to each low-level action, HFO's referee, the LOW_LEVEL_FEATURE_SET for one agent and
 Hausknecht & Stone's shaped reward. Every function works on one copy: its state is a float64 vector
-(the indices below) and its random numbers come from its own buffer of uniform draws. The scalar env
+(the indices below) and its random numbers come from its own stream (:func:`uniform`). The scalar env
 calls :func:`step_one` and :func:`reset_one` for its copy; the batched env calls :func:`step_batch` and
 :func:`reset_batch`, one compiled loop over the copies. A change here changes both.
 
@@ -13,7 +13,8 @@ degrees normalised to (-180, 180], +90 along +y, positive relative angles on the
 
 Everything Numba compiles lives in this one module with the constants it reads, so that Numba's
 on-disk cache (keyed by this file) is never stale. ``fastmath`` stays off: the recording of the real
-server is matched to the last digits the agent sees (``tests/test_hfo_traces.py``).
+server is matched to the last digits the agent sees (``tests/test_hfo_traces.py``). The speed of the
+compiled loop is recorded in ``benchmarks/hfo_speed.md``.
 """
 
 from __future__ import annotations
@@ -24,7 +25,8 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-jit = numba.njit(cache=True, nogil=True)
+#: ``error_model="numpy"``: no zero-divisor checks (every division here has a nonzero divisor or a guard).
+jit = numba.njit(cache=True, nogil=True, error_model="numpy")
 
 # --- Geometry (spec 2.1) -----------------------------------------------------------------------
 PITCH_HALF_LENGTH = 52.5
@@ -103,17 +105,15 @@ SEEN = 10
 EFFORT, RECOVERY, CAPACITY, PREV_BX, PREV_BY = range(20, 25)
 HOLDER, UNTOUCHED, CYCLES, KICKED, LAST_ACTION_OK, COLLIDED_BALL, COLLIDED_POST, KICKABLE_NOW = range(25, 33)
 #: Actions this episode; the kick bonus paid; the previous features the reward differences (f12, f53, and the
-#: ball-to-goal distance); the next unread entry of this copy's buffer of uniform draws.
-STEPS, BONUS_PAID, PREV_KICKABLE, PREV_BALL_PROXIMITY, PREV_TO_GOAL, CURSOR = range(33, 39)
-STATE_SIZE = 39
+#: ball-to-goal distance).
+STEPS, BONUS_PAID, PREV_KICKABLE, PREV_BALL_PROXIMITY, PREV_TO_GOAL = range(33, 38)
+#: The seen body angle whose cosine and sine are kept (they change only when the player turns).
+TRIG_BODY, COS_BODY, SIN_BODY = range(38, 41)
+STATE_SIZE = 41
 
 # --- Settings vector (built by :func:`settings`) -----------------------------------------------
 _PLAYER_RAND, _BALL_RAND, _KICK_RAND, _N_FEATURES, _MAX_DIST, _OOB_X, _OOB_Y = range(7)
 _TIMEOUT_TERMINAL, _TERMINAL_DELTAS, _FIRST_STEP_REWARD, _UNIFORM_BODY = range(7, 11)
-
-#: Uniform draws one step may take at most: a placement (5), a body angle and a push-apart direction on a
-#: reset; a turn's or a kick's noise (2), two movements' (4) and a push-apart direction on a step.
-MAX_DRAWS_PER_STEP = 8
 
 
 @dataclass(frozen=True)
@@ -199,26 +199,76 @@ def round_command(value):
     return np.rint(value * 1000.0) / 1000.0
 
 
+# --- One copy's random stream ---------------------------------------------------------------
+# xoshiro256++ (Blackman & Vigna, https://prng.di.unimi.it/xoshiro256plusplus.c): four uint64 words per
+# copy, advanced in place. Drawing from N buffers refilled from N NumPy generators cost a third of the
+# batched step at N = 1024 (the refills in Python, the reads scattered over N rows); these 32 bytes per
+# copy sit beside its state. Each copy's words are seeded from its own generator (``seed_stream``).
 @jit
-def uniform(s, draws, low, high):
-    """The copy's next U(low, high) draw, from its buffer ``draws`` at the cursor ``s[CURSOR]``."""
-    k = int(s[CURSOR])
-    s[CURSOR] = k + 1
-    return low + (high - low) * draws[k]
+def _rotl(x, k):
+    return (x << np.uint64(k)) | (x >> np.uint64(64 - k))
+
+
+@jit
+def next_double(r):
+    """The next number of the stream ``r`` (uint64[4]) in [0, 1): its top 53 bits times 2**-53."""
+    s0, s1, s2, s3 = r[0], r[1], r[2], r[3]
+    result = _rotl(s0 + s3, 23) + s0
+    t = s1 << np.uint64(17)
+    s2 ^= s0
+    s3 ^= s1
+    s1 ^= s2
+    s0 ^= s3
+    s2 ^= t
+    r[0], r[1], r[2], r[3] = s0, s1, s2, _rotl(s3, 45)
+    return (result >> np.uint64(11)) * (1.0 / 9007199254740992.0)
+
+
+@jit
+def _splitmix64(x):
+    """SplitMix64's output for ``x`` (https://prng.di.unimi.it/splitmix64.c): spreads the bits of a seed."""
+    z = x + np.uint64(0x9E3779B97F4A7C15)
+    z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
+    z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
+    return z ^ (z >> np.uint64(31))
+
+
+@jit
+def seed_stream(r, u):
+    """Seed the stream ``r`` from four numbers ``u`` in [0, 1) drawn from the copy's generator."""
+    for k in range(4):
+        r[k] = _splitmix64(np.uint64(u[k] * 9007199254740992.0) + np.uint64(k))
+
+
+@jit
+def uniform(rng, low, high):
+    """The next U(low, high) draw of a copy's stream ``rng``, as NumPy draws it: low + (high - low) u."""
+    return low + (high - low) * next_double(rng)
 
 
 def _fullstate_table() -> np.ndarray:
-    """Rows ``(bound, scale, scale_at_bound)`` per binary exponent e of ``math.frexp``, from e = -664
-    (1e-200) to 997 (1e300): the decimal exponent estimate k = floor((e - 1) log10 2), the power 10**(k + 1)
-    bounding it, and the scales 10**(5 - k), 10**(4 - k) giving 6 significant digits below and at or above."""
+    """Per biased binary exponent b of a float64 (its bits 52-62): the decimal exponent estimate
+    k = floor((b - 1023) log10 2) of a magnitude with that exponent, the power 10**(k + 1) bounding it, and
+    the scales 10**(5 - k) and 10**(4 - k) giving 6 significant digits below and at or above that bound."""
     rows = []
-    for e in range(-664, 998):
-        k = math.floor((e - 1) * math.log10(2.0))
+    for b in range(2048):
+        k = min(max(math.floor((b - 1023) * math.log10(2.0)), -294), 294)  # beyond: never reached
         rows.append((10.0 ** (k + 1), 10.0 ** (5 - k), 10.0 ** (4 - k)))
     return np.array(rows)
 
 
 _FULLSTATE = _fullstate_table()
+
+
+@jit
+def six_digits(x, biased_exponent):
+    """``x`` to 6 significant digits, given the biased binary exponent of its float64 (halves to even)."""
+    magnitude = abs(x)
+    if magnitude < 1e-200:
+        return x  # zero, or a decayed velocity too small to matter
+    row = _FULLSTATE[biased_exponent]
+    scale = row[2] if magnitude >= row[0] else row[1]
+    return np.rint(x * scale) / scale
 
 
 @jit
@@ -229,12 +279,7 @@ def fullstate_value(x):
     computed from them, and the recording shows rounding boundaries mattering (a turn moment 0.0005 from
     a multiple of 0.001 is rounded the other way when computed from the exact speed).
     """
-    magnitude = abs(x)
-    if magnitude < 1e-200:
-        return x  # zero, or a decayed velocity too small to matter
-    row = min(math.frexp(magnitude)[1] + 664, _FULLSTATE.shape[0] - 1)
-    scale = _FULLSTATE[row, 2] if magnitude >= _FULLSTATE[row, 0] else _FULLSTATE[row, 1]
-    return np.rint(x * scale) / scale
+    return six_digits(x, math.frexp(abs(x))[1] + 1022)
 
 
 # --- The agent's view (spec 2.3) ---------------------------------------------------------------
@@ -246,8 +291,9 @@ def sense(s):
     shows the server's 1.085 m (a ball 1.046 m away was reported kickable and kicked; one such case in
     the trace, and no counter-example).
     """
+    bits = s[:10].view(np.int64)  # the exponents from the bits: cheaper than frexp, the same numbers
     for k in range(10):
-        s[SEEN + k] = fullstate_value(s[k])
+        s[SEEN + k] = six_digits(s[k], (bits[k] >> 52) & 0x7FF)
     dist = norm(s[SEEN + BX] - s[SEEN + PX], s[SEEN + BY] - s[SEEN + PY])
     s[KICKABLE_NOW] = dist <= (KICKABLE_AREA if s[KICKED] else AGENT_KICKABLE_AREA)
 
@@ -299,17 +345,17 @@ def dash(s, power, direction):
 
 
 @jit
-def turn(s, draws, direction, player_rand):
+def turn(s, rng, direction, player_rand):
     """TURN(direction): the agent pre-multiplies by the inertia factor the server divides by."""
     moment = direction * (1.0 + INERTIA_MOMENT * norm(s[SEEN + PVX], s[SEEN + PVY]))
     moment = round_command(clip(moment, -180.0, 180.0))
     inertia = 1.0 + INERTIA_MOMENT * norm(s[PVX], s[PVY])
-    noise = 1.0 + uniform(s, draws, -player_rand, player_rand) if player_rand else 1.0
+    noise = 1.0 + uniform(rng, -player_rand, player_rand) if player_rand else 1.0
     s[BODY] = normalize_angle(s[BODY] + noise * moment / inertia)
 
 
 @jit
-def kick(s, draws, power, direction, kick_rand):
+def kick(s, rng, power, direction, kick_rand):
     """KICK(power, direction), sent only if the agent's test says kickable; returns the ball's acceleration."""
     power = round_command(clip(power, 0.0, 100.0))
     direction = clip(direction, -180.0, 180.0)
@@ -327,8 +373,8 @@ def kick(s, draws, power, direction, kick_rand):
         pos_rate = 0.5 + 0.25 * (dir_diff + gap)
         speed_rate = 0.5 + 0.5 * norm(s[BVX], s[BVY]) / (BALL_SPEED_MAX * BALL_DECAY)
         max_noise = kick_rand * (power / 100.0) * (pos_rate + speed_rate)
-        length = uniform(s, draws, 0.0, max_noise)
-        angle = uniform(s, draws, -math.pi, math.pi)
+        length = uniform(rng, 0.0, max_noise)
+        angle = uniform(rng, -math.pi, math.pi)
         kx += length * math.cos(angle)
         ky += length * math.sin(angle)
     return kx, ky
@@ -398,7 +444,7 @@ def post_collisions(x, y, vx, vy, radius):
 
 
 @jit
-def move(s, draws, o, ax, ay, accel_max, speed_max, rand, decay, radius):
+def move(s, rng, o, ax, ay, accel_max, speed_max, rand, decay, radius):
     """Spec 2.5.1 for the object whose x is ``s[o]`` (player ``PX`` or ball ``BX``); returns the post flag."""
     x, y, vx, vy = s[o], s[o + 1], s[o + 2], s[o + 3]
     if ax != 0.0 or ay != 0.0:
@@ -409,8 +455,8 @@ def move(s, draws, o, ax, ay, accel_max, speed_max, rand, decay, radius):
         shrink = speed_max / speed if speed > speed_max else 1.0
         vx, vy = vx * shrink, vy * shrink
     if rand and (vx != 0.0 or vy != 0.0):
-        length = uniform(s, draws, 0.0, rand * norm(vx, vy))
-        angle = uniform(s, draws, -math.pi, math.pi)
+        length = uniform(rng, 0.0, rand * norm(vx, vy))
+        angle = uniform(rng, -math.pi, math.pi)
         vx, vy = vx + length * math.cos(angle), vy + length * math.sin(angle)
     x, y, vx, vy, collided = post_collisions(x, y, vx, vy, radius)
     s[o], s[o + 1], s[o + 2], s[o + 3] = x, y, vx * decay, vy * decay
@@ -418,14 +464,14 @@ def move(s, draws, o, ax, ay, accel_max, speed_max, rand, decay, radius):
 
 
 @jit
-def resolve_overlap(s, draws):
+def resolve_overlap(s, rng):
     """Push player and ball apart about their midpoint to touching distance; both velocities * -0.1."""
     dx, dy = s[BX] - s[PX], s[BY] - s[PY]
     dist = norm(dx, dy)
     if dist > 0.0:
         nx, ny = dx / dist, dy / dist
     else:
-        angle = uniform(s, draws, -math.pi, math.pi)
+        angle = uniform(rng, -math.pi, math.pi)
         nx, ny = math.cos(angle), math.sin(angle)
     mx, my = 0.5 * (s[BX] + s[PX]), 0.5 * (s[BY] + s[PY])
     half = 0.5 * TOUCH_DISTANCE + CONTACT_EPSILON
@@ -483,7 +529,7 @@ def update_stamina(s):
 
 
 @jit
-def simulate(s, draws, a, x0, x1, cfg):
+def simulate(s, rng, a, x0, x1, cfg):
     """One agent action (``DASH(x0, x1)``, ``TURN(x0)`` or ``KICK(x0, x1)``) and one server cycle after it:
     movement, collisions, referee, stamina, the agent's new view. Returns the referee's status."""
     pax = pay = bax = bay = 0.0
@@ -491,19 +537,19 @@ def simulate(s, draws, a, x0, x1, cfg):
     if a == DASH:
         pax, pay = dash(s, x0, x1)
     elif a == TURN:
-        turn(s, draws, x0, cfg[_PLAYER_RAND])
+        turn(s, rng, x0, cfg[_PLAYER_RAND])
     elif s[KICKABLE_NOW]:
-        bax, bay = kick(s, draws, x0, x1, cfg[_KICK_RAND])
+        bax, bay = kick(s, rng, x0, x1, cfg[_KICK_RAND])
     else:
         sent = False  # HFO sends (turn 0) instead: no effect on the state (spec 2.12.3)
     s[KICKED] = a == KICK and sent
     s[LAST_ACTION_OK] = sent
     rand = cfg[_PLAYER_RAND]
-    s[COLLIDED_POST] = move(s, draws, PX, pax, pay, PLAYER_ACCEL_MAX, PLAYER_SPEED_MAX, rand, PLAYER_DECAY, PLAYER_SIZE)
-    move(s, draws, BX, bax, bay, BALL_ACCEL_MAX, BALL_SPEED_MAX, cfg[_BALL_RAND], BALL_DECAY, BALL_SIZE)
+    s[COLLIDED_POST] = move(s, rng, PX, pax, pay, PLAYER_ACCEL_MAX, PLAYER_SPEED_MAX, rand, PLAYER_DECAY, PLAYER_SIZE)
+    move(s, rng, BX, bax, bay, BALL_ACCEL_MAX, BALL_SPEED_MAX, cfg[_BALL_RAND], BALL_DECAY, BALL_SIZE)
     s[COLLIDED_BALL] = norm(s[BX] - s[PX], s[BY] - s[PY]) < TOUCH_DISTANCE
     if s[COLLIDED_BALL]:
-        resolve_overlap(s, draws)
+        resolve_overlap(s, rng)
     status = referee(s)
     update_stamina(s)
     sense(s)
@@ -512,7 +558,7 @@ def simulate(s, draws, a, x0, x1, cfg):
 
 # --- Episode start (spec 2.7 "Reset") -----------------------------------------------------------
 @jit
-def place(s, draws, bx, by, px, py):
+def place(s, rng, bx, by, px, py):
     """Start an episode with ball and player at rest at these positions; the body angle is kept.
 
     Mirrors what the agent first observes, two server cycles after HFO's placement (spec 2.7): full
@@ -523,7 +569,7 @@ def place(s, draws, bx, by, px, py):
     s[BX], s[BY], s[BVX], s[BVY] = bx, by, 0.0, 0.0
     s[STAMINA], s[EFFORT], s[RECOVERY], s[CAPACITY] = STAMINA_MAX, 1.0, 1.0, STAMINA_CAPACITY
     if norm(bx - px, by - py) < TOUCH_DISTANCE:
-        resolve_overlap(s, draws)
+        resolve_overlap(s, rng)
     s[PREV_BX], s[PREV_BY] = s[BX], s[BY]
     near = norm(s[BX] - s[PX], s[BY] - s[PY]) <= KICKABLE_AREA
     s[HOLDER] = near
@@ -531,29 +577,30 @@ def place(s, draws, bx, by, px, py):
     s[CYCLES] = COUNTERS_AT_FIRST_OBSERVATION
     s[COLLIDED_BALL] = s[COLLIDED_POST] = s[KICKED] = 0.0
     s[LAST_ACTION_OK] = 0.0  # HFO's interface took NOOPs between episodes (spec 2.8, f58)
+    s[TRIG_BODY] = np.nan
     sense(s)
 
 
 @jit
-def start_episode(s, draws, cfg, options, f):
+def start_episode(s, rng, cfg, options, f):
     """A new episode: HFO's placement, the body angle by the settings' rule, then any of ``options``
     (ball x, y, player x, y, body; NaN where not given) in their place. The features go to ``f``."""
-    u0, u1, u2 = uniform(s, draws, 0.0, 1.0), uniform(s, draws, 0.0, 1.0), uniform(s, draws, 0.0, 1.0)
-    u3, u4 = uniform(s, draws, 0.0, 1.0), uniform(s, draws, 0.0, 1.0)
+    u0, u1, u2 = uniform(rng, 0.0, 1.0), uniform(rng, 0.0, 1.0), uniform(rng, 0.0, 1.0)
+    u3, u4 = uniform(rng, 0.0, 1.0), uniform(rng, 0.0, 1.0)
     bx = BALL_X_MAX * u0
     by = -BALL_Y_MAX + 2.0 * BALL_Y_MAX * u1
     k = min(int(10.0 * u2), 9)
     px = clip(bx + START_SPREAD * (u3 + START_OFFSETS[k, 0]), START_X_MIN, PITCH_HALF_LENGTH)
     py = clip(by + START_SPREAD * (u4 + START_OFFSETS[k, 1]), -BALL_Y_MAX, BALL_Y_MAX)
     if cfg[_UNIFORM_BODY]:
-        s[BODY] = normalize_angle(uniform(s, draws, -180.0, 180.0))
+        s[BODY] = normalize_angle(uniform(rng, -180.0, 180.0))
     if not math.isnan(options[0]):
         bx, by = options[0], options[1]
     if not math.isnan(options[2]):
         px, py = options[2], options[3]
     if not math.isnan(options[4]):
         s[BODY] = normalize_angle(options[4])
-    place(s, draws, bx, by, px, py)
+    place(s, rng, bx, by, px, py)
     s[STEPS] = s[BONUS_PAID] = 0.0
     features(s, cfg, f)
     s[PREV_KICKABLE], s[PREV_BALL_PROXIMITY], s[PREV_TO_GOAL] = f[KICKABLE], f[BALL_PROXIMITY], ball_to_goal(f)
@@ -594,8 +641,10 @@ def features(s, cfg, f):
     lies in [-1, 1]; flags are ``2 f - 1``."""
     px, py, body, stamina = s[SEEN + PX], s[SEEN + PY], s[SEEN + BODY], s[SEEN + STAMINA]
     bx, by = s[SEEN + BX], s[SEEN + BY]
-    theta = math.radians(body)
-    cos_t, sin_t = math.cos(theta), math.sin(theta)
+    if s[TRIG_BODY] != body:  # NaN after a placement
+        theta = math.radians(body)
+        s[TRIG_BODY], s[COS_BODY], s[SIN_BODY] = body, math.cos(theta), math.sin(theta)
+    cos_t, sin_t = s[COS_BODY], s[SIN_BODY]
     f[0] = f[1] = f[50] = f[54] = 1.0  # position and velocity valid, ball position and velocity valid
     f[8] = f[10] = -1.0  # no opponent collision, no teammate collision
     f[9] = 1.0 if s[COLLIDED_BALL] else -1.0
@@ -635,11 +684,11 @@ def ball_to_goal(f):
 
 
 @jit
-def step_copy(s, draws, a, x0, x1, cfg, f):
+def step_copy(s, rng, a, x0, x1, cfg, f):
     """One step of one copy: the action, a server cycle, the features into ``f`` and Hausknecht & Stone's
     reward ``Δ ball proximity + 1[first time kickable] + 3 · (−Δ ball-to-goal, if the agent holds the
     ball) + 5 · 1[goal]`` with the quirks of the settings (spec 2.9). Returns ``(reward, status)``."""
-    status = simulate(s, draws, a, x0, x1, cfg)
+    status = simulate(s, rng, a, x0, x1, cfg)
     s[STEPS] += 1
     features(s, cfg, f)
     to_goal = ball_to_goal(f)
@@ -666,42 +715,34 @@ def ending(status, cfg):
 
 
 # --- Entry points: one copy (the scalar env) and a loop over copies (the batched env) -----------
-# ``draws`` and ``cursors`` are a ``RandomStreams``' buffers and cursors (``pamdp.envs.vector``); the cursor
-# of the copy at work is kept in its state while it steps.
 @jit
-def step_one(s, draws, cursors, a, x0, x1, cfg, f, obs):
-    """:func:`step_copy` of the one copy of ``draws`` (shape (1, capacity)); the observation, float32, into
-    ``obs``. Returns ``(reward, status)``."""
-    s[CURSOR] = cursors[0]
-    reward, status = step_copy(s, draws[0], a, x0, x1, cfg, f)
-    cursors[0] = s[CURSOR]
+def step_one(s, rng, a, x0, x1, cfg, f, obs):
+    """:func:`step_copy` of one copy; the observation, float32, into ``obs``. Returns ``(reward, status)``."""
+    reward, status = step_copy(s, rng, a, x0, x1, cfg, f)
     for k in range(obs.shape[0]):
         obs[k] = f[k]
     return reward, status
 
 
 @jit
-def reset_one(s, draws, cursors, cfg, options, f, obs):
-    """:func:`start_episode` of the one copy of ``draws``; the observation, float32, into ``obs``."""
-    s[CURSOR] = cursors[0]
-    start_episode(s, draws[0], cfg, options, f)
-    cursors[0] = s[CURSOR]
+def reset_one(s, rng, cfg, options, f, obs):
+    """:func:`start_episode` of one copy; the observation, float32, into ``obs``."""
+    start_episode(s, rng, cfg, options, f)
     for k in range(obs.shape[0]):
         obs[k] = f[k]
 
 
 @jit
-def step_batch(states, draws, cursors, a, dash_params, turn_params, kick_params, resetting, cfg, obs, reward,
-               status, terminated, truncated):  # fmt: skip
-    """Every copy i steps on its own state row and draw buffer; a copy whose episode ended on the previous
-    step (``resetting``) starts a new one instead, ignoring its action (Gymnasium's next-step autoreset)."""
+def step_batch(states, rngs, a, dash_params, turn_params, kick_params, resetting, cfg, obs, reward, status,
+               terminated, truncated):  # fmt: skip
+    """Every copy i steps on its own state row and stream; a copy whose episode ended on the previous step
+    (``resetting``) starts a new one instead, ignoring its action (Gymnasium's next-step autoreset)."""
     f = np.empty(59)
     no_options = np.full(5, np.nan)
     for i in range(states.shape[0]):
-        s = states[i]
-        s[CURSOR] = cursors[i]
+        s, r = states[i], rngs[i]
         if resetting[i]:
-            start_episode(s, draws[i], cfg, no_options, f)
+            start_episode(s, r, cfg, no_options, f)
             reward[i], status[i], terminated[i], truncated[i] = 0.0, IN_GAME, False, False
         else:
             action = a[i]
@@ -711,25 +752,21 @@ def step_batch(states, draws, cursors, a, dash_params, turn_params, kick_params,
                 x0 = x1 = turn_params[i, 0]
             else:
                 x0, x1 = kick_params[i, 0], kick_params[i, 1]
-            reward[i], status[i] = step_copy(s, draws[i], action, x0, x1, cfg, f)
+            reward[i], status[i] = step_copy(s, r, action, x0, x1, cfg, f)
             terminated[i], truncated[i] = ending(status[i], cfg)
-        cursors[i] = s[CURSOR]
         for k in range(obs.shape[1]):
             obs[i, k] = f[k]
 
 
 @jit
-def reset_batch(states, draws, cursors, mask, cfg, options, obs):
+def reset_batch(states, rngs, mask, cfg, options, obs):
     """A new episode in every copy where ``mask`` is true, row i of ``options`` as :func:`start_episode`'s;
     the other copies' rows of ``obs`` get their current observation."""
     f = np.empty(59)
     for i in range(states.shape[0]):
-        s = states[i]
         if mask[i]:
-            s[CURSOR] = cursors[i]
-            start_episode(s, draws[i], cfg, options[i], f)
-            cursors[i] = s[CURSOR]
+            start_episode(states[i], rngs[i], cfg, options[i], f)
         else:
-            features(s, cfg, f)
+            features(states[i], cfg, f)
         for k in range(obs.shape[1]):
             obs[i, k] = f[k]

@@ -8,10 +8,6 @@ from gymnasium import spaces
 
 from pamdp.envs.hfo import dynamics as dyn
 from pamdp.envs.hfo.interface import check_settings, draw_half_field, hfo_action_space, parse_action, reset_options
-from pamdp.envs.vector import RandomStreams
-
-#: Uniform draws kept per copy (scalar and batched); any size gives the same episodes.
-BUFFER_SIZE = 512
 
 
 class HalfFieldOffenseEnv(gymnasium.Env):
@@ -48,7 +44,8 @@ class HalfFieldOffenseEnv(gymnasium.Env):
     observation returned with a terminal status is the true terminal state. ``reset(options=...)``
     accepts ``ball`` (x, y), ``player`` (x, y) and ``body`` (degrees), in the server's metres (goal
     centre at (52.5, 0)); missing ones are drawn as usual. Every random number (placements, actuator
-    noise) comes from ``np_random`` in order, as in each copy of :class:`HalfFieldOffenseVectorEnv`.
+    noise) comes from a stream seeded from ``np_random`` (``dynamics.seed_stream``; again whenever
+    ``np_random`` is replaced, as by a seeded reset), as in each copy of :class:`HalfFieldOffenseVectorEnv`.
     ``state`` is the copy's state vector (indices in ``dynamics``).
     """
 
@@ -74,7 +71,8 @@ class HalfFieldOffenseEnv(gymnasium.Env):
         self.observation_space = spaces.Box(-1.0, 1.0, (n,), dtype=np.float32)
         self.action_space = hfo_action_space()
         self.state = np.zeros(dyn.STATE_SIZE)  # the first episode faces the goal (body 0)
-        self.streams = RandomStreams(1, "random", BUFFER_SIZE)
+        self.stream = np.zeros(4, dtype=np.uint64)
+        self._stream_source = None  # the generator that seeded the stream
         self._features = np.zeros(59)
         self._started = False
 
@@ -83,10 +81,9 @@ class HalfFieldOffenseEnv(gymnasium.Env):
         placement = reset_options(options, 1)[0]
         if seed is not None:
             self.state[dyn.BODY] = 0.0  # a seed starts a new server run, whose first episode faces the goal
-        self._draw_ready()
+        self._follow_np_random()
         obs = np.empty(self.profile.n_features, dtype=np.float32)
-        streams = self.streams
-        dyn.reset_one(self.state, streams.buffers, streams.cursors, self.settings, placement, self._features, obs)
+        dyn.reset_one(self.state, self.stream, self.settings, placement, self._features, obs)
         self._started = True
         return obs, {"status": "IN_GAME", "step": 0}
 
@@ -94,11 +91,9 @@ class HalfFieldOffenseEnv(gymnasium.Env):
         if not self._started:
             raise gymnasium.error.ResetNeeded("call reset() before step()")
         a, x0, x1 = parse_action(action)
-        self._draw_ready()
+        self._follow_np_random()
         obs = np.empty(self.profile.n_features, dtype=np.float32)
-        reward, status = dyn.step_one(
-            self.state, self.streams.buffers, self.streams.cursors, a, x0, x1, self.settings, self._features, obs
-        )
+        reward, status = dyn.step_one(self.state, self.stream, a, x0, x1, self.settings, self._features, obs)
         terminated, truncated = dyn.ending(status, self.settings)
         info = {"status": dyn.STATUS_NAMES[status], "step": int(self.state[dyn.STEPS])}
         if terminated or truncated:
@@ -110,8 +105,9 @@ class HalfFieldOffenseEnv(gymnasium.Env):
             return None
         return draw_half_field(self.state)
 
-    def _draw_ready(self) -> None:
-        """Draw from ``np_random`` (a seeded reset or an assignment may have replaced it), enough for a step."""
-        self.streams.follow(0, self.np_random)
-        if self.streams.cursors[0] > BUFFER_SIZE - dyn.MAX_DRAWS_PER_STEP:
-            self.streams.refill(dyn.MAX_DRAWS_PER_STEP)
+    def _follow_np_random(self) -> None:
+        """Seed the stream from ``np_random`` if that is a new generator (a seeded reset or an assignment)."""
+        rng = self.np_random
+        if rng is not self._stream_source:
+            dyn.seed_stream(self.stream, rng.random(4))
+            self._stream_source = rng
