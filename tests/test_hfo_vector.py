@@ -1,10 +1,8 @@
 """The batched HFO env: registration, per-copy random streams (copy i is the scalar env with copy i's seed,
-noise on), next-step autoreset, reset options and masks, errors, copies, rendering."""
+noise on), next-step autoreset, reset options and masks, errors, rendering. Copies of the env:
+``tests/test_vector.py``."""
 
 from __future__ import annotations
-
-import copy
-import pickle
 
 import gymnasium
 import numpy as np
@@ -149,22 +147,6 @@ def test_bad_batched_actions_raise_clear_errors(make, words):
     with pytest.raises(ValueError) as error:
         env.step(make(2))
     assert all(w in str(error.value) for w in words), str(error.value)
-
-
-def test_a_copied_batched_env_goes_on_as_the_original():
-    env = HalfFieldOffenseVectorEnv(num_envs=3)
-    env.reset(seed=1)
-    env.action_space.seed(0)
-    for _ in range(5):
-        env.step(env.action_space.sample())
-    copies = [copy.deepcopy(env), pickle.loads(pickle.dumps(env))]
-    for _ in range(60):
-        action = env.action_space.sample()
-        obs, reward, *_ = env.step(action)
-        for other in copies:
-            obs2, reward2, *_ = other.step(action)
-            np.testing.assert_array_equal(obs2, obs)
-            np.testing.assert_array_equal(reward2, reward)
 
 
 def test_noise_and_render():

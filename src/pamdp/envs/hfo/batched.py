@@ -21,7 +21,8 @@ _STATUS_NAMES = np.array(dyn.STATUS_NAMES)
 class HalfFieldOffenseVectorEnv(BatchedVectorEnv):
     """``num_envs`` HFO 1v0 games, with Gymnasium's next-step autoreset.
 
-    Takes the keyword arguments of :class:`pamdp.envs.hfo.HalfFieldOffenseEnv`. Actions are the
+    Takes the keyword arguments of :class:`pamdp.envs.hfo.HalfFieldOffenseEnv` (``settings``), and the
+    shell's ``max_episode_steps`` (None: HFO's own clocks end the episodes). Actions are the
     ``batch_space`` of the scalar action space: ``(a[N], (dash[N, 2], turn[N, 1], kick[N, 2]))``. A copy
     that ended on the previous step is reset instead of stepped (its action is ignored) and returns its
     first observation with reward 0. ``infos`` holds ``status`` (strings) and ``step`` per copy, and
@@ -40,20 +41,9 @@ class HalfFieldOffenseVectorEnv(BatchedVectorEnv):
     draws_per_step = 0  # the numbers come from the copies' streams, not from the shell's buffers
 
     def __init__(
-        self,
-        num_envs: int = 1,
-        render_mode: str | None = None,
-        profile: str = "hfo2017",
-        deterministic: bool = False,
-        timeout_terminal: bool = False,
-        body_reset: str = "carry",
-        first_step_reward: bool = False,
-        terminal_deltas: bool = False,
-        max_episode_steps: int | None = None,
+        self, num_envs: int = 1, render_mode: str | None = None, max_episode_steps: int | None = None, **settings
     ):
-        single = HalfFieldOffenseEnv(
-            render_mode, profile, deterministic, timeout_terminal, body_reset, first_step_reward, terminal_deltas
-        )
+        single = HalfFieldOffenseEnv(render_mode, **settings)
         super().__init__(num_envs, single, max_episode_steps, render_mode)
         self.profile, self.settings = single.profile, single.settings
         self.states = np.zeros((self.num_envs, dyn.STATE_SIZE))
