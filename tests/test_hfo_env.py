@@ -11,8 +11,8 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 import pamdp  # noqa: F401  (registers the envs)
+import pamdp.envs.hfo.dynamics as dyn
 from pamdp.envs.hfo import HalfFieldOffenseEnv, scripted_scorer
-from pamdp.envs.hfo import dynamics as dyn
 from pamdp.envs.rendering import record_episode
 
 TURN0 = (1, (np.zeros(2, np.float32), np.zeros(1, np.float32), np.zeros(2, np.float32)))

@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
+import pamdp.envs.hfo.dynamics as dyn
 from pamdp.envs.hfo import HalfFieldOffenseEnv
-from pamdp.envs.hfo import dynamics as dyn
 from pamdp.envs.hfo.dynamics import DASH, KICK, TURN
 
 

@@ -10,8 +10,8 @@ import pytest
 from gymnasium.vector import AutoresetMode
 
 import pamdp  # noqa: F401  (registers the envs)
+import pamdp.envs.hfo.dynamics as dyn
 from pamdp.envs.hfo import HalfFieldOffenseEnv, HalfFieldOffenseVectorEnv, scripted_scorer_batch
-from pamdp.envs.hfo import dynamics as dyn
 
 
 def mixed_actions(obs, rng):

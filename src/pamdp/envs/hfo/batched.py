@@ -10,7 +10,7 @@ from __future__ import annotations
 import gymnasium
 import numpy as np
 
-from pamdp.envs.hfo import dynamics as dyn
+import pamdp.envs.hfo.dynamics as dyn
 from pamdp.envs.hfo.env import HalfFieldOffenseEnv
 from pamdp.envs.hfo.interface import draw_half_field, parse_actions, reset_options
 from pamdp.envs.vector import BatchedVectorEnv, copy_seeds

@@ -6,7 +6,7 @@ import gymnasium
 import numpy as np
 from gymnasium import spaces
 
-from pamdp.envs.hfo import dynamics as dyn
+import pamdp.envs.hfo.dynamics as dyn
 from pamdp.envs.hfo.interface import check_settings, draw_half_field, hfo_action_space, parse_action, reset_options
 
 

@@ -9,7 +9,7 @@ import math
 import numpy as np
 from gymnasium import spaces
 
-from pamdp.envs.hfo import dynamics as dyn
+import pamdp.envs.hfo.dynamics as dyn
 from pamdp.envs.rendering import Canvas
 
 ACTION_NAMES = ("DASH", "TURN", "KICK")
