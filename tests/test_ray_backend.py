@@ -8,9 +8,8 @@ import textwrap
 from pathlib import Path
 
 import pytest
-from ray_cluster import run_on_local_cluster
-
 from pamdp.experiments.ray_backend import _Inbox, _Mirror
+from ray_cluster import run_on_local_cluster
 
 
 class _Rounds:
@@ -31,12 +30,14 @@ class _Rounds:
 
 
 def _tree(directory: Path) -> list[Path]:
-    return sorted(p for p in directory.rglob("*") if p.is_file())
+    """The files, less the lock file that each side holds for itself."""
+    return sorted(p for p in directory.rglob("*") if p.is_file() and p.name != ".lock")
 
 
-def _same_files(a: Path, b: Path, hidden=(".lock",)) -> None:
-    seen = {p.relative_to(a).as_posix(): p.read_bytes() for p in _tree(a) if p.name not in hidden}
-    assert seen == {p.relative_to(b).as_posix(): p.read_bytes() for p in _tree(b)}
+def _same_files(a: Path, b: Path) -> None:
+    assert {p.relative_to(a).as_posix(): p.read_bytes() for p in _tree(a)} == {
+        p.relative_to(b).as_posix(): p.read_bytes() for p in _tree(b)
+    }
 
 
 def test_the_driver_copy_follows_rewrites_and_appends_and_refuses_an_older_attempt(tmp_path):
@@ -53,6 +54,7 @@ def test_the_driver_copy_follows_rewrites_and_appends_and_refuses_an_older_attem
             f.write(f"epoch {epoch}\n")
         assert a.send()
         _same_files(first, out)
+    assert not (out / ".lock").exists(), "the worker's lock file stays on the worker"
     sent = a.mirror._scan()
     assert sent == [], "nothing changed, nothing to send"
 
@@ -66,6 +68,7 @@ def test_the_driver_copy_follows_rewrites_and_appends_and_refuses_an_older_attem
     assert b.send()
     assert (out / "stdout.log").read_text() == "epoch 1\nepoch 2\nepoch 3\nresumed\n"
     _same_files(second, out)
+    inbox.close()
 
 
 def _rows(path: Path) -> list[dict]:
@@ -129,6 +132,10 @@ def test_a_sweep_survives_the_loss_of_a_worker_node_and_its_run_resumes_from_its
         run = tmp_path / f"seed{seed}"
         for name in ("run.json", "final_model.pt", "evaluation.json"):
             assert (run / name).exists(), run / name
+        assert json.loads((run / "run.json").read_text())["command"] == [
+            str(tmp_path / "cluster_script.py"),
+            str(tmp_path),
+        ]
         rows = _rows(run / "progress.csv")
         steps = [float(r["time/total_timesteps"]) for r in rows]
         assert [float(r["time/epoch"]) for r in rows] == list(range(1, len(rows) + 1)), "each epoch exactly once"

@@ -13,6 +13,7 @@ epoch is counted twice. Needs the ``ray`` extra: ``pip install pamdp[ray]``.
 from __future__ import annotations
 
 import os
+import sys
 import tempfile
 import time
 import traceback
@@ -87,6 +88,10 @@ class _Inbox:
             _write(Path(out) / rel, offset, data)
         return True
 
+    def close(self) -> None:
+        """Let the run directories go (the sweep is over): no attempt writes any more."""
+        self.attempts.clear()
+
 
 class _Mirror:
     """A task's side of its run directory: sends the driver what changed in ``run_dir`` since the last send."""
@@ -118,10 +123,12 @@ class _Mirror:
 
         changes = self._scan()
         if changes and not ray.get(self.inbox.write.remote(self.out, self.attempt, changes)):
-            raise RuntimeError(f"{self.out}: a later attempt at this run has taken over; this one stops")
+            raise RuntimeError(
+                f"{self.out} takes no more writes from this attempt (a later one took over, or the sweep ended)"
+            )
 
 
-def _remote_run(spec: RunSpec, out: str, inbox) -> tuple[dict | None, str | None]:
+def _remote_run(spec: RunSpec, out: str, inbox, command: list[str]) -> tuple[dict | None, str | None]:
     import ray
 
     attempt, files = ray.get(inbox.open.remote(out))
@@ -134,10 +141,13 @@ def _remote_run(spec: RunSpec, out: str, inbox) -> tuple[dict | None, str | None
         with open(run_dir / "stdout.log", "a") as f:
             node = ray.get_runtime_context().get_node_id()
             print(f"attempt {attempt} on Ray node {node} ({ray.util.get_node_ip_address()})", file=f)
+        worker_argv, sys.argv = sys.argv, command  # run.json records the command that started the sweep
         try:
             result, error = _worker(spec, str(run_dir), callback=mirror.send), None
         except Exception:
             result, error = None, traceback.format_exc()
+        finally:
+            sys.argv = worker_argv
         mirror.send()
         return result, error
 
@@ -167,17 +177,22 @@ def run_all_ray(
         task = ray.remote(num_cpus=1, max_retries=retries)(_remote_run)
         pending = {}
         for spec, out in jobs:
-            pending[task.remote(spec, os.path.abspath(out), inbox)] = (spec, out, time.time())
+            pending[task.remote(spec, os.path.abspath(out), inbox, sys.argv)] = (spec, out, time.time())
         outcomes: list[RunOutcome] = []
-        while pending:
-            (ref,), _ = ray.wait(list(pending), num_returns=1)
-            spec, out, t0 = pending.pop(ref)
-            try:
-                result, error = ray.get(ref)
-            except Exception:
-                result, error = None, traceback.format_exc()
-            outcomes.append(RunOutcome(spec, out, result, error, time.time() - t0))
-            log(_describe(outcomes[-1]))
+        try:
+            while pending:
+                (ref,), _ = ray.wait(list(pending), num_returns=1)
+                spec, out, t0 = pending.pop(ref)
+                try:
+                    result, error = ray.get(ref)
+                except Exception:
+                    result, error = None, traceback.format_exc()
+                outcomes.append(RunOutcome(spec, out, result, error, time.time() - t0))
+                log(_describe(outcomes[-1]))
+        finally:  # interrupted: the runs still going stop, and their directories are let go
+            for ref in pending:
+                ray.cancel(ref, force=True)
+            ray.get(inbox.close.remote())
         return outcomes
     finally:
         if started_here:
