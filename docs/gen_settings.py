@@ -19,15 +19,11 @@ import sys
 import typing
 from pathlib import Path
 
-from pamdp.algos.hyar import HyARConfig
-from pamdp.algos.paddpg import PADDPGConfig
-from pamdp.algos.pappo import PAPPOConfig
-from pamdp.algos.pasvg import PASVG0Config
-from pamdp.algos.patrpo import PATRPOConfig
-from pamdp.algos.pdqn import PDQNConfig
+from pamdp.algos import ALGORITHMS, algorithm_class
 
 UNCONSTRAINED = {bool: "True or False", int: "any integer", float: "any finite number"}
-CONFIGS = {c.__name__: c for c in (PATRPOConfig, PAPPOConfig, PASVG0Config, PADDPGConfig, PDQNConfig, HyARConfig)}
+# every registered algorithm's config, so that a new algorithm's table is asked for (its markers) and written
+CONFIGS = {c.__name__: c for c in (algorithm_class(name).config_class for name in ALGORITHMS)}
 DOC = Path(__file__).with_name("algorithms.md")
 BLOCK = re.compile(r"(<!-- settings:(\w+) start -->\n)(.*?)(<!-- settings:\2 end -->)", re.DOTALL)
 

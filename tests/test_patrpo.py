@@ -1,5 +1,7 @@
 """PATRPO: advantages by hand, reproducibility, save/load, errors, and a short learning run."""
 
+import copy
+import dataclasses
 import os
 import stat
 
@@ -16,7 +18,6 @@ from pamdp.algos.paddpg import PADDPGConfig
 from pamdp.algos.patrpo import PATRPOConfig
 from pamdp.algos.trpo import flat_grad, flat_params
 from pamdp.distributions import KL_ESTIMATORS, kl_divergence
-from pamdp.evaluation import evaluate
 
 SMALL = PATRPOConfig(hidden_sizes=(32, 32), batch_size=1000, num_envs=8, vf_hidden_sizes=(32,))
 
@@ -112,21 +113,35 @@ def test_same_seed_gives_identical_first_epochs():
     assert not torch.equal(stats[0], torch.cat([p.detach().flatten() for p in other.policy.parameters()]))
 
 
+def float64_batch(model: PATRPO, n: int) -> tuple[torch.Tensor, ...]:
+    """``n`` samples of ``model``'s policy with their advantages, as the policy update takes them, after which
+    the policy computes in float64: so that its conjugate gradients converge to rounding."""
+    cfg = model.config
+    batch = model.rollout.collect(model.vec_env, model.policy, model.hybrid, n, model.np_rng, model.torch_gen)
+    model.policy.double()
+    data, _ = advantage_batch(batch, model._values, cfg.gamma, cfg.gae_lambda, True)
+    return tuple(t.double() if t.is_floating_point() else t for t in update_tensors(data))
+
+
 @pytest.mark.parametrize("estimator", ["chain_analytic", "chain_sample"])
 def test_gauss_newton_and_double_backprop_take_the_same_step(estimator):
-    """The two Fisher-vector products are the same matrix, so an epoch ends at the same parameters."""
-    params = []
+    """The two Fisher-vector products are the same matrix, so from the same batch, parameters and random
+    stream (the product's subsample) the two updates take the same step. The products agree to float64
+    rounding; ten conjugate-gradient iterations on an ill-conditioned matrix amplify that to about 1e-6 of
+    the step's largest entry."""
+    cfg = PATRPOConfig.from_dict({"kl_estimator": estimator, "fvp_subsample": 0.5}, base=SMALL)
+    model = PATRPO("pamdp/Platform-v0", cfg)
+    tensors = float64_batch(model, 1000)
+    start, stream = copy.deepcopy(model.policy.state_dict()), model.torch_gen.get_state()
+    before = flat_params(list(model.policy.parameters()))
+    steps = []
     for fvp in ("gauss_newton", "double_backprop"):
-        cfg = PATRPOConfig.from_dict({"fvp": fvp, "kl_estimator": estimator, "fvp_subsample": 0.5}, base=SMALL)
-        model = PATRPO("pamdp/Platform-v0", cfg)
-        before = torch.cat([p.detach().flatten() for p in model.policy.parameters()])
-        stats = []
-        model.learn(1000, progress_bar=False, callback=lambda algo, s, out=stats: out.append(s))
-        assert stats[0]["train/line_search_success"] == 1.0
-        params.append(torch.cat([p.detach().flatten() for p in model.policy.parameters()]))
-    step = params[1] - before
-    # float32 conjugate gradients on two roundings of one matrix: agreement to a few 1e-4 of the largest entry
-    torch.testing.assert_close(params[0] - before, step, atol=3e-4 * float(step.abs().max()), rtol=0)
+        model.policy.load_state_dict(start)
+        model.torch_gen.set_state(stream)
+        model.config = dataclasses.replace(cfg, fvp=fvp)
+        assert model._update_policy(*tensors)["train/line_search_success"] == 1.0
+        steps.append(flat_params(list(model.policy.parameters())) - before)
+    torch.testing.assert_close(steps[0], steps[1], atol=1e-5 * float(steps[1].abs().max()), rtol=0)
 
 
 def test_save_load_predict_round_trip(tmp_path):
@@ -166,7 +181,7 @@ def test_load_errors_are_clear(tmp_path):
 
 def test_predict_and_save_refuse_bad_input_clearly(tmp_path):
     model = PATRPO("pamdp/Platform-v0", SMALL)
-    with pytest.raises(ValueError, match=r"observation of shape \(5,\); expected \(9,\) or \(N, 9\)"):
+    with pytest.raises(ValueError, match=r"observation.* of shape \(5,\); expected .*\(9,\) or \(N, 9\)"):
         model.predict(np.zeros(5))
     obs = np.zeros((3, 9))
     obs[1, 4] = np.nan
@@ -199,15 +214,6 @@ def test_loading_never_executes_code(tmp_path):
     assert not (tmp_path / "flag").exists()
 
 
-def test_short_run_beats_the_random_policy():
-    cfg = PATRPOConfig.preset("tuned")
-    model = PATRPO("pamdp/Platform-v0", cfg)
-    model.learn(40_000, progress_bar=False)
-    result = evaluate(model, episodes=300, seed=123)
-    # The uniformly random policy scores 0.154 (spec section 8).
-    assert result["mean_return"] > 0.25, result
-
-
 def test_top_level_import():
     assert pamdp.PATRPO is PATRPO
 
@@ -231,10 +237,7 @@ def test_an_update_takes_the_natural_step_of_its_kl_estimators_explicit_hessian(
     settings = {"hidden_sizes": [6], "kl_estimator": estimator, "delta": 1e-3, "cg_iters": 200, "cg_damping": 1e-2}
     cfg = PATRPOConfig.from_dict(settings, SMALL)
     model = PATRPO("pamdp/Platform-v0", cfg)
-    batch = model.rollout.collect(model.vec_env, model.policy, model.hybrid, 300, model.np_rng, model.torch_gen)
-    model.policy.double()  # float64, so that the conjugate gradients solve D d = g to rounding
-    data, _ = advantage_batch(batch, model._values, cfg.gamma, cfg.gae_lambda, True)
-    obs, a, x, adv = (t.double() if t.is_floating_point() else t for t in update_tensors(data))
+    obs, a, x, adv = float64_batch(model, 300)
     params = [p for p in model.policy.parameters() if p.requires_grad]
     with torch.no_grad():
         old = model.policy(obs).detach()

@@ -53,7 +53,7 @@ class PAPPOConfig(AlgoConfig):
 
     num_envs: int = setting(
         64,
-        "Copies of the env stepped together (batched from 48 on, twice as fast as 32 scalar copies on Platform).",
+        "Copies of the env stepped together; PAPPO's samples are on-policy, so more is just faster.",
         at_least(1),
     )
     hidden_sizes: tuple[int, ...] = setting((64, 64), "Hidden layers of pi_d and pi_c (each its own network).", LAYERS)
@@ -86,8 +86,8 @@ class PAPPOConfig(AlgoConfig):
     )
     ent_coef_d: float = setting(
         0.01,
-        "Weight of pi_d's entropy in the loss: keeps every discrete action tried. Platform needs 0.3; at 0.01-0.1 "
-        "pi_d turns deterministic within ~150k samples and the return stays at 0.80-0.90.",
+        "Weight of pi_d's entropy in the loss: keeps every discrete action tried. Platform needs about 0.3 (the "
+        "tuned preset): with less, pi_d turns deterministic early and the return stalls below the optimum.",
         NON_NEGATIVE,
     )
     ent_coef_c: float = setting(
@@ -116,11 +116,8 @@ class PAPPOConfig(AlgoConfig):
 
     @classmethod
     def presets(cls) -> dict[str, Self]:
-        # "tuned": single runs of 300k samples on Platform (this project's shared 2-core machine; probes, not a
-        # benchmark). The defaults and six variations (target_kl 0.02; ent_coef_d 0.05 or 0.1; init_log_std -1 or
-        # -0.5; ent_coef_c 0.01 with gae_lambda 0.97; relu {200, 100, 50}) settled within 150k samples at greedy
-        # returns of 0.80 to 0.90, falling into the second gap: pi_d's entropy had dropped to ~0.01 nats. With
-        # ent_coef_d = 0.3 it keeps ~0.2 nats; greedy returns after 300k samples 1.000, 0.970, 0.958 (seeds 0-2).
+        # "tuned": found by single probe runs on Platform (ent_coef_d's help says why; the record of its
+        # learning: benchmarks/later_platform.md)
         return {"default": cls(), "tuned": cls(ent_coef_d=0.3, target_kl=0.02)}
 
 

@@ -86,7 +86,7 @@ class AlgoConfig:
         True,
         "Flush subnormal floats to zero (x86 FTZ/DAZ) in the CPU arithmetic of the gradient updates, never while "
         "the env steps: Adam's decaying moments can reach the subnormal range, where each operation is many times "
-        "slower (PASVG(0) trains 1.6x to 1.7x faster with it, benchmarks/denormals.md).",
+        "slower (what it buys each algorithm: benchmarks/denormals.md).",
     )
     vector_mode: str = setting(
         "auto",

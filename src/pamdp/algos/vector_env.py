@@ -12,12 +12,10 @@ from gymnasium import spaces
 __all__ = ["env_spec", "make_vector_env", "describe_env", "auto_batch_min"]
 
 # A batched env on its NumPy backend pays NumPy's per-call cost on every inner loop iteration, whatever its
-# number of copies; below about this many copies, scalar envs stepped one after the other are faster (measured
-# on Platform: 8 copies run ~600 steps/s batched, ~3 500 as scalar copies; the two meet near 48; HFO's near 32).
+# number of copies: below about this many copies, scalar envs stepped one after the other are faster.
 AUTO_BATCH_MIN = 48
-# With Numba (pamdp[fast]) the batched envs run compiled kernels and win from two copies on (2026-11-29, one
-# core: Platform 13 000 against 4 000 steps/s at 2 copies, 73 000 against 6 300 at 8; HFO 55 000 against
-# 21 000 at 2, 196 000 against 29 000 at 8); a single HFO copy is faster scalar (34 000 against 16 000).
+# With Numba (pamdp[fast]) the batched envs run compiled kernels and win from two copies on (the measurements:
+# benchmarks/platform_speed.md, benchmarks/hfo_speed.md).
 AUTO_BATCH_MIN_NUMBA = 2
 
 
