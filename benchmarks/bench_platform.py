@@ -255,7 +255,7 @@ def main(argv=None) -> None:
     scalar_ratio = np.median(results["pamdp PlatformEnv"]) / peer_median
     vec_ratio = np.median(results["pamdp PlatformVectorEnv, N=1024"]) / peer_median
     load = os.getloadavg() if hasattr(os, "getloadavg") else None
-    command = " ".join([os.path.relpath(sys.executable), os.path.relpath(__file__), *(argv or sys.argv[1:])])
+    command = " ".join(["python", os.path.relpath(__file__), *(argv or sys.argv[1:])])
     text = f"""# Platform speed: agent steps per second, random actions
 
 Written by `benchmarks/bench_platform.py` on {datetime.datetime.now().strftime("%Y-%m-%d %H:%M")}.
