@@ -9,6 +9,7 @@ import typing
 
 import pytest
 
+from pamdp.algos import ALGORITHMS, algorithm_class
 from pamdp.algos.hyar import HyARConfig
 from pamdp.algos.paddpg import PADDPGConfig
 from pamdp.algos.pappo import PAPPOConfig
@@ -17,7 +18,7 @@ from pamdp.algos.patrpo import PATRPOConfig
 from pamdp.algos.pdqn import PDQNConfig
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, at_least, interval, one_of
 
-CONFIGS = [PATRPOConfig, PAPPOConfig, PASVG0Config, PADDPGConfig, PDQNConfig, HyARConfig]
+CONFIGS = [algorithm_class(name).config_class for name in ALGORITHMS]  # every registered algorithm's
 # Settings any value of their type suits: PATRPO's and PAPPO's initial log-std (any finite number).
 UNCONSTRAINED = {(PATRPOConfig, "init_log_std"), (PAPPOConfig, "init_log_std")}
 

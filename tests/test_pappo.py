@@ -17,7 +17,6 @@ import pamdp
 from pamdp import PAPPO
 from pamdp.algos.pappo import PAPPOConfig, clipped_surrogate, ppo_loss
 from pamdp.cli import main
-from pamdp.experiments.runner import default_preset
 from pamdp.policies import HybridPolicy, ValueNetwork
 from pamdp.spaces import HybridActionSpace
 
@@ -179,9 +178,7 @@ def test_bad_settings_raise_errors_naming_the_field(kwargs, match):
         PAPPOConfig(**kwargs)
 
 
-def test_presets_and_plain_data():
-    presets = PAPPOConfig.presets()
-    assert presets["default"] == PAPPOConfig() and default_preset(PAPPOConfig) == "tuned"
+def test_plain_data_with_an_unknown_or_mistyped_setting_is_refused_naming_it():
     with pytest.raises(ValueError, match="unknown PAPPOConfig setting"):
         PAPPOConfig.from_dict({"clip": 0.1})
     with pytest.raises(ValueError, match="'n_epochs' = 2.5"):
