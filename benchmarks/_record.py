@@ -95,7 +95,6 @@ def run_and_record(
     seeds,
     runs=None,
     title=None,
-    stack: int = 1,
 ) -> None:
     """Run ``experiment`` (a TOML file next to this script, or a packaged experiment's name such as
     ``platform``), only its arms labelled ``runs`` if given, and write ``record`` with its figures.
@@ -108,7 +107,7 @@ def run_and_record(
     jobs = [(s, str(exp.run_dir(out_root, s))) for s in specs]
     finished_before = all(is_finished(Path(out), spec) for spec, out in jobs)
     t0 = time.time()
-    outcomes = run_all(jobs, workers=workers, stack=stack)
+    outcomes = run_all(jobs, workers=workers)
     wall = time.time() - t0
     if finished_before and (HERE / record).exists() and not any(o.error for o in outcomes):
         # Every run had finished before: the record already says what they gave, with its own command and date.
@@ -142,7 +141,6 @@ def run_and_record(
         f"- date: {dt.datetime.now().isoformat(timespec='minutes')}",
         f"- machine: {machine()}",
         f"- {len(jobs)} runs of {jobs[0][0].total_steps:,} steps, {workers} processes at a time"
-        + (f", up to {stack} seeds stacked in each" if stack > 1 else "")
         + "; this invocation took "
         f"{wall / 60:.1f} min (runs finished by an earlier, interrupted invocation are skipped, partial ones resumed)",
         "- training time of one run (median per setting, from its progress.csv; another run beside it): "
@@ -177,7 +175,7 @@ def run_and_record(
 
 def main(experiment: str, doc: str, workers: int = 2, runs=None, record=None, title=None) -> None:
     """The command line every learning benchmark shares:
-    ``[--workers N] [--stack S] [--scale F] [--seeds 0,1] [--out DIR]`` (``--stack``: ``pamdp reproduce --stack``).
+    ``[--workers N] [--scale F] [--seeds 0,1] [--out DIR]``.
 
     ``experiment``, ``runs`` and ``title`` as in :func:`run_and_record`; ``record`` defaults to the
     experiment file's name with ``.md``.
@@ -186,11 +184,10 @@ def main(experiment: str, doc: str, workers: int = 2, runs=None, record=None, ti
 
     p = argparse.ArgumentParser(description=doc, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--workers", type=int, default=workers)
-    p.add_argument("--stack", type=int, default=1, help="seeds per process, stacked (pamdp reproduce --stack)")
     p.add_argument("--scale", type=float, default=1.0)
     p.add_argument("--seeds", default=None)
     p.add_argument("--out", default="results/bench")
     a = p.parse_args()
     seeds = [int(s) for s in a.seeds.split(",")] if a.seeds else None
     record = record or Path(experiment).with_suffix(".md").name
-    run_and_record(experiment, a.out, record, a.workers, a.scale, seeds, runs, title, a.stack)
+    run_and_record(experiment, a.out, record, a.workers, a.scale, seeds, runs, title)

@@ -3,9 +3,14 @@
 For each algorithm and preset, a model is warmed up (replay filled past ``learning_starts``), then
 measured ``--repeats`` times:
 
-- updates/s: ``_update()`` calls (one critic and one actor step on a replayed minibatch) per second;
-- samples/s: environment samples per second during training, i.e. whole epochs of collecting and
+- updates/s: ``_update()`` calls (one critic and one actor step on a replayed minibatch) per CPU-second;
+- samples/s: environment samples per CPU-second during training, i.e. whole epochs of collecting and
   learning at the preset's update-to-data ratio (``learn()``'s own loop).
+
+Times are the worker process's CPU time (``time.process_time``, one torch thread), so other jobs on a shared
+machine slow the figures less than they would a wall clock. The row "paper, autograd update" runs PASVG(0)'s
+paper preset on its autograd update instead of the hand-written one (``_dense = None``), which says whether
+the hand-written update still pays.
 
 With ``--baseline REF`` the same cases also run on the package as it was at git commit ``REF`` (exported
 to a temporary directory), with the settings of the current presets. Each case runs in one worker process
@@ -34,6 +39,7 @@ from pathlib import Path
 # (algorithm, preset, settings on top of the preset, label)
 CASES = [
     ("PASVG0", "paper", {}, "paper"),
+    ("PASVG0", "paper", {"autograd": True}, "paper, autograd update"),
     ("PASVG0", "tuned", {}, "tuned"),
     ("PADDPG", "paper", {}, "paper"),
     ("PADDPG", "hausknecht_stone", {}, "hausknecht_stone"),
@@ -65,6 +71,7 @@ def worker(algo: str, config_json: str, n_updates: int, n_samples: int) -> int:
 
     cls, config_class = config_classes()[algo]
     values = json.loads(config_json)
+    autograd = values.pop("autograd", False)
     known = {f.name for f in dataclasses.fields(config_class)}
     if set(values) - known:  # a setting newer than the baseline's code: measure without it
         print(f"{algo}: ignoring settings unknown to this version: {sorted(set(values) - known)}", file=sys.stderr)
@@ -72,17 +79,19 @@ def worker(algo: str, config_json: str, n_updates: int, n_samples: int) -> int:
     config = dataclasses.replace(config, learning_starts=n_samples, epoch_steps=n_samples, buffer_size=200_000)
     model = cls("pamdp/Platform-v0", config)
     torch.set_num_threads(config.torch_threads)
+    if autograd:
+        model._dense = None
     model.learn(n_samples, progress_bar=False)  # fills the buffer past learning_starts and warms up
     print(json.dumps({"ready": True}), flush=True)
     for _ in sys.stdin:
-        t = time.perf_counter()
+        t = time.process_time()
         for _ in range(n_updates):
             model._update()
-        updates = n_updates / (time.perf_counter() - t)
+        updates = n_updates / (time.process_time() - t)
         start = model.num_timesteps
-        t = time.perf_counter()
+        t = time.process_time()
         model.learn(n_samples, progress_bar=False)
-        samples = (model.num_timesteps - start) / (time.perf_counter() - t)
+        samples = (model.num_timesteps - start) / (time.process_time() - t)
         print(json.dumps({"updates_per_s": updates, "samples_per_s": samples}), flush=True)
     return 0
 
@@ -177,7 +186,8 @@ def main(argv=None) -> int:
         f"load average at start {os.getloadavg()[0]:.1f}; Python {platform.python_version()}, "
         f"torch {torch.__version__}",
         f"- medians of {args.repeats} repeats; {args.updates} updates and {args.samples} samples per repeat; "
-        "torch threads 1; samples/s is whole training epochs (collect + learn at the preset's update-to-data ratio)"
+        "CPU time, torch threads 1; samples/s is whole training epochs (collect + learn at the preset's "
+        "update-to-data ratio)"
         + ("; the two versions alternate repeat by repeat, each in its own process" if args.baseline else ""),
         "",
         cols,
@@ -188,8 +198,9 @@ def main(argv=None) -> int:
         for name, preset, overrides, label in CASES:
             if wanted and (name, label) not in wanted:
                 continue
-            cfg = dataclasses.replace(classes[name][1].preset(preset), **overrides)
-            results = measure(name, cfg.to_dict(), args, sources)
+            settings = {k: v for k, v in overrides.items() if k != "autograd"}
+            cfg = dataclasses.replace(classes[name][1].preset(preset), **settings)
+            results = measure(name, {**cfg.to_dict(), **overrides}, args, sources)
             cells = [name, label, "-".join(map(str, cfg.hidden_sizes)), cfg.batch_size, cfg.num_envs]
             cells.append(f"{cfg.updates_per_step:g}")
             now = results[0]

@@ -71,7 +71,6 @@ def test_bad_values_give_clear_errors(tmp_path, capsys):
         (["reproduce", "step-size", "--seeds", "0,x", "--status"], "--seeds: '0,x'; expected comma-separated seeds"),
         (["reproduce", "step-size", "--seeds", "-1", "--status"], "--seeds: '-1'; expected comma-separated seeds"),
         (["reproduce", "step-size", "--workers", "0", "--status"], "--workers: '0'; expected an integer >= 1"),
-        (["reproduce", "step-size", "--stack", "0", "--status"], "--stack: '0'; expected an integer >= 1"),
         (["train", "patrpo", "--env-kwargs", "{bad"], "--env-kwargs: '{bad' is not valid JSON"),
         (["train", "patrpo", "--env-kwargs", "[1]"], "--env-kwargs: '[1]'; expected a JSON object"),
     ],
@@ -80,13 +79,6 @@ def test_bad_arguments_are_refused_before_anything_runs(argv, message, capsys):
     with pytest.raises(SystemExit) as exit_info:
         main(argv)
     assert exit_info.value.code == 2 and message in capsys.readouterr().err
-
-
-def test_seed_stacks_are_refused_on_ray_before_ray_is_needed(tmp_path, capsys):
-    argv = ["reproduce", "step-size", "--backend", "ray", "--stack", "3", "--out", str(tmp_path)]
-    assert main(argv) == 2
-    assert "--stack 3: seed stacks run on the local backend only" in capsys.readouterr().err
-    assert not any(tmp_path.iterdir())
 
 
 @pytest.mark.parametrize(

@@ -10,8 +10,8 @@ from torch import nn
 
 from pamdp import PADDPG, PASVG0
 from pamdp.algos.dense import Dense
-from pamdp.algos.offpolicy import clip_grads, optimizer_step
-from pamdp.algos.paddpg import PADDPGConfig, backprop_actor
+from pamdp.algos.offpolicy import backprop_actor, clip_grads, optimizer_step
+from pamdp.algos.paddpg import PADDPGConfig
 from pamdp.algos.pasvg import PASVG0Config
 from pamdp.policies import mlp
 
@@ -60,29 +60,6 @@ def test_backward_matches_finite_differences():
     assert grads[2][i, j].item() == pytest.approx(((up - down) / (2 * eps)).item(), rel=1e-6)
 
 
-def test_stacked_passes_are_each_members_own():
-    nets = [_net("leaky_relu", seed=s) for s in range(3)]
-    params = {}
-    for name, _ in nets[0].named_parameters():
-        ts = [n.get_parameter(name).detach() for n in nets]
-        params[f"net.{name}"] = torch.stack([t.t() if name.endswith("weight") else t for t in ts])  # (S, in, out)
-    dense = Dense.of_stack(nets[0], params, "net")
-    x = torch.randn(3, 6, 7)
-    g = torch.randn(3, 6, 5)
-    with torch.no_grad():
-        y, cache = dense.forward_cached(x)
-        grads, dx = dense.backward(cache, g, inputs=True)
-    for s, net in enumerate(nets):
-        xs = x[s].clone().requires_grad_(True)
-        out = net(xs)
-        out.backward(g[s])
-        torch.testing.assert_close(y[s], out.detach())
-        for (name, p), mine in zip(net.named_parameters(), grads, strict=True):
-            expect = p.grad.t() if name.endswith("weight") else p.grad
-            torch.testing.assert_close(mine[s], expect)
-        torch.testing.assert_close(dx[s], xs.grad)
-
-
 def test_layers_it_cannot_apply_are_refused():
     with pytest.raises(TypeError, match="Dropout"):
         Dense.of(nn.Sequential(nn.Linear(3, 4), nn.Dropout(0.1), nn.Linear(4, 1)))
@@ -112,9 +89,10 @@ def test_optimizer_step_is_adams_own_step():
 SMALL = PADDPGConfig(hidden_sizes=(32, 24), learning_starts=64, batch_size=16, epoch_steps=200, beta=0.3)
 
 
-def _autograd_update(model, batch):
-    """PADDPG's update as it was written before pamdp.algos.dense, on autograd."""
+def _autograd_update(model):
+    """PADDPG's update on autograd: the form its hand-written update must equal."""
     cfg = model.config
+    batch = model.replay.sample(cfg.batch_size, model.np_rng)
     obs, next_obs = batch["obs"], batch["next_obs"]
     with torch.no_grad():
         q_next = model.critic_target(next_obs, model.actor_target(next_obs).clamp(-1.0, 1.0))
@@ -141,11 +119,9 @@ def test_paddpg_update_matches_the_autograd_update(bound):
     mine = PADDPG("pamdp/Platform-v0", cfg)
     mine.learn(200, progress_bar=False)  # fills the replay and takes ~140 updates, so Adam's state exists
     ref = copy.deepcopy(mine)
-    for _ in range(30):
-        batch = mine._stack_sample()
-        mine_batch = {k: v.clone() for k, v in batch.items()}
-        _autograd_update(ref, batch)
-        mine._update_with(mine_batch)
+    for _ in range(30):  # both draw the same batch from their (equal) random streams
+        _autograd_update(ref)
+        mine._update()
     for name, module in mine._modules().items():
         for (pname, p), q in zip(module.named_parameters(), ref._modules()[name].parameters()):
             torch.testing.assert_close(p, q, atol=2e-6, rtol=1e-4, msg=f"{name}.{pname}")
@@ -165,20 +141,16 @@ SVG_SMALL = PASVG0Config(hidden_sizes=(32, 24), learning_starts=64, batch_size=1
 def test_pasvg_update_matches_the_autograd_update(settings):
     cfg = dataclasses.replace(SVG_SMALL, **settings)
     mine = PASVG0("pamdp/Platform-v0", cfg)
-    assert mine._dense is not None
     mine.learn(200, progress_bar=False)
     ref = copy.deepcopy(mine)
+    ref._bind_networks()  # its soft update over its own copies
+    ref._dense = None  # the autograd update
     for _ in range(30):  # both draw the same batch and noise from their (equal) random streams
         stats = mine._update()
-        ref_stats = ref._update_autograd()
+        ref_stats = ref._update()
     assert stats.keys() == ref_stats.keys() and list(stats) == list(ref_stats)  # the same log columns
     for key in stats:
         assert stats[key] == pytest.approx(ref_stats[key], rel=1e-4, abs=1e-6), key
     for name, module in mine._modules().items():
         for (pname, p), q in zip(module.named_parameters(), ref._modules()[name].parameters()):
             torch.testing.assert_close(p, q, atol=2e-6, rtol=1e-4, msg=f"{name}.{pname}")
-
-
-def test_pasvg_variants_without_a_hand_written_update_keep_autograd():
-    for settings in ({"discrete_gradient": "expected"}, {"twin_critics": True}, {"policy_delay": 2}):
-        assert PASVG0("pamdp/Platform-v0", dataclasses.replace(SVG_SMALL, **settings))._dense is None

@@ -14,7 +14,7 @@ from numeric import finite_difference
 from pamdp import HyAR
 from pamdp.algos.checkpoints import load_model
 from pamdp.algos.hyar import ActionRepresentation, HyARConfig, latent_bounds
-from pamdp.algos.paddpg import backprop_actor, invert_gradients
+from pamdp.algos.offpolicy import backprop_actor, invert_gradients
 from pamdp.cli import main
 from pamdp.spaces import HybridActionSpace
 
@@ -343,15 +343,6 @@ def test_tiny_learning_run_logs(tmp_path):
     for key in ("losses/critic_loss", "losses/actor_loss", "losses/vae_recon", "losses/vae_kl", "train/relabelled"):
         assert np.isfinite(float(last[key])), key
     assert 0.0 <= float(last["train/relabelled"]) <= 1.0 and float(last["train/latent_box_width"]) > 0
-
-
-def test_presets():
-    presets = HyARConfig.presets()
-    assert list(presets) == ["cpu", "paper"] and presets["paper"] == HyARConfig()
-    paper = presets["paper"]
-    assert (paper.policy_delay, paper.target_noise, paper.target_noise_clip, paper.tau) == (2, 0.2, 0.5, 0.005)
-    assert paper.kl_weight == 1.0 and paper.warmup_steps == 11_000  # the paper's loss; ~5000 random Platform episodes
-    assert presets["cpu"].updates_per_step < 1 and presets["cpu"].num_envs >= 48  # batched env copies
 
 
 def test_cli_trains_and_evaluates(tmp_path, capsys):

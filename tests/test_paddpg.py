@@ -11,7 +11,8 @@ from torch import nn
 import pamdp
 from pamdp import PADDPG
 from pamdp.algos.checkpoints import load_model
-from pamdp.algos.paddpg import Actor, Critic, PADDPGConfig, invert_gradients, zero_gradients
+from pamdp.algos.offpolicy import invert_gradients, zero_gradients
+from pamdp.algos.paddpg import Actor, Critic, PADDPGConfig
 from pamdp.cli import main
 from pamdp.spaces import HybridActionSpace
 
@@ -124,22 +125,6 @@ def test_epsilon_is_annealed_linearly():
 def test_bad_settings_raise_clear_errors(kwargs, match):
     with pytest.raises(ValueError, match=match):
         PADDPGConfig(**kwargs)
-
-
-def test_presets():
-    presets = PADDPGConfig.presets()
-    assert presets["paper"].hidden_sizes == (400, 300) and presets["paper_hfo"].hidden_sizes == (400, 300, 200)
-    hs = presets["hausknecht_stone"]
-    assert hs.hidden_sizes == (1024, 512, 256, 128) and hs.activation == "leaky_relu"
-    assert (hs.adam_beta1, hs.actor_lr, hs.critic_lr, hs.grad_clip, hs.tau, hs.gamma) == (
-        0.95,
-        1e-5,
-        1e-3,
-        10,
-        1e-3,
-        0.99,
-    )
-    assert (hs.buffer_size, hs.batch_size, hs.beta, hs.bound) == (500_000, 32, 0.2, "invert")
 
 
 def test_epoch_stores_monte_carlo_returns_and_explores():

@@ -182,13 +182,6 @@ def test_bad_settings_raise_clear_errors(kwargs, match):
         PASVG0Config(**kwargs)
 
 
-def test_paper_preset_is_the_papers():
-    cfg = PASVG0Config.preset("paper")
-    assert (cfg.hidden_sizes, cfg.critic_lr, cfg.policy_lr, cfg.temperature) == ((400, 300), 1e-3, 1e-5, 1.0)
-    assert (cfg.buffer_size, cfg.learning_starts, cfg.epoch_steps) == (10_000_000, 10_000, 10_000)
-    assert "tuned" in PASVG0Config.presets()
-
-
 def flat_params(model):
     return torch.cat([p.detach().flatten() for m in (model.policy, model.critic) for p in m.parameters()])
 

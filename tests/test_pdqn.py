@@ -14,8 +14,7 @@ from numeric import finite_difference
 import pamdp
 from pamdp import PDQN
 from pamdp.algos.checkpoints import load_model
-from pamdp.algos.offpolicy import OUNoise
-from pamdp.algos.paddpg import backprop_actor, invert_gradients
+from pamdp.algos.offpolicy import OUNoise, backprop_actor, invert_gradients
 from pamdp.algos.pdqn import ParamActor, PDQNConfig, QNetwork, param_blocks
 from pamdp.cli import main
 from pamdp.spaces import HybridActionSpace
@@ -207,16 +206,6 @@ def test_bad_settings_raise_errors_naming_the_value(kwargs, match):
 def test_bad_types_from_plain_data_are_named():
     with pytest.raises(ValueError, match="'multi_pass' = 'yes'"):
         PDQNConfig.from_dict({"multi_pass": "yes"})
-
-
-def test_presets():
-    presets = PDQNConfig.presets()
-    assert list(presets) == ["paper", "tuned"] and presets["paper"] == PDQNConfig()
-    paper, tuned = presets["paper"], presets["tuned"]
-    assert (paper.q_lr, paper.actor_lr, paper.tau_q, paper.tau_actor, paper.gamma) == (1e-3, 1e-4, 0.1, 0.001, 0.9)
-    assert (paper.batch_size, paper.buffer_size, paper.epsilon_end, paper.bound) == (128, 10_000, 0.01, "invert")
-    assert tuned.updates_per_step < 1 and tuned.num_envs >= 48  # batched env copies
-    assert not paper.multi_pass and not tuned.multi_pass  # the flag picks the method whatever the preset
 
 
 def test_replay_holds_what_q_saw_and_monte_carlo_returns():

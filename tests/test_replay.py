@@ -125,6 +125,7 @@ def test_clipped_step_clips_the_gradient_norm_before_stepping(max_norm, expected
 def test_epoch_stats_average_each_figure_over_the_updates_that_computed_it():
     """A figure computed every third update (a delayed actor step) is the mean of those steps, not diluted."""
     from pamdp.algos.offpolicy import OffPolicyLoop
+    from pamdp.algos.paddpg import PADDPGConfig
     from pamdp.algos.vector_env import make_vector_env
     from pamdp.spaces import HybridActionSpace
 
@@ -138,7 +139,8 @@ def test_epoch_stats_average_each_figure_over_the_updates_that_computed_it():
         "next_obs": ((env.single_observation_space.shape[0],), np.float32),
         "terminated": ((), np.bool_),
     }
-    loop = OffPolicyLoop(hybrid, ReplayBuffer(1000, fields))
+    config = PADDPGConfig(epoch_steps=40, learning_starts=0)
+    loop = OffPolicyLoop(config, hybrid, ReplayBuffer(1000, fields))
     calls = []
 
     def act(obs, step, episode_start):
@@ -151,7 +153,7 @@ def test_epoch_stats_average_each_figure_over_the_updates_that_computed_it():
         return {"every": float(i), **({"third": float(10 * i)} if i % 3 == 0 else {})}
 
     rng = np.random.default_rng(0)
-    stats = loop.run_epoch(env, act, update, 40, 0, 0, 1.0, rng)
+    stats = loop.run_epoch(env, act, update, 0, rng)
     assert stats["train/updates"] == len(calls) >= 40
     assert stats["every"] == pytest.approx(np.mean(calls))
     assert stats["third"] == pytest.approx(np.mean([10 * i for i in calls if i % 3 == 0]))

@@ -170,14 +170,6 @@ def build_parser() -> argparse.ArgumentParser:
     rp.add_argument(
         "--workers", type=_positive_int, default=1, help="runs side by side in processes (one torch thread each)"
     )
-    rp.add_argument(
-        "--stack",
-        type=_positive_int,
-        default=1,
-        help="train up to this many seeds of a setting in one process, their updates batched together "
-        "(PADDPG, PASVG(0): 3 gives 1.1x to 1.3x the seeds per hour on a 2-core CPU; "
-        "default: %(default)s, each seed alone)",
-    )
     rp.add_argument("--out", default="results", help="results root (default: %(default)s)")
     rp.add_argument("--backend", choices=["local", "ray"], default="local", help="local processes or a Ray cluster")
     rp.add_argument("--address", default=None, help="Ray cluster address HOST:PORT (with --backend ray)")
@@ -273,15 +265,13 @@ def cmd_reproduce(args) -> int:
         return 0
     print(f"{exp.name}: {exp.description}; {len(jobs)} runs of {jobs[0][0].total_steps:,} steps", file=sys.stderr)
     if args.backend == "ray":
-        if args.stack > 1:
-            raise ValueError(f"--stack {args.stack}: seed stacks run on the local backend only; drop it for Ray")
         from pamdp.experiments.ray_backend import run_all_ray
 
         outcomes = run_all_ray(jobs, address=args.address, log=lambda m: print(m, file=sys.stderr))
     else:
         from pamdp.experiments.runner import run_all
 
-        outcomes = run_all(jobs, workers=args.workers, log=lambda m: print(m, file=sys.stderr), stack=args.stack)
+        outcomes = run_all(jobs, workers=args.workers, log=lambda m: print(m, file=sys.stderr))
     failed = [o for o in outcomes if o.error is not None]
     _print_report(write_report([Path(args.out) / exp.name], Path(args.out) / exp.name, exp.description))
     if failed:

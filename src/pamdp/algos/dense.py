@@ -1,11 +1,10 @@
 """Hand-written forward and backward passes of :func:`~pamdp.policies.mlp` networks, for the off-policy updates.
 
 An off-policy update with the paper's {400, 300} networks and a batch of 32 is a few dozen small matrix
-products, about 0.5 ms of arithmetic on one core; through ``nn.Module`` calls and the autograd engine it took
-3.6 ms. :class:`Dense` applies a network's layers as plain products (``addmm``, or ``baddbmm`` over the
-``(S, in, out)`` weights of a seed stack) and back-propagates by hand with ATen's own activation derivatives,
-so the gradients are autograd's, in a fraction of the calls (``tests/test_dense.py`` checks them against
-autograd; ``benchmarks/offpolicy_speed.md`` has the times).
+products, where the calls through ``nn.Module`` and the autograd engine cost more than the arithmetic.
+:class:`Dense` applies a network's layers as plain products (``addmm``) and back-propagates by hand with ATen's
+own activation derivatives, so the gradients are autograd's (``tests/test_dense.py``) in a fraction of the
+calls (the times: ``benchmarks/offpolicy_speed.md``).
 
     net = Dense.of(critic.net)                      # the module's own parameter tensors, no copies
     q, cache = net.forward_cached(x)
@@ -14,7 +13,6 @@ autograd; ``benchmarks/offpolicy_speed.md`` has the times).
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from dataclasses import dataclass
 
 import torch
@@ -63,59 +61,37 @@ def _slope_times(kind: str, c: float, g: torch.Tensor, z: torch.Tensor, y: torch
 class Dense:
     """An ``mlp``'s linear layers and activations, applied and differentiated by hand (no autograd graph).
 
-    ``weights[i]`` is ``(out, in)`` as ``nn.Linear`` stores it, or ``(S, in, out)`` when ``stacked`` (the layout
-    of :class:`~pamdp.algos.stacking.SeedStack`), with inputs ``(S, B, in)``. ``acts[i]`` is the activation
-    after linear layer ``i`` (``None`` for none), as ``(kind, constant)``.
+    ``weights[i]`` is ``(out, in)`` as ``nn.Linear`` stores it; ``acts[i]`` is the activation after linear layer
+    ``i`` (``None`` for none), as ``(kind, constant)``.
     """
 
     weights: tuple[torch.Tensor, ...]
     biases: tuple[torch.Tensor, ...]
     acts: tuple[tuple[str, float] | None, ...]
-    stacked: bool = False
 
     @classmethod
     def of(cls, net: nn.Sequential) -> Dense:
         """The network's own parameter tensors (updates to them show through)."""
-        return cls._build(net, lambda k, layer: (layer.weight, layer.bias), stacked=False)
-
-    @classmethod
-    def of_stack(cls, template: nn.Sequential, params: Mapping[str, torch.Tensor], prefix: str) -> Dense:
-        """A seed stack's tensors ``params[f"{prefix}.{k}.weight"]`` ``(S, in, out)``, laid out as ``template``."""
-
-        def tensors(k, layer):
-            return params[f"{prefix}.{k}.weight"], params[f"{prefix}.{k}.bias"]
-
-        return cls._build(template, tensors, stacked=True)
-
-    @classmethod
-    def _build(cls, net: nn.Sequential, tensors, stacked: bool) -> Dense:
         weights, biases, acts = [], [], []
-        for k, layer in net.named_children():
+        for layer in net:
             if isinstance(layer, nn.Linear):
                 if layer.bias is None:
                     raise TypeError("Dense needs linear layers with a bias, as mlp builds them")
-                w, b = tensors(k, layer)
-                weights.append(w)
-                biases.append(b)
+                weights.append(layer.weight)
+                biases.append(layer.bias)
                 acts.append(None)
             elif not acts or acts[-1] is not None:
                 raise TypeError(f"Dense expects one activation after a linear layer; got {net!r}")
             else:
                 acts[-1] = _activation(layer)
-        return cls(tuple(weights), tuple(biases), tuple(acts), stacked)
+        return cls(tuple(weights), tuple(biases), tuple(acts))
 
     def _linear(self, i: int, h: torch.Tensor) -> torch.Tensor:
-        if self.stacked:
-            return torch.baddbmm(self.biases[i].unsqueeze(1), h, self.weights[i])
         return torch.addmm(self.biases[i], h, self.weights[i].t())
 
-    def _flat(self, x: torch.Tensor) -> torch.Tensor:
-        """Inputs as ``(B, in)``, or ``(S, B, in)`` when stacked."""
-        return x.reshape(x.shape[0], -1, x.shape[-1]) if self.stacked else x.reshape(-1, x.shape[-1])
-
     def __call__(self, x: torch.Tensor) -> torch.Tensor:
-        """The network's outputs for inputs ``x`` of any leading shape (``(S, ...)`` when stacked)."""
-        h = self._flat(x)
+        """The network's outputs for inputs ``x`` of any leading shape."""
+        h = x.reshape(-1, x.shape[-1])
         for i, act in enumerate(self.acts):
             h = self._linear(i, h)
             if act is not None:
@@ -124,7 +100,7 @@ class Dense:
 
     def forward_cached(self, x: torch.Tensor) -> tuple[torch.Tensor, list[torch.Tensor]]:
         """Outputs as :meth:`__call__`, with what :meth:`backward` needs (each layer's input and output)."""
-        h = self._flat(x)
+        h = x.reshape(-1, x.shape[-1])
         cache = [h]
         for i, act in enumerate(self.acts):
             z = self._linear(i, h)
@@ -141,9 +117,8 @@ class Dense:
     ) -> tuple[list[torch.Tensor] | None, torch.Tensor | None]:
         """Back-propagate ``grad`` (d loss / d outputs, the outputs' shape) through the cached pass.
 
-        Returns the parameter gradients in the order of ``net.parameters()`` (weight then bias per layer, each
-        in its tensor's layout; ``None`` unless ``weights``) and d loss / d inputs (``None`` unless ``inputs``),
-        shaped as the flattened inputs.
+        Returns the parameter gradients in the order of ``net.parameters()`` (weight then bias per layer; ``None``
+        unless ``weights``) and d loss / d inputs (``None`` unless ``inputs``), shaped as the flattened inputs.
         """
         g = grad.reshape(cache[-1].shape)
         pairs: list[tuple[torch.Tensor, torch.Tensor]] = []  # (weight, bias) gradients, last layer first
@@ -157,11 +132,8 @@ class Dense:
                 pos -= 1
             h = cache[pos]  # the layer's input
             if weights:
-                if self.stacked:
-                    pairs.append((torch.bmm(h.transpose(1, 2), g), g.sum(1)))
-                else:
-                    pairs.append((torch.mm(g.t(), h), g.sum(0)))
+                pairs.append((torch.mm(g.t(), h), g.sum(0)))
             if i > 0 or inputs:
-                g = torch.bmm(g, self.weights[i].transpose(1, 2)) if self.stacked else torch.mm(g, self.weights[i])
+                g = torch.mm(g, self.weights[i])
         grads = [t for pair in reversed(pairs) for t in pair] if weights else None
         return grads, (g if inputs else None)

@@ -49,10 +49,17 @@ import torch.nn.functional as F
 from torch import nn
 
 from pamdp.algos.base import Algorithm
-from pamdp.algos.offpolicy import OffPolicyLoop, clipped_step, linear_epsilon, soft_update
-from pamdp.algos.paddpg import backprop_actor
+from pamdp.algos.offpolicy import (
+    OffPolicyConfig,
+    OffPolicyLoop,
+    backprop_actor,
+    clipped_step,
+    linear_epsilon,
+    shared_setting,
+    soft_update,
+)
 from pamdp.algos.replay import ReplayBuffer, transition_fields
-from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
+from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, at_least, interval, one_of, setting
 from pamdp.policies import ACTIVATIONS, mlp
 from pamdp.spaces import HybridActionSpace
 
@@ -65,13 +72,10 @@ RELABEL = ("invalid", "all", "none")
 
 
 @dataclasses.dataclass(frozen=True)
-class HyARConfig(AlgoConfig):
+class HyARConfig(OffPolicyConfig, AlgoConfig):
     """HyAR-TD3's settings. The defaults are the ``paper`` preset: the paper's schedule, with TD3's published
     settings (Fujimoto et al. 2018) where the text available here gives none; assumptions are marked."""
 
-    num_envs: int = setting(
-        8, "Copies of the env stepped together; learning per sample is set by updates_per_step.", at_least(1)
-    )
     embed_dim: int = setting(6, "Size of a discrete action's embedding, d1 (assumed: 6).", at_least(1))
     latent_dim: int = setting(6, "Size of the parameters' latent z, d2 (assumed: 6).", at_least(1))
     vae_hidden_sizes: tuple[int, ...] = setting(
@@ -128,11 +132,7 @@ class HyARConfig(AlgoConfig):
     )
     actor_lr: float = setting(3e-4, "Adam learning rate of the actor (TD3: 3e-4).", POSITIVE)
     critic_lr: float = setting(3e-4, "Adam learning rate of the critics (TD3: 3e-4).", POSITIVE)
-    grad_clip: float = setting(
-        0.0, "Clip each network's gradient norm to this; 0 turns clipping off (TD3: off).", NON_NEGATIVE
-    )
-    batch_size: int = setting(128, "Transitions per TD3 update (assumed: 128).", at_least(1))
-    gamma: float = setting(0.99, "Discount factor.", interval(0, 1))
+    batch_size: int = shared_setting("batch_size", 128, "assumed: 128")
     tau: float = setting(0.005, "Soft target-update rate (TD3: 0.005).", interval(0, 1, low_open=True))
     exploration_noise: float = setting(
         0.1, "Std of the Gaussian noise on the actor's [-1, 1] output (TD3: 0.1).", NON_NEGATIVE
@@ -151,18 +151,7 @@ class HyARConfig(AlgoConfig):
     )
     target_noise_clip: float = setting(0.5, "Clip of the target policy smoothing noise (TD3: 0.5).", NON_NEGATIVE)
     policy_delay: int = setting(2, "Critic updates per actor and target update (TD3: 2).", at_least(1))
-    buffer_size: int = setting(
-        1_000_000,
-        "Replay capacity.",
-        Check(lambda v: v >= 1, "an integer >= warmup_steps"),  # the rest: __post_init__
-    )
-    updates_per_step: float = setting(
-        1.0, "Update-to-data ratio: TD3 updates (critics) per environment sample.", POSITIVE
-    )
-    epoch_steps: int = setting(10_000, "Samples per epoch, the unit of logging and checkpoints.", at_least(1))
-    save_replay: bool = setting(
-        True, "Store the replay contents in checkpoints (the representation's training data); else a resume refills it."
-    )
+    save_replay: bool = shared_setting("save_replay", True, "true here: it is the representation's training data")
 
     def __post_init__(self):
         """The checks across settings (each setting's own runs in AlgoConfig)."""
@@ -173,6 +162,11 @@ class HyARConfig(AlgoConfig):
             "False with bound='squash' (a Tanh output cannot be rescaled exactly)",
         )
         self._check(self.buffer_size >= self.warmup_steps, "buffer_size", f">= warmup_steps ({self.warmup_steps})")
+
+    @property
+    def learning_starts(self) -> int:
+        """The samples before the first update (:class:`~pamdp.algos.offpolicy.OffPolicyLoop`): the warm-up's."""
+        return self.warmup_steps
 
     @classmethod
     def presets(cls) -> dict[str, Self]:
@@ -327,7 +321,7 @@ class HyAR(Algorithm):
             latent=((self.latent_size,), np.float32),  # the latent action that was decoded and executed
         )
         self.replay = ReplayBuffer(cfg.buffer_size, fields)
-        self.loop = OffPolicyLoop(h, self.replay, cfg.gamma)
+        self.loop = OffPolicyLoop(cfg, h, self.replay)
         self.pretrained = False  # the warm-up round of representation training is done
         self.n_updates = 0  # TD3 updates so far (the policy delay and the representation rounds count them)
 
@@ -391,18 +385,7 @@ class HyAR(Algorithm):
 
     # -- learning --------------------------------------------------------------------------------
     def _run_epoch(self) -> dict[str, float]:
-        cfg = self.config
-        stats = self.loop.run_epoch(
-            self.vec_env,
-            self._explore,
-            self._update,
-            cfg.epoch_steps,
-            self.num_timesteps,
-            cfg.warmup_steps,
-            cfg.updates_per_step,
-            self.np_rng,
-            self.config.flush_denormal,
-        )
+        stats = self.loop.run_epoch(self.vec_env, self._explore, self._update, self.num_timesteps, self.np_rng)
         stats["train/latent_box_width"] = float((self.actor.high - self.actor.low).mean())
         stats["train/epsilon"] = self.epsilon(self.num_timesteps + stats["steps"])
         return stats

@@ -1,9 +1,12 @@
-"""What PASVG(0), PADDPG and PDQN share: the collect-and-learn loop over a replay buffer, and target networks.
+"""What the off-policy algorithms share: their loop settings, the collect-and-learn loop over a replay buffer,
+target networks, and the bounded-gradient tricks of deterministic actors.
 
-:class:`OffPolicyLoop` steps the batched env with the algorithm's exploration policy, stores every valid
-transition in the :class:`~pamdp.algos.replay.ReplayBuffer`, and interleaves gradient updates: once the
-buffer holds ``learning_starts`` transitions, each new sample earns ``updates_per_step`` updates (the
-update-to-data ratio), so ``num_envs`` changes how samples are batched, not how much is learned per sample.
+:class:`OffPolicyConfig` declares the settings of the loop and the replay once; an algorithm's config inherits
+it beside :class:`~pamdp.algos.settings.AlgoConfig`. :class:`OffPolicyLoop` reads them: it steps the batched
+env with the algorithm's exploration policy, stores every valid transition in the
+:class:`~pamdp.algos.replay.ReplayBuffer`, and interleaves gradient updates: once the buffer holds
+``learning_starts`` transitions, each new sample earns ``updates_per_step`` updates (the update-to-data ratio),
+so ``num_envs`` changes how samples are batched, not how much is learned per sample.
 
 Gymnasium's vector envs reset a finished copy on the *next* step and ignore that step's action: such
 autoreset steps are marked invalid and never stored. A true termination stores ``terminated = True`` (no
@@ -12,10 +15,14 @@ observation. Episodes carry across epochs; a resumed run starts new episodes (en
 
 With ``mc_returns`` the loop also writes each transition's discounted Monte-Carlo return-to-go into the
 buffer's ``"mc"`` field when its episode ends (``NaN`` until then), for PADDPG's mixed targets.
+
+The actors of PADDPG, P-DQN and HyAR output bounded values trained along ``dQ/d output``; Hausknecht & Stone's
+three ways of keeping them in ``[-1, 1]`` (spec "PADDPG") are :data:`BOUNDS`, applied by :func:`backprop_actor`.
 """
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable, Sequence
 
 import numpy as np
@@ -24,14 +31,16 @@ from torch import nn
 
 from pamdp.algos.logger import EpisodeTracker
 from pamdp.algos.replay import ReplayBuffer
+from pamdp.algos.settings import NON_NEGATIVE, POSITIVE, at_least, interval, setting
 from pamdp.algos.subnormals import subnormals_flushed
 
 __all__ = [
+    "OffPolicyConfig",
+    "shared_setting",
     "OffPolicyLoop",
     "OUNoise",
     "soft_update",
     "soft_updater",
-    "hard_update",
     "clipped_step",
     "clip_grads",
     "optimizer_step",
@@ -39,7 +48,55 @@ __all__ = [
     "linear_epsilon",
     "mixed_target",
     "discounted_returns",
+    "BOUNDS",
+    "invert_gradients",
+    "zero_gradients",
+    "bounded",
+    "backprop_actor",
 ]
+
+BOUNDS = ("invert", "squash", "zero")
+
+
+@dataclasses.dataclass(frozen=True)
+class OffPolicyConfig:
+    """The settings of the collect-and-learn loop and its replay, declared once for every off-policy algorithm.
+
+    An algorithm's config inherits it beside :class:`~pamdp.algos.settings.AlgoConfig`, which brings the checks
+    and the settings of every algorithm (``class PADDPGConfig(OffPolicyConfig, AlgoConfig)``): each base is one
+    level up, and this one holds fields only. An algorithm whose paper gives another default declares the
+    setting again with :func:`shared_setting`, which keeps the help and the check written here. Each config also
+    declares ``learning_starts``, the samples in the replay before the first update (HyAR's is its warm-up).
+    """
+
+    num_envs: int = setting(
+        8,
+        "Copies of the env stepped together; learning per sample is set by updates_per_step, not by this.",
+        at_least(1),
+    )
+    batch_size: int = setting(64, "Transitions per gradient update.", at_least(1))
+    gamma: float = setting(0.99, "Discount factor.", interval(0, 1))
+    grad_clip: float = setting(
+        0.0, "Clip each network's gradient norm to this before a step; 0 turns clipping off.", NON_NEGATIVE
+    )
+    buffer_size: int = setting(
+        1_000_000, "Replay capacity; memory grows with the contents, not the capacity.", at_least(1)
+    )
+    updates_per_step: float = setting(1.0, "Update-to-data ratio: gradient updates per environment sample.", POSITIVE)
+    epoch_steps: int = setting(
+        10_000, "Samples per epoch, the unit of logging and checkpoints (paper: 10 000).", at_least(1)
+    )
+    save_replay: bool = setting(
+        False, "Store the replay contents in checkpoints (large); otherwise a resumed run refills the buffer."
+    )
+
+
+def shared_setting(name: str, default, source: str):
+    """:class:`OffPolicyConfig`'s setting ``name`` with an algorithm's own ``default``; ``source`` says where the
+    value comes from and joins the help ("Transitions per gradient update (Hausknecht & Stone: 32).")."""
+    help = OffPolicyConfig.__dataclass_fields__[name].metadata["help"]
+    return setting(default, f"{help.rstrip('.')} ({source}).")
+
 
 # act(obs (N, d) tensor, global step, episode_start (N,) bool) -> (a (N,), x (N, m) in [-1, 1], extra fields)
 ActFn = Callable[[torch.Tensor, int, np.ndarray], tuple[torch.Tensor, torch.Tensor, dict[str, np.ndarray]]]
@@ -65,10 +122,6 @@ def soft_updater(pairs: Sequence[tuple[nn.Module, nn.Module]]) -> Callable[[floa
             torch._foreach_lerp_(targets, sources, tau)
 
     return update
-
-
-def hard_update(target: nn.Module, source: nn.Module) -> None:
-    target.load_state_dict(source.state_dict())
 
 
 class OUNoise:
@@ -110,8 +163,8 @@ def optimizer_step(optimizer: torch.optim.Optimizer, grads: Sequence[torch.Tenso
     """``optimizer.step()`` with ``grads``, in the order of its one parameter group.
 
     A fused ``Adam`` whose state exists gets one ``torch._fused_adam_`` call, the kernel its own ``step`` ends
-    in, without the bookkeeping around it (about 0.15 ms of Python a call, a tenth of an update of PADDPG);
-    any other optimizer gets the gradients as ``.grad`` and its own ``step``.
+    in, without the Python bookkeeping around it; any other optimizer gets the gradients as ``.grad`` and its
+    own ``step``.
     """
     group = optimizer.param_groups[0]
     params = group["params"]
@@ -184,30 +237,76 @@ def discounted_returns(rewards: np.ndarray, gamma: float, tail: float = 0.0) -> 
     return out
 
 
+def invert_gradients(grad: torch.Tensor, p: torch.Tensor, low: float = -1.0, high: float = 1.0) -> torch.Tensor:
+    """Hausknecht & Stone's inverting gradients, for an ascent direction ``grad = dQ/dp`` at outputs ``p``.
+
+    Components that would increase ``p`` are scaled by ``(high - p) / (high - low)``, those that would
+    decrease it by ``(p - low) / (high - low)``: 0 at the bound being approached, 1 at the far bound, and
+    negative (pushing back) once ``p`` is past it.
+    """
+    width = high - low
+    return grad * torch.where(grad > 0, (high - p) / width, (p - low) / width)
+
+
+def zero_gradients(grad: torch.Tensor, p: torch.Tensor, low: float = -1.0, high: float = 1.0) -> torch.Tensor:
+    """Zero the components of the ascent direction ``grad`` that push an output at or past a bound further out."""
+    leaving = ((grad > 0) & (p >= high)) | ((grad < 0) & (p <= low))
+    return torch.where(leaving, torch.zeros_like(grad), grad)
+
+
+def bounded(dq_dp: torch.Tensor, p: torch.Tensor, bound: str) -> torch.Tensor:
+    """``dQ/dp`` at outputs ``p`` edited by ``bound`` (:data:`BOUNDS`; ``squash``, a Tanh layer, keeps it)."""
+    if bound == "invert":
+        return invert_gradients(dq_dp, p)
+    if bound == "zero":
+        return zero_gradients(dq_dp, p)
+    return dq_dp
+
+
+def backprop_actor(
+    actor: Callable[[torch.Tensor], torch.Tensor],
+    critic: Callable[[torch.Tensor, torch.Tensor], torch.Tensor],
+    obs: torch.Tensor,
+    bound: str,
+) -> tuple[torch.Tensor, torch.Tensor]:
+    """Back-propagate ``-mean_s Q(s, mu(s))`` into the actor, with ``dQ/dmu`` edited by ``bound`` on the way.
+
+    ``Q`` is summed over its last axis if it has one (P-DQN's K values). The critic's weights get no gradient.
+    Returns the actor's outputs and ``Q(s, mu(s))``, detached.
+    """
+    out = actor(obs)
+    p = out.detach().requires_grad_(True)
+    q = critic(obs, p)
+    (dq_dp,) = torch.autograd.grad(q.sum(), p)  # per-sample dQ/dp, the ascent direction
+    out.backward(-bounded(dq_dp, p.detach(), bound) / len(out))  # descend on -mean Q over the batch
+    return out.detach(), q.detach()
+
+
 class OffPolicyLoop:
     """Collect-and-learn epochs for an off-policy algorithm (see the module docstring).
 
     Args:
+        config: the algorithm's settings: an :class:`OffPolicyConfig` with ``learning_starts`` and
+            ``flush_denormal`` (the updates, not the env steps, flush subnormal floats to zero).
         hybrid: the env's hybrid action space.
         buffer: where transitions go; it needs the fields ``obs, a, x, reward, next_obs, terminated``, the
             algorithm's extras, and ``mc`` when ``mc_returns``.
-        gamma: discount of the Monte-Carlo returns.
-        mc_returns: compute Monte-Carlo returns when episodes end.
+        mc_returns: compute Monte-Carlo returns (discounted by ``config.gamma``) when episodes end.
         tail_value: with ``mc_returns``, the value of a truncated episode's final observations
             ``(B, d) -> (B,)``, which bootstraps its Monte-Carlo return; ``None`` treats the cut as an end.
     """
 
     def __init__(
         self,
+        config: OffPolicyConfig,
         hybrid,
         buffer: ReplayBuffer,
-        gamma: float = 0.99,
         mc_returns: bool = False,
         tail_value: Callable[[np.ndarray], np.ndarray] | None = None,
     ):
+        self.config = config
         self.hybrid = hybrid
         self.buffer = buffer
-        self.gamma = gamma
         self.mc_returns = mc_returns
         self.tail_value = tail_value
         self.update_credit = 0.0
@@ -223,20 +322,12 @@ class OffPolicyLoop:
         self.obs, _ = env.reset(seed=int(np_rng.integers(2**31 - 1)))
 
     def run_epoch(
-        self,
-        env,
-        act: ActFn,
-        update: UpdateFn,
-        n_samples: int,
-        start_step: int,
-        learning_starts: int,
-        updates_per_step: float,
-        np_rng: np.random.Generator,
-        flush_denormal: bool = False,
+        self, env, act: ActFn, update: UpdateFn, start_step: int, np_rng: np.random.Generator
     ) -> dict[str, float]:
-        """Collect at least ``n_samples`` valid transitions, updating as they arrive; returns the epoch's stats.
-
-        ``flush_denormal``: the updates (not the env steps) flush subnormal floats to zero."""
+        """Collect at least ``config.epoch_steps`` valid transitions, updating as they arrive; returns the epoch's
+        stats. ``start_step`` is the number of samples collected before (``act`` gets the running count)."""
+        cfg = self.config
+        n_samples, learning_starts, updates_per_step = cfg.epoch_steps, cfg.learning_starts, cfg.updates_per_step
         if self.obs is None:
             self._start(env, np_rng)
         counts = np.zeros(self.hybrid.n_actions, dtype=np.int64)
@@ -272,7 +363,7 @@ class OffPolicyLoop:
                 n_valid += n
                 if len(self.buffer) >= learning_starts:
                     self.update_credit += updates_per_step * n
-                    with subnormals_flushed(flush_denormal):
+                    with subnormals_flushed(cfg.flush_denormal):
                         while self.update_credit >= 1.0:
                             self.update_credit -= 1.0
                             for k, v in update().items():
@@ -302,7 +393,7 @@ class OffPolicyLoop:
             self._pending[i][1].append(float(reward[i]))
         for i in ended:
             stored, rewards = self._pending[i]
-            returns = discounted_returns(np.asarray(rewards), self.gamma, float(tails[i]))
+            returns = discounted_returns(np.asarray(rewards), self.config.gamma, float(tails[i]))
             self.buffer.write("mc", np.asarray(stored), returns.astype(np.float32))
             self._pending[i] = ([], [])
 

@@ -10,23 +10,25 @@ Bounded outputs (``bound``, the three options Hausknecht & Stone compared; spec 
 - ``invert`` (the default, theirs): with ``g = dQ/dp`` at the actor's output, scale ``g`` by
   ``(p_max - p) / (p_max - p_min)`` where it would increase ``p`` and by ``(p - p_min) / (p_max - p_min)``
   where it would decrease it, so an output slows down as it nears a bound and is pushed back (the factor
-  turns negative) once it has crossed one. See :func:`invert_gradients`.
+  turns negative) once it has crossed one. See :func:`~pamdp.algos.offpolicy.invert_gradients`.
 - ``squash``: a Tanh output layer and the plain gradient.
 - ``zero``: the plain gradient, except that components pushing an output at or past a bound further out
-  are set to 0 (:func:`zero_gradients`).
+  are set to 0 (:func:`~pamdp.algos.offpolicy.zero_gradients`).
 
 The bound handling edits ``dQ/dp`` for the whole batch before it is back-propagated into the actor.
 Exploration is epsilon-greedy over the whole output vector (uniform in ``[-1, 1]`` with probability
 epsilon, annealed linearly), optionally with Ornstein-Uhlenbeck noise on the actor's parameters. Targets
 may mix in on-policy Monte-Carlo returns, ``y = beta * MC + (1 - beta) * (r + gamma Q'(s', mu'(s')))``; a
 transition whose episode has not ended yet uses the TD target alone.
+
+The update is back-propagated by hand (:mod:`pamdp.algos.dense`), which pays here
+(``benchmarks/offpolicy_speed.md``); ``tests/test_dense.py`` holds the autograd form it must equal.
 """
 
 from __future__ import annotations
 
 import copy
 import dataclasses
-from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -35,7 +37,18 @@ from torch import nn
 
 from pamdp.algos.base import Algorithm
 from pamdp.algos.dense import Dense
-from pamdp.algos.offpolicy import OffPolicyLoop, OUNoise, gradient_step, linear_epsilon, mixed_target, soft_updater
+from pamdp.algos.offpolicy import (
+    BOUNDS,
+    OffPolicyConfig,
+    OffPolicyLoop,
+    OUNoise,
+    bounded,
+    gradient_step,
+    linear_epsilon,
+    mixed_target,
+    shared_setting,
+    soft_updater,
+)
 from pamdp.algos.replay import ReplayBuffer, transition_fields
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, at_least, interval, one_of, setting
 from pamdp.policies import ACTIVATIONS, mlp
@@ -44,22 +57,15 @@ from pamdp.spaces import HybridActionSpace
 if TYPE_CHECKING:
     from typing_extensions import Self
 
-__all__ = ["PADDPG", "PADDPGConfig", "invert_gradients", "zero_gradients", "backprop_actor", "BOUNDS"]
-
-BOUNDS = ("invert", "squash", "zero")
+__all__ = ["PADDPG", "PADDPGConfig"]
 
 
 @dataclasses.dataclass(frozen=True)
-class PADDPGConfig(AlgoConfig):
+class PADDPGConfig(OffPolicyConfig, AlgoConfig):
     """PADDPG's settings. The defaults are the seed paper's preset: Hausknecht & Stone's settings with the
     hidden layers {400, 300} of DDPG (the paper used {400, 300, 200} on Half Field Offense: preset
     ``paper_hfo``; Hausknecht & Stone's own 1024-512-256-128 towers: preset ``hausknecht_stone``)."""
 
-    num_envs: int = setting(
-        8,
-        "Copies of the env stepped together; learning per sample is set by updates_per_step, not by this.",
-        at_least(1),
-    )
     hidden_sizes: tuple[int, ...] = setting(
         (400, 300), "Hidden layers of the actor and the critic (paper: {400, 300}).", LAYERS
     )
@@ -74,11 +80,8 @@ class PADDPGConfig(AlgoConfig):
     adam_beta1: float = setting(
         0.95, "Adam's beta1 for both networks (Hausknecht & Stone: 0.95).", interval(0, 1, high_open=True)
     )
-    grad_clip: float = setting(
-        10.0, "Clip each network's gradient norm to this; 0 turns clipping off (H&S: 10).", NON_NEGATIVE
-    )
-    batch_size: int = setting(32, "Transitions per gradient update (Hausknecht & Stone: 32).", at_least(1))
-    gamma: float = setting(0.99, "Discount factor.", interval(0, 1))
+    grad_clip: float = shared_setting("grad_clip", 10.0, "Hausknecht & Stone: 10")
+    batch_size: int = shared_setting("batch_size", 32, "Hausknecht & Stone: 32")
     tau: float = setting(
         0.001, "Soft target-update rate: target <- tau * online + (1 - tau) * target.", interval(0, 1, low_open=True)
     )
@@ -100,16 +103,9 @@ class PADDPGConfig(AlgoConfig):
     ou_theta: float = setting(
         0.15, "Mean reversion of the Ornstein-Uhlenbeck noise (DDPG's 0.15).", interval(0, 1, low_open=True)
     )
-    buffer_size: int = setting(500_000, "Replay capacity (Hausknecht & Stone: 500 000).", at_least(1))
+    buffer_size: int = shared_setting("buffer_size", 500_000, "Hausknecht & Stone: 500 000")
     learning_starts: int = setting(
         10_000, "Samples in the replay buffer before the first update (the seed paper: 10^4).", at_least(0)
-    )
-    updates_per_step: float = setting(1.0, "Update-to-data ratio: gradient updates per environment sample.", POSITIVE)
-    epoch_steps: int = setting(
-        10_000, "Samples per epoch, the unit of logging and checkpoints (paper: 10 000).", at_least(1)
-    )
-    save_replay: bool = setting(
-        False, "Store the replay contents in checkpoints (large); otherwise a resumed run refills the buffer."
     )
 
     @classmethod
@@ -119,46 +115,6 @@ class PADDPGConfig(AlgoConfig):
             "paper_hfo": cls(hidden_sizes=(400, 300, 200)),
             "hausknecht_stone": cls(hidden_sizes=(1024, 512, 256, 128)),
         }
-
-
-def invert_gradients(grad: torch.Tensor, p: torch.Tensor, low: float = -1.0, high: float = 1.0) -> torch.Tensor:
-    """Hausknecht & Stone's inverting gradients, for an ascent direction ``grad = dQ/dp`` at outputs ``p``.
-
-    Components that would increase ``p`` are scaled by ``(high - p) / (high - low)``, those that would
-    decrease it by ``(p - low) / (high - low)``: 0 at the bound being approached, 1 at the far bound, and
-    negative (pushing back) once ``p`` is past it.
-    """
-    width = high - low
-    return grad * torch.where(grad > 0, (high - p) / width, (p - low) / width)
-
-
-def zero_gradients(grad: torch.Tensor, p: torch.Tensor, low: float = -1.0, high: float = 1.0) -> torch.Tensor:
-    """Zero the components of the ascent direction ``grad`` that push an output at or past a bound further out."""
-    leaving = ((grad > 0) & (p >= high)) | ((grad < 0) & (p <= low))
-    return torch.where(leaving, torch.zeros_like(grad), grad)
-
-
-def backprop_actor(
-    actor: Callable[[torch.Tensor], torch.Tensor],
-    critic: Callable[[torch.Tensor, torch.Tensor], torch.Tensor],
-    obs: torch.Tensor,
-    bound: str,
-) -> tuple[torch.Tensor, torch.Tensor]:
-    """Back-propagate ``-mean_s Q(s, mu(s))`` into the actor, with ``dQ/dmu`` edited by ``bound`` on the way.
-
-    ``Q`` is summed over its last axis if it has one (P-DQN's K values). The critic's weights get no gradient.
-    Returns the actor's outputs and ``Q(s, mu(s))``, detached.
-    """
-    out = actor(obs)
-    p = out.detach().requires_grad_(True)
-    q = critic(obs, p)
-    (dq_dp,) = torch.autograd.grad(q.sum(), p)  # per-sample dQ/dp, the ascent direction
-    if bound == "invert":
-        dq_dp = invert_gradients(dq_dp, p.detach())
-    elif bound == "zero":
-        dq_dp = zero_gradients(dq_dp, p.detach())
-    out.backward(-dq_dp / out.shape[-2])  # descend on -mean Q over the batch (of each stacked seed)
-    return out.detach(), q.detach()
 
 
 class Actor(nn.Module):
@@ -212,7 +168,7 @@ class PADDPG(Algorithm):
         self.critic_target = copy.deepcopy(self.critic).requires_grad_(False)
         self._bind_networks()
         betas = (cfg.adam_beta1, 0.999)
-        # fused: one kernel per step instead of a dozen foreach passes, about 3x faster on a CPU.
+        # fused: one kernel per step instead of a dozen foreach passes (benchmarks/offpolicy_speed.md).
         self.actor_optimizer = torch.optim.Adam(self.actor.parameters(), lr=cfg.actor_lr, betas=betas, fused=True)
         self.critic_optimizer = torch.optim.Adam(self.critic.parameters(), lr=cfg.critic_lr, betas=betas, fused=True)
         fields = transition_fields(
@@ -222,7 +178,7 @@ class PADDPG(Algorithm):
             out=((self.out_size,), np.float32),  # the output vector the critic sees (after exploration)
         )
         self.replay = ReplayBuffer(cfg.buffer_size, fields)
-        self.loop = OffPolicyLoop(h, self.replay, cfg.gamma, mc_returns=cfg.beta > 0, tail_value=self._target_value)
+        self.loop = OffPolicyLoop(cfg, h, self.replay, mc_returns=cfg.beta > 0, tail_value=self._target_value)
         self._ou = OUNoise(cfg.ou_theta, cfg.ou_sigma)
 
     def _bind_networks(self) -> None:
@@ -282,103 +238,39 @@ class PADDPG(Algorithm):
             return self.critic_target(o, self.actor_target(o).clamp(-1.0, 1.0)).numpy()
 
     def _run_epoch(self) -> dict[str, float]:
-        cfg = self.config
-        stats = self.loop.run_epoch(
-            self.vec_env,
-            self._explore,
-            self._update,
-            cfg.epoch_steps,
-            self.num_timesteps,
-            cfg.learning_starts,
-            cfg.updates_per_step,
-            self.np_rng,
-            self.config.flush_denormal,
-        )
+        stats = self.loop.run_epoch(self.vec_env, self._explore, self._update, self.num_timesteps, self.np_rng)
         stats["train/epsilon"] = self.epsilon(self.num_timesteps + stats["steps"])
         return stats
 
     def _update(self) -> dict[str, float]:
-        """One critic step on the mixed target and one actor step along the bounded ``dQ/dmu``."""
-        return self._update_with(self._stack_sample())
-
-    def _update_with(self, batch: dict[str, torch.Tensor]) -> dict[str, float]:
+        """One critic step on the mixed target and one actor step along the bounded ``dQ/dmu``, back-propagated
+        by hand through the :mod:`~pamdp.algos.dense` views of the networks."""
         cfg = self.config
-
-        stats = _update_step(
-            cfg,
-            batch,
-            self._dense,
-            self.obs_dim,
-            gradient_step(self.critic_optimizer, cfg.grad_clip),
-            gradient_step(self.actor_optimizer, cfg.grad_clip),
-            lambda: self._soft_update(cfg.tau),
-        )
-        return {k: float(v) for k, v in stats.items()}
-
-    # -- seed stacking (pamdp.algos.stacking) ---------------------------------------------------------
-    def _stack_sample(self) -> dict[str, torch.Tensor]:
-        return self.replay.sample(self.config.batch_size, self.np_rng)
-
-    @classmethod
-    def _stacked_update(cls, stack, b: dict[str, torch.Tensor]) -> list[dict[str, float]]:
-        """:meth:`_update` for every member of a seed stack at once, on their batches stacked ``(S, B, ...)``."""
-        cfg = stack.config
-
-        nets = {name: stack.dense(name, "net") for name in ("actor", "critic", "actor_target", "critic_target")}
-
-        obs_dim = stack.members_active()[0].obs_dim
-        stats = _update_step(
-            cfg,
-            b,
-            nets,
-            obs_dim,
-            stack.gradient_step("critic", cfg.grad_clip),
-            stack.gradient_step("actor", cfg.grad_clip),
-            lambda: (
-                stack.soft_update("critic_target", "critic", cfg.tau),
-                stack.soft_update("actor_target", "actor", cfg.tau),
-            ),
-        )
-        columns = {k: v.tolist() for k, v in stats.items()}
-        return [{k: columns[k][j] for k in columns} for j in range(len(b["obs"]))]
-
-
-def _update_step(cfg, b, nets, obs_dim, critic_step, actor_step, soft):
-    """PADDPG's update on a batch ``(B, ...)``, or on the batches of stacked seeds ``(S, B, ...)`` with the
-    networks applied per seed: every mean is over the batch axis, so each seed's loss and gradient are its own.
-
-    ``nets`` maps actor, critic and their targets to :class:`~pamdp.algos.dense.Dense` views of their
-    networks; the gradients are back-propagated by hand (autograd's numbers, ``tests/test_dense.py``) and
-    handed to ``critic_step`` and ``actor_step``. Returns each statistic per seed (a scalar tensor without
-    stacking)."""
-    obs, next_obs = b["obs"], b["next_obs"]
-    batch = obs.shape[-2]
-    actor, critic = nets["actor"], nets["critic"]
-    with torch.no_grad():
-        out_next = nets["actor_target"](next_obs).clamp(-1.0, 1.0)
-        q_next = nets["critic_target"](torch.cat([next_obs, out_next], dim=-1)).squeeze(-1)
-        y = b["reward"] + cfg.gamma * (~b["terminated"]).float() * q_next
-        if cfg.beta > 0:
-            y = mixed_target(y, b["mc"], cfg.beta)
-        # critic: descend on mean (Q - y)^2 over the batch
-        q, cache = critic.forward_cached(torch.cat([obs, b["out"]], dim=-1))
-        q = q.squeeze(-1)
-        error = q - y
-        critic_step(critic.backward(cache, error * (2.0 / batch))[0])
-        # actor: ascend on Q(s, mu(s)) with the critic just updated, dQ/dmu edited at the bounds
-        out, actor_cache = actor.forward_cached(obs)
-        q_mu, q_cache = critic.forward_cached(torch.cat([obs, out], dim=-1))
-        _, dq_dx = critic.backward(q_cache, torch.ones_like(q_mu), weights=False, inputs=True)
-        dq_dp = dq_dx[..., obs_dim:].reshape(out.shape)
-        if cfg.bound == "invert":
-            dq_dp = invert_gradients(dq_dp, out)
-        elif cfg.bound == "zero":
-            dq_dp = zero_gradients(dq_dp, out)
-        actor_step(actor.backward(actor_cache, -dq_dp / batch)[0])
-        soft()
-    return {
-        "losses/critic_loss": error.square().mean(-1),
-        "losses/actor_loss": -q_mu.squeeze(-1).mean(-1),
-        "train/q_mean": q.mean(-1),
-        "train/outputs_out_of_bounds": (out.abs() > 1.0).float().flatten(-2).mean(-1),
-    }
+        b = self.replay.sample(cfg.batch_size, self.np_rng)
+        obs, next_obs = b["obs"], b["next_obs"]
+        batch, nets = len(obs), self._dense
+        actor, critic = nets["actor"], nets["critic"]
+        with torch.no_grad():
+            out_next = nets["actor_target"](next_obs).clamp(-1.0, 1.0)
+            q_next = nets["critic_target"](torch.cat([next_obs, out_next], dim=-1)).squeeze(-1)
+            y = b["reward"] + cfg.gamma * (~b["terminated"]).float() * q_next
+            if cfg.beta > 0:
+                y = mixed_target(y, b["mc"], cfg.beta)
+            # critic: descend on mean (Q - y)^2 over the batch
+            q, cache = critic.forward_cached(torch.cat([obs, b["out"]], dim=-1))
+            q = q.squeeze(-1)
+            error = q - y
+            gradient_step(self.critic_optimizer, cfg.grad_clip)(critic.backward(cache, error * (2.0 / batch))[0])
+            # actor: ascend on Q(s, mu(s)) with the critic just updated, dQ/dmu edited at the bounds
+            out, actor_cache = actor.forward_cached(obs)
+            q_mu, q_cache = critic.forward_cached(torch.cat([obs, out], dim=-1))
+            _, dq_dx = critic.backward(q_cache, torch.ones_like(q_mu), weights=False, inputs=True)
+            dq_dp = bounded(dq_dx[:, self.obs_dim :], out, cfg.bound)
+            gradient_step(self.actor_optimizer, cfg.grad_clip)(actor.backward(actor_cache, -dq_dp / batch)[0])
+            self._soft_update(cfg.tau)
+        return {
+            "losses/critic_loss": float(error.square().mean()),
+            "losses/actor_loss": float(-q_mu.mean()),
+            "train/q_mean": float(q.mean()),
+            "train/outputs_out_of_bounds": float((out.abs() > 1.0).float().mean()),
+        }

@@ -38,10 +38,16 @@ from torch import nn
 
 from pamdp.algos.base import Algorithm
 from pamdp.algos.dense import Dense
-from pamdp.algos.offpolicy import OffPolicyLoop, clipped_step, gradient_step, soft_update, soft_updater
+from pamdp.algos.offpolicy import (
+    OffPolicyConfig,
+    OffPolicyLoop,
+    clipped_step,
+    gradient_step,
+    shared_setting,
+    soft_updater,
+)
 from pamdp.algos.replay import ReplayBuffer, transition_fields
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
-from pamdp.algos.stacking import clip_per_member
 from pamdp.policies import ACTIVATIONS, mlp
 from pamdp.spaces import HybridActionSpace
 
@@ -54,14 +60,9 @@ LOG_STD_MIN, LOG_STD_MAX = -5.0, 2.0
 
 
 @dataclasses.dataclass(frozen=True)
-class PASVG0Config(AlgoConfig):
+class PASVG0Config(OffPolicyConfig, AlgoConfig):
     """PASVG(0)'s settings; the defaults are the paper's preset (DDPG's where the paper says nothing)."""
 
-    num_envs: int = setting(
-        8,
-        "Copies of the env stepped together; learning per sample is set by updates_per_step, not by this.",
-        at_least(1),
-    )
     hidden_sizes: tuple[int, ...] = setting(
         (400, 300), "Hidden layers of pi_d, pi_c and the critic (paper: {400, 300}).", LAYERS
     )
@@ -121,30 +122,15 @@ class PASVG0Config(AlgoConfig):
     policy_lr: float = setting(
         1e-5, "Adam learning rate of pi_d and pi_c (paper: 1e-5, which learns slowly).", POSITIVE
     )
-    batch_size: int = setting(64, "Transitions per gradient update (DDPG's 64; the paper does not say).", at_least(1))
-    gamma: float = setting(0.99, "Discount factor.", interval(0, 1))
+    batch_size: int = shared_setting("batch_size", 64, "DDPG's 64; the paper does not say")
     tau: float = setting(
         0.001,
         "Soft target-update rate (DDPG's 0.001): target <- tau * online + (1 - tau) * target.",
         interval(0, 1, low_open=True),
     )
-    grad_clip: float = setting(
-        0.0, "Clip each network's gradient norm to this before a step; 0 turns clipping off.", NON_NEGATIVE
-    )
-    buffer_size: int = setting(
-        10_000_000, "Replay capacity (paper: 10^7); memory grows with the contents, not the capacity.", at_least(1)
-    )
+    buffer_size: int = shared_setting("buffer_size", 10_000_000, "paper: 10^7")
     learning_starts: int = setting(
         10_000, "Samples in the replay buffer before the first update (paper: 10^4).", at_least(0)
-    )
-    updates_per_step: float = setting(
-        1.0, "Update-to-data ratio: gradient updates (critic and policy) per environment sample.", POSITIVE
-    )
-    epoch_steps: int = setting(
-        10_000, "Samples per epoch, the unit of logging and checkpoints (paper: 10 000).", at_least(1)
-    )
-    save_replay: bool = setting(
-        False, "Store the replay contents in checkpoints (large); otherwise a resumed run refills the buffer."
     )
 
     def __post_init__(self):
@@ -161,17 +147,11 @@ class PASVG0Config(AlgoConfig):
     def presets(cls) -> dict[str, Self]:
         return {
             "paper": cls(),
-            # Small networks, 64 batched env copies and a quarter of an update per sample (1M samples in about
-            # an hour of one core here instead of the paper preset's ~5 hours); pi_d's gradient from the exact
-            # expectation over the K actions instead of the Gumbel-Softmax estimate; pi_d's entropy held at
-            # 0.3 nats (of ln 3 = 1.10) by a tuned weight; 5 % of the collected discrete actions uniform; a
-            # fixed parameter noise (std 0.2 before the Tanh).
-            # History (benchmarks/pasvg_tuning.md): a fixed entropy bonus of 0.1 left one seed in five never
-            # leaping (5 x 300k: 0.789 +- 0.248); 0.02-0.05 collapsed onto run/hop. The entropy target fixed that
-            # seed, but over 1M samples seeds collapsed late (0.95 -> 0.32 at 550k; with policy_lr 1e-4 and
-            # the uniform 5 %, 0.90 -> 0.42 at 850k) while the learned noise std fell to ~0.01-0.03. Fixing the
-            # std alone did not steady the policy (0.55-0.88 by 340k); with the exact expectation as well it
-            # held 0.945-0.968 from 50k on.
+            # Small networks, 64 batched env copies and a quarter of an update per sample; pi_d's gradient from
+            # the exact expectation over the K actions instead of the Gumbel-Softmax estimate; pi_d's entropy
+            # held at 0.3 nats (of ln 3 = 1.10) by a tuned weight; 5 % of the collected discrete actions
+            # uniform; a fixed parameter noise (std 0.2 before the Tanh). How each choice was reached, and what
+            # it fixed: benchmarks/pasvg_tuning.md.
             "tuned": cls(
                 num_envs=64,
                 hidden_sizes=(128, 128),
@@ -215,58 +195,7 @@ def gumbel_softmax_sample(
     return index, onehot - soft.detach() + soft
 
 
-def _rows(table: torch.Tensor, index: torch.Tensor) -> torch.Tensor:
-    """The rows of a per-action table ``(K, m)`` at actions ``index`` (any shape): ``index.shape + (m,)``. A seed
-    stack's table ``(S, K, m)`` with ``index`` of shape ``(S, ...)`` gives each seed the rows of its own table."""
-    if table.dim() == 2:
-        return table[index]
-    K, m = table.shape[1:]
-    table = table.reshape(table.shape[0], *([1] * (index.dim() - 2)), K, m).expand(*index.shape[:-1], K, m)
-    return torch.gather(table, -2, index.unsqueeze(-1).expand(*index.shape, m))
-
-
-class HybridSampling:
-    """How ``(pi_d, pi_c, log_std)`` turn noise into actions, written over any leading axes, so that the same code
-    serves one policy (:class:`GumbelHybridPolicy`) and a seed stack's (``PASVG0._stacked_update``).
-
-    A subclass provides ``pi_d(obs)`` (logits over K actions), ``pi_c(inputs)`` (pre-Tanh means), ``log_std``
-    (``(K, m)``, or ``(S, K, m)`` stacked), ``mask`` (``(K, m)``) and ``n_actions``.
-    """
-
-    pi_d: Callable[[torch.Tensor], torch.Tensor]
-    pi_c: Callable[[torch.Tensor], torch.Tensor]
-    log_std: torch.Tensor
-    mask: torch.Tensor
-    n_actions: int
-
-    def sample(
-        self, obs: torch.Tensor, eta_a: torch.Tensor, eta_x: torch.Tensor, temperature: float, hard: bool
-    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
-        """``(logits, index, a, x)`` for the noise ``(eta_a, eta_x)``: ``pi_d``'s logits, the action, the critic's
-        action input ``a`` and the parameters ``x``, so an update runs ``pi_d`` once."""
-        logits = self.pi_d(obs)
-        index, a = gumbel_softmax_sample(logits, eta_a, temperature, hard)
-        return logits, index, a, self.params(obs, index, a, eta_x)
-
-    def params(self, obs: torch.Tensor, index: torch.Tensor, a: torch.Tensor, eta_x: torch.Tensor) -> torch.Tensor:
-        """``x = g(s, a, eta_x)``: ``pi_c``'s parameters for action ``a`` (one-hot or soft; ``index`` its argmax)."""
-        std = _rows(self.log_std.clamp(LOG_STD_MIN, LOG_STD_MAX).exp(), index)
-        return torch.tanh(self.pi_c(torch.cat([obs, a], dim=-1)) + std * eta_x) * self.mask[index]
-
-    def params_all(self, obs: torch.Tensor, eta_x: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
-        """Every action's parameters for the noise ``eta_x``: ``(obs_k, onehots, x)``, each ``(..., K, .)``.
-
-        ``obs_k`` and ``onehots`` are the critic's matching state and action inputs, so that
-        ``critic(obs_k, onehots, x)`` is ``Q(s, k, x_k)`` for every ``k`` in one batched pass.
-        """
-        lead, K = obs.shape[:-1], self.n_actions
-        index = torch.arange(K).expand(*lead, K)
-        onehots = torch.eye(K, dtype=obs.dtype).expand(*lead, K, K)
-        obs_k = obs.unsqueeze(-2).expand(*lead, K, obs.shape[-1])
-        return obs_k, onehots, self.params(obs_k, index, onehots, eta_x.unsqueeze(-2))
-
-
-class GumbelHybridPolicy(nn.Module, HybridSampling):
+class GumbelHybridPolicy(nn.Module):
     """``pi_d`` (logits over K actions) and ``pi_c`` (pre-Tanh means of ``m`` parameters given ``[s, a]``).
 
     The parameter noise has a state-independent log-std per action and parameter; parameters an action does
@@ -285,6 +214,35 @@ class GumbelHybridPolicy(nn.Module, HybridSampling):
             nn.init.uniform_(head.weight, -3e-3, 3e-3)
             nn.init.zeros_(head.bias)
 
+    def std(self) -> torch.Tensor:
+        """The parameter noise's std per action and parameter, ``(K, m)``."""
+        return self.log_std.clamp(LOG_STD_MIN, LOG_STD_MAX).exp()
+
+    def sample(
+        self, obs: torch.Tensor, eta_a: torch.Tensor, eta_x: torch.Tensor, temperature: float, hard: bool
+    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
+        """``(logits, index, a, x)`` for the noise ``(eta_a, eta_x)``: ``pi_d``'s logits, the action, the critic's
+        action input ``a`` and the parameters ``x``, so an update runs ``pi_d`` once."""
+        logits = self.pi_d(obs)
+        index, a = gumbel_softmax_sample(logits, eta_a, temperature, hard)
+        return logits, index, a, self.params(obs, index, a, eta_x)
+
+    def params(self, obs: torch.Tensor, index: torch.Tensor, a: torch.Tensor, eta_x: torch.Tensor) -> torch.Tensor:
+        """``x = g(s, a, eta_x)``: ``pi_c``'s parameters for action ``a`` (one-hot or soft; ``index`` its argmax)."""
+        return torch.tanh(self.pi_c(torch.cat([obs, a], dim=-1)) + self.std()[index] * eta_x) * self.mask[index]
+
+    def params_all(self, obs: torch.Tensor, eta_x: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+        """Every action's parameters for the noise ``eta_x``: ``(obs_k, onehots, x)``, each ``(B, K, .)``.
+
+        ``obs_k`` and ``onehots`` are the critic's matching state and action inputs, so that
+        ``critic(obs_k, onehots, x)`` is ``Q(s, k, x_k)`` for every ``k`` in one batched pass.
+        """
+        batch, K = len(obs), self.n_actions
+        index = torch.arange(K).expand(batch, K)
+        onehots = torch.eye(K, dtype=obs.dtype).expand(batch, K, K)
+        obs_k = obs.unsqueeze(-2).expand(batch, K, obs.shape[-1])
+        return obs_k, onehots, self.params(obs_k, index, onehots, eta_x.unsqueeze(-2))
+
     def forward(
         self, obs: torch.Tensor, eta_a: torch.Tensor, eta_x: torch.Tensor, temperature: float, hard: bool
     ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
@@ -299,7 +257,7 @@ class GumbelHybridPolicy(nn.Module, HybridSampling):
 
 
 def expected_q(
-    policy: HybridSampling, critic: Callable, obs: torch.Tensor, eta_x: torch.Tensor
+    policy: GumbelHybridPolicy, critic: Callable, obs: torch.Tensor, eta_x: torch.Tensor
 ) -> tuple[torch.Tensor, torch.Tensor]:
     """``(logits, E_{k ~ pi_d}[Q(s, k, g(s, k, eta_x))])``: the value the Gumbel-Softmax sample estimates, exactly.
 
@@ -359,7 +317,7 @@ class PASVG0(Algorithm):
             critic_params += list(self.critic2.parameters())
         self.critic_params = critic_params
         self.critic_updates = 0  # for policy_delay
-        # fused: one kernel per step instead of a dozen foreach passes, about 3x faster on a CPU.
+        # fused: one kernel per step instead of a dozen foreach passes (benchmarks/offpolicy_speed.md).
         self.policy_params = [p for p in self.policy.parameters() if p.requires_grad]
         self.policy_optimizer = torch.optim.Adam(self.policy_params, lr=cfg.policy_lr, fused=True)
         self.critic_optimizer = torch.optim.Adam(self.critic_params, lr=cfg.critic_lr, fused=True)
@@ -381,24 +339,26 @@ class PASVG0(Algorithm):
             eta_x=((m,), np.float32),
         )
         self.replay = ReplayBuffer(cfg.buffer_size, fields)
-        self.loop = OffPolicyLoop(h, self.replay, cfg.gamma)
+        self.loop = OffPolicyLoop(cfg, h, self.replay)
         self._bind_networks()
 
     def _bind_networks(self) -> None:
-        """The hand-written update's views of the networks (:mod:`pamdp.algos.dense`), for the settings it
-        covers (:func:`_dense_update`); ``_dense = None`` runs the autograd update. Called again by whoever
-        replaces a module."""
+        """The soft target update over the modules' own tensors and, with the paper's settings, the hand-written
+        update's views of the networks (:mod:`pamdp.algos.dense`). Called again by whoever replaces a module."""
+        pairs = [(self.critic_target, self.critic), (self.policy_target, self.policy)]
+        if self.critic2 is not None:
+            pairs.append((self.critic2_target, self.critic2))
+        self._soft_update = soft_updater(pairs)
+        cfg = self.config
         self._dense = None
-        if self._stack_refusal(self.config) is None and self.config.discrete_gradient == "gumbel":
+        # The paper's settings: the Gumbel-Softmax gradient, one critic, no policy delay, a fixed entropy weight.
+        paper = cfg.discrete_gradient == "gumbel" and not cfg.twin_critics and cfg.policy_delay == 1
+        if paper and cfg.target_entropy is None:
             self._dense = {
                 "pi_d": Dense.of(self.policy.pi_d),
                 "pi_c": Dense.of(self.policy.pi_c),
                 "critic": Dense.of(self.critic.net),
-                "pi_d_target": Dense.of(self.policy_target.pi_d),
-                "pi_c_target": Dense.of(self.policy_target.pi_c),
-                "critic_target": Dense.of(self.critic_target.net),
             }
-            self._soft_update = soft_updater(((self.critic_target, self.critic), (self.policy_target, self.policy)))
 
     def _modules(self):
         modules = {
@@ -452,64 +412,36 @@ class PASVG0(Algorithm):
         return index, x, {"a_in": a_in.numpy(), "eta_a": eta_a.numpy(), "eta_x": eta_x.numpy()}
 
     def _run_epoch(self) -> dict[str, float]:
-        cfg = self.config
-        return self.loop.run_epoch(
-            self.vec_env,
-            self._explore,
-            self._update,
-            cfg.epoch_steps,
-            self.num_timesteps,
-            cfg.learning_starts,
-            cfg.updates_per_step,
-            self.np_rng,
-            self.config.flush_denormal,
-        )
+        return self.loop.run_epoch(self.vec_env, self._explore, self._update, self.num_timesteps, self.np_rng)
 
     def _target_q(self, obs: torch.Tensor, a: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
         """The target critic's ``Q'``; with ``twin_critics`` the smaller of the two target critics' values."""
         q = self.critic_target(obs, a, x)
         return q if self.critic2 is None else torch.minimum(q, self.critic2_target(obs, a, x))
 
+    @torch.no_grad()
+    def _td_target(self, b: dict[str, torch.Tensor]) -> torch.Tensor:
+        """``y = r + gamma Q'(s', a', x')``, the next action drawn from the target policy with fresh noise (or,
+        with ``discrete_gradient="expected"``, ``E_{k ~ pi_d'}[Q'(s', k, x'_k)]``); no bootstrap after a
+        termination."""
+        cfg = self.config
+        next_obs = b["next_obs"]
+        eta_a, eta_x = self._noise(len(next_obs))
+        if cfg.discrete_gradient == "expected":
+            _, q_next = expected_q(self.policy_target, self._target_q, next_obs, eta_x)
+        else:
+            _, a_next, x_next = self.policy_target(next_obs, eta_a, eta_x, cfg.temperature, cfg.straight_through)
+            q_next = self._target_q(next_obs, a_next, x_next)
+        return b["reward"] + cfg.gamma * (~b["terminated"]).float() * q_next
+
     def _update(self) -> dict[str, float]:
         """One critic TD step and (every ``policy_delay``-th call) one value-gradient step of both policies."""
-        if self._dense is not None:
-            return self._update_dense(self._stack_sample())
-        return self._update_autograd()
-
-    def _update_dense(self, b: dict[str, torch.Tensor]) -> dict[str, float]:
-        """:meth:`_update_autograd`'s step, back-propagated by hand (:func:`_dense_update`), on the batch and
-        noise ``b`` of :meth:`_stack_sample`."""
-        cfg = self.config
-
-        stats = _dense_update(
-            cfg,
-            b,
-            self._dense,
-            self.policy.log_std,
-            self.policy_target.log_std,
-            self.policy.mask,
-            gradient_step(self.critic_optimizer, cfg.grad_clip),
-            gradient_step(self.policy_optimizer, cfg.grad_clip),
-            lambda: self._soft_update(cfg.tau),
-        )
-        self.critic_updates += 1
-        out = {k: float(v) for k, v in stats.items()}
-        out["train/entropy_coef"] = cfg.entropy_coef
-        out["train/param_std"] = float(self.policy.log_std.detach().exp()[self.policy.mask.bool()].mean())
-        return out
-
-    def _update_autograd(self) -> dict[str, float]:
         cfg = self.config
         b = self.replay.sample(cfg.batch_size, self.np_rng)
-        obs, next_obs = b["obs"], b["next_obs"]
-        with torch.no_grad():
-            eta_a, eta_x = self._noise(len(obs))
-            if cfg.discrete_gradient == "expected":  # E_k~pi_d'[Q'(s', k, x'_k)]
-                _, q_next = expected_q(self.policy_target, self._target_q, next_obs, eta_x)
-            else:
-                _, a_next, x_next = self.policy_target(next_obs, eta_a, eta_x, cfg.temperature, cfg.straight_through)
-                q_next = self._target_q(next_obs, a_next, x_next)
-            y = b["reward"] + cfg.gamma * (~b["terminated"]).float() * q_next
+        y = self._td_target(b)
+        if self._dense is not None:
+            return self._update_by_hand(b, y)
+        obs = b["obs"]
         q = self.critic(obs, b["a_in"], b["x"])
         critic_loss = F.mse_loss(q, y)
         if self.critic2 is not None:
@@ -520,12 +452,13 @@ class PASVG0(Algorithm):
         self.critic_updates += 1
         stats = {"losses/critic_loss": float(critic_loss.detach()), "train/q_mean": float(q.detach().mean())}
         if self.critic_updates % cfg.policy_delay == 0:
-            stats.update(self._policy_update(obs, b))
+            stats.update(self._policy_update(b))
         return stats
 
-    def _policy_update(self, obs: torch.Tensor, b: dict[str, torch.Tensor]) -> dict[str, float]:
+    def _policy_update(self, b: dict[str, torch.Tensor]) -> dict[str, float]:
         """The value-gradient step of pi_d and pi_c, the entropy weight's step and the soft target updates."""
         cfg = self.config
+        obs = b["obs"]
         # The recorded noise, pushed through the current policy: a = f(s, eta_a), x = g(s, a, eta_x).
         if cfg.discrete_gradient == "expected":
             logits, q_pi = expected_q(self.policy, self.critic, obs, b["eta_x"])
@@ -546,205 +479,53 @@ class PASVG0(Algorithm):
             self.entropy_optimizer.zero_grad(set_to_none=True)
             alpha_loss.backward()
             self.entropy_optimizer.step()
+        self._soft_update(cfg.tau)
+        return self._policy_stats(actor_loss.detach(), q_pi, entropy.detach(), alpha)
 
-        soft_update(self.critic_target, self.critic, cfg.tau)
-        if self.critic2 is not None:
-            soft_update(self.critic2_target, self.critic2, cfg.tau)
-        soft_update(self.policy_target, self.policy, cfg.tau)
-        mask = self.policy.mask.bool()
+    def _policy_stats(self, actor_loss, q_pi, entropy, alpha) -> dict[str, float]:
         return {
-            "losses/actor_loss": float(actor_loss.detach()),
+            "losses/actor_loss": float(actor_loss),
             "train/q_pi_mean": float(q_pi.detach().mean()),
-            "train/entropy": float(entropy.detach()),
+            "train/entropy": float(entropy),
             "train/entropy_coef": alpha,
-            "train/param_std": float(self.policy.log_std.detach().exp()[mask].mean()),
+            "train/param_std": float(self.policy.std().detach()[self.policy.mask.bool()].mean()),
         }
 
-    # -- seed stacking (pamdp.algos.stacking) ---------------------------------------------------------
-    @classmethod
-    def _stack_refusal(cls, config: PASVG0Config) -> str | None:
-        """The settings a seed stack cannot take (it batches the paper's update, not every variant)."""
-        if config.twin_critics:
-            return "twin_critics"
-        if config.policy_delay != 1:
-            return f"policy_delay = {config.policy_delay} (its counter is per run)"
-        if config.target_entropy is not None:
-            return "target_entropy (a tuned entropy weight)"
-        return None
+    @torch.no_grad()
+    def _update_by_hand(self, b: dict[str, torch.Tensor], y: torch.Tensor) -> dict[str, float]:
+        """:meth:`_update`'s two steps with the paper's settings, back-propagated by hand: the same gradients as
+        autograd's (``tests/test_dense.py``) in fewer calls (``benchmarks/offpolicy_speed.md``).
 
-    def _stack_sample(self) -> dict[str, torch.Tensor]:
-        """What :meth:`_update` draws from this run's random streams, in its order: the batch, then the noise."""
-        b = self.replay.sample(self.config.batch_size, self.np_rng)
-        b["next_eta_a"], b["next_eta_x"] = self._noise(self.config.batch_size)
-        return b
-
-    @classmethod
-    def _stacked_update(cls, stack, b: dict[str, torch.Tensor]) -> list[dict[str, float]]:
-        """:meth:`_update` for every member of a seed stack at once, on their batches stacked ``(S, B, ...)``.
-
-        The same computation written over a leading seed axis: every mean is over the batch, and each seed's
-        rows of ``log_std`` are gathered with its own actions.
-        """
-        cfg = stack.config
-        if cfg.discrete_gradient == "gumbel":
-            return cls._stacked_dense_update(stack, b)
-
-        def critic(module):
-            return lambda o, a, x: stack.sequential(module, "net", torch.cat([o, a, x], dim=-1)).squeeze(-1)
-
-        obs, next_obs = b["obs"], b["next_obs"]
-        policy, policy_target = _StackedPolicy(stack, "policy"), _StackedPolicy(stack, "policy_target")
-        with torch.no_grad():
-            if cfg.discrete_gradient == "expected":
-                _, q_next = expected_q(policy_target, critic("critic_target"), next_obs, b["next_eta_x"])
-            else:
-                _, _, a_next, x_next = policy_target.sample(
-                    next_obs, b["next_eta_a"], b["next_eta_x"], cfg.temperature, cfg.straight_through
-                )
-                q_next = critic("critic_target")(next_obs, a_next, x_next)
-            y = b["reward"] + cfg.gamma * (~b["terminated"]).float() * q_next
-        q = critic("critic")(obs, b["a_in"], b["x"])
-        critic_loss = (q - y).square().mean(-1)  # F.mse_loss, per seed
-        critic_params = list(stack.params["critic"].values())
-        stack.optimizers["critic"].zero_grad(set_to_none=True)
-        critic_loss.sum().backward()
-        clip_per_member([p.grad for p in critic_params], cfg.grad_clip)
-        stack.optimizers["critic"].step()
-
-        if cfg.discrete_gradient == "expected":
-            logits, q_pi = expected_q(policy, critic("critic"), obs, b["eta_x"])
-        else:
-            logits, _, a, x = policy.sample(obs, b["eta_a"], b["eta_x"], cfg.temperature, cfg.straight_through)
-            q_pi = critic("critic")(obs, a, x)
-        entropy = -(logits.softmax(-1) * logits.log_softmax(-1)).sum(-1).mean(-1)
-        actor_loss = -q_pi.mean(-1) - cfg.entropy_coef * entropy
-        policy_params = [p for p in stack.params["policy"].values() if p.requires_grad]
-        grads = torch.autograd.grad(actor_loss.sum(), policy_params)
-        for p, g in zip(policy_params, grads):
-            p.grad = g
-        clip_per_member([p.grad for p in policy_params], cfg.grad_clip)
-        stack.optimizers["policy"].step()
-        stack.soft_update("critic_target", "critic", cfg.tau)
-        stack.soft_update("policy_target", "policy", cfg.tau)
-        std = policy.log_std.detach().exp()[:, policy.mask.bool()].mean(-1)
-        columns = {
-            "losses/critic_loss": critic_loss.detach().tolist(),
-            "train/q_mean": q.detach().mean(-1).tolist(),
-            "losses/actor_loss": actor_loss.detach().tolist(),
-            "train/q_pi_mean": q_pi.detach().mean(-1).tolist(),
-            "train/entropy": entropy.detach().tolist(),
-            "train/param_std": std.tolist(),
-        }
-        stats = [{k: v[j] for k, v in columns.items()} for j in range(len(obs))]
-        for st in stats:
-            st["train/entropy_coef"] = cfg.entropy_coef
-        for m in stack.members_active():
-            m.critic_updates += 1
-        return stats
-
-    @classmethod
-    def _stacked_dense_update(cls, stack, b: dict[str, torch.Tensor]) -> list[dict[str, float]]:
-        """:meth:`_update_dense` for every member of a seed stack at once (:func:`_dense_update` over ``(S, ...)``)."""
-        cfg = stack.config
-        nets = {
-            "pi_d": stack.dense("policy", "pi_d"),
-            "pi_c": stack.dense("policy", "pi_c"),
-            "critic": stack.dense("critic", "net"),
-            "pi_d_target": stack.dense("policy_target", "pi_d"),
-            "pi_c_target": stack.dense("policy_target", "pi_c"),
-            "critic_target": stack.dense("critic_target", "net"),
-        }
-
-        def soft():
-            stack.soft_update("critic_target", "critic", cfg.tau)
-            stack.soft_update("policy_target", "policy", cfg.tau)
-
-        log_std = stack.params["policy"]["log_std"]
-        mask = stack.buffer("policy", "mask")
-        stats = _dense_update(
-            cfg,
-            b,
-            nets,
-            log_std,
-            stack.params["policy_target"]["log_std"],
-            mask,
-            stack.gradient_step("critic", cfg.grad_clip),
-            stack.gradient_step("policy", cfg.grad_clip),
-            soft,
-        )
-        seeds = len(b["obs"])
-        columns = {k: v.tolist() for k, v in stats.items()}  # then the solo update's last two columns
-        columns["train/entropy_coef"] = [cfg.entropy_coef] * seeds
-        columns["train/param_std"] = log_std.detach().exp()[:, mask.bool()].mean(-1).tolist()
-        rows = [{k: v[j] for k, v in columns.items()} for j in range(seeds)]
-        for m in stack.members_active():
-            m.critic_updates += 1
-        return rows
-
-
-class _StackedPolicy(HybridSampling):
-    """A seed stack's ``module`` (a :class:`GumbelHybridPolicy` in every member) as one policy over ``(S, ...)``."""
-
-    def __init__(self, stack, module: str):
-        self.stack, self.module = stack, module
-        self.log_std = stack.params[module]["log_std"]
-        self.mask = stack.buffer(module, "mask")
-        self.n_actions = self.mask.shape[0]
-
-    def pi_d(self, obs: torch.Tensor) -> torch.Tensor:
-        return self.stack.sequential(self.module, "pi_d", obs)
-
-    def pi_c(self, inputs: torch.Tensor) -> torch.Tensor:
-        return self.stack.sequential(self.module, "pi_c", inputs)
-
-
-def _dense_update(cfg, b, nets, log_std, log_std_target, mask, critic_step, policy_step, soft) -> dict:
-    """The paper's update (``discrete_gradient="gumbel"``, one critic, a fixed entropy weight, no policy delay),
-    back-propagated by hand on a batch ``(B, ...)`` or a seed stack's ``(S, B, ...)``.
-
-    ``nets`` maps ``pi_d``, ``pi_c``, ``critic`` and their ``*_target`` to :class:`~pamdp.algos.dense.Dense`
-    views; ``log_std`` is ``(K, m)`` or ``(S, K, m)``. The gradients are autograd's through
-    :meth:`HybridSampling.sample` and the critic (``tests/test_dense.py``): the straight-through one-hot carries
-    the softmax's gradient, ``pi_c`` sees the action, and ``log_std`` gets its rows' share through ``exp`` and
-    the clamp. ``policy_step`` receives them in the order of the policy's trainable parameters (``log_std``,
-    then ``pi_d``'s and ``pi_c``'s). Returns the statistics per seed (scalars without stacking)."""
-    obs, next_obs = b["obs"], b["next_obs"]
-    batch, d = obs.shape[-2], obs.shape[-1]
-    K = mask.shape[0]
-    temperature, hard = cfg.temperature, cfg.straight_through
-    with torch.no_grad():
-        # TD target: the target policy's action for fresh noise, valued by the target critic
-        index_next, a_next = gumbel_softmax_sample(nets["pi_d_target"](next_obs), b["next_eta_a"], temperature, hard)
-        std_next = _rows(log_std_target.clamp(LOG_STD_MIN, LOG_STD_MAX).exp(), index_next)
-        pre_next = nets["pi_c_target"](torch.cat([next_obs, a_next], dim=-1))
-        x_next = torch.tanh(pre_next + std_next * b["next_eta_x"]) * mask[index_next]
-        q_next = nets["critic_target"](torch.cat([next_obs, a_next, x_next], dim=-1)).squeeze(-1)
-        y = b["reward"] + cfg.gamma * (~b["terminated"]).float() * q_next
-
+        The straight-through one-hot carries the softmax's gradient, ``pi_c`` sees the action, and ``log_std``
+        gets its rows' share through ``exp`` and the clamp."""
+        cfg, nets, policy = self.config, self._dense, self.policy
+        obs, eta_x = b["obs"], b["eta_x"]
+        batch, d, K = obs.shape[0], obs.shape[1], policy.n_actions
+        temperature, hard = cfg.temperature, cfg.straight_through
         critic = nets["critic"]
+        # critic: descend on mean (Q - y)^2
         q, cache = critic.forward_cached(torch.cat([obs, b["a_in"], b["x"]], dim=-1))
         q = q.squeeze(-1)
         error = q - y
-        critic_step(critic.backward(cache, error * (2.0 / batch))[0])
+        gradient_step(self.critic_optimizer, cfg.grad_clip)(critic.backward(cache, error * (2.0 / batch))[0])
+        self.critic_updates += 1
 
-        # The policy loss -mean Q(s, a, x) - alpha * mean H(pi_d), with the recorded noise
+        # policy: descend on -mean Q(s, a, x) - alpha * mean H(pi_d), with the recorded noise
         logits, d_cache = nets["pi_d"].forward_cached(obs)
         log_p = logits.log_softmax(-1)
         z = log_p + b["eta_a"]
         soft_a = torch.softmax(z / temperature, dim=-1)
         index = z.argmax(-1)
         a = F.one_hot(index, K).to(soft_a.dtype) if hard else soft_a
-        std = _rows(log_std.clamp(LOG_STD_MIN, LOG_STD_MAX).exp(), index)
+        std = policy.std()[index]
         pre, c_cache = nets["pi_c"].forward_cached(torch.cat([obs, a], dim=-1))
-        t = torch.tanh(pre + std * b["eta_x"])
-        rows = mask[index]
-        x = t * rows
-        q_pi, q_cache = critic.forward_cached(torch.cat([obs, a, x], dim=-1))
+        t = torch.tanh(pre + std * eta_x)
+        rows = policy.mask[index]
+        q_pi, q_cache = critic.forward_cached(torch.cat([obs, a, t * rows], dim=-1))
         _, d_in = critic.backward(q_cache, torch.full_like(q_pi, -1.0 / batch), weights=False, inputs=True)
-        d_in = d_in.reshape(*obs.shape[:-1], -1)
-        d_u = torch.ops.aten.tanh_backward(d_in[..., d + K :] * rows, t)  # through x = tanh(u) * mask
+        d_u = torch.ops.aten.tanh_backward(d_in[:, d + K :] * rows, t)  # through x = tanh(u) * mask
         pc_grads, d_pc_in = nets["pi_c"].backward(c_cache, d_u, inputs=True)
-        d_a = d_in[..., d : d + K] + d_pc_in.reshape(*obs.shape[:-1], -1)[..., d:]
+        d_a = d_in[:, d : d + K] + d_pc_in[:, d:]
         # a carries softmax(z / t)'s gradient (straight-through, or the soft sample itself), z = log pi_d + eta_a
         d_z = soft_a * (d_a - (d_a * soft_a).sum(-1, keepdim=True)) / temperature
         p = log_p.exp()
@@ -755,19 +536,15 @@ def _dense_update(cfg, b, nets, log_std, log_std_target, mask, critic_step, poli
             d_logits = d_logits + (alpha / batch) * p * (log_p + entropy.unsqueeze(-1))
         pd_grads, _ = nets["pi_d"].backward(d_cache, d_logits)
         grads = pd_grads + pc_grads
-        if log_std.requires_grad:  # the policy's own parameter, so first in its parameters()
+        if policy.log_std.requires_grad:  # the policy's own parameter, so first in its parameters()
             # u = mu + exp(clamp(log_std))[a] * eta_x: each row's share, summed over the samples of its action
-            onehot_t = F.one_hot(index, K).to(d_u.dtype).transpose(-1, -2)
-            d_table = torch.matmul(onehot_t, d_u * b["eta_x"] * std).reshape(log_std.shape)
-            inside = (log_std >= LOG_STD_MIN) & (log_std <= LOG_STD_MAX)
+            d_table = F.one_hot(index, K).to(d_u.dtype).t() @ (d_u * eta_x * std)
+            inside = (policy.log_std >= LOG_STD_MIN) & (policy.log_std <= LOG_STD_MAX)
             grads.insert(0, d_table * inside)
-        policy_step(grads)
-        soft()
-    q_pi = q_pi.squeeze(-1)
-    return {
-        "losses/critic_loss": error.square().mean(-1),
-        "train/q_mean": q.mean(-1),
-        "losses/actor_loss": -q_pi.mean(-1) - alpha * entropy.mean(-1),
-        "train/q_pi_mean": q_pi.mean(-1),
-        "train/entropy": entropy.mean(-1),
-    }
+        gradient_step(self.policy_optimizer, cfg.grad_clip)(grads)
+        self._soft_update(cfg.tau)
+        q_pi = q_pi.squeeze(-1)
+        entropy = entropy.mean()
+        stats = {"losses/critic_loss": float(error.square().mean()), "train/q_mean": float(q.mean())}
+        stats.update(self._policy_stats(-q_pi.mean() - alpha * entropy, q_pi, entropy, alpha))
+        return stats

@@ -12,7 +12,7 @@ argmax over the K discrete actions and learns the continuous parameters with a d
   Monte-Carlo return as PADDPG does, ``y = beta * MC + (1 - beta) * y`` (``beta``; Bester et al. used such
   mixed targets on Half Field Offense);
 - the actor ascends ``sum_k Q_k(s, x(s))`` with Q's weights held fixed. Its outputs are kept in ``[-1, 1]``
-  by Hausknecht & Stone's inverting gradients (``bound``; the helpers are PADDPG's).
+  by Hausknecht & Stone's inverting gradients (``bound``; :func:`~pamdp.algos.offpolicy.backprop_actor`).
 
 MP-DQN (Bester, James & Konidaris 2019, "Multi-Pass Q-Networks for Deep Reinforcement Learning with
 Parameterised Action Spaces", arXiv 1905.04388) points out that with the joint input ``Q_k`` depends on the
@@ -39,8 +39,18 @@ import torch.nn.functional as F
 from torch import nn
 
 from pamdp.algos.base import Algorithm
-from pamdp.algos.offpolicy import OffPolicyLoop, OUNoise, clipped_step, linear_epsilon, mixed_target, soft_update
-from pamdp.algos.paddpg import BOUNDS, backprop_actor
+from pamdp.algos.offpolicy import (
+    BOUNDS,
+    OffPolicyConfig,
+    OffPolicyLoop,
+    OUNoise,
+    backprop_actor,
+    clipped_step,
+    linear_epsilon,
+    mixed_target,
+    shared_setting,
+    soft_update,
+)
 from pamdp.algos.replay import ReplayBuffer, transition_fields
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, at_least, interval, one_of, setting
 from pamdp.policies import ACTIVATIONS, mlp
@@ -53,16 +63,11 @@ __all__ = ["PDQN", "PDQNConfig", "ParamActor", "QNetwork", "param_blocks"]
 
 
 @dataclasses.dataclass(frozen=True)
-class PDQNConfig(AlgoConfig):
+class PDQNConfig(OffPolicyConfig, AlgoConfig):
     """P-DQN's and MP-DQN's settings. The defaults are the ``paper`` preset: Bester et al.'s Platform settings,
     recalled from their paper rather than checked against its text (provisional); values it does not give are
     marked as assumptions in the help."""
 
-    num_envs: int = setting(
-        8,
-        "Copies of the env stepped together; learning per sample is set by updates_per_step, not by this.",
-        at_least(1),
-    )
     multi_pass: bool = setting(
         False, "MP-DQN: Q_k from a pass that sees only action k's parameters; false: P-DQN's joint input."
     )
@@ -79,11 +84,9 @@ class PDQNConfig(AlgoConfig):
     actor_lr: float = setting(
         1e-4, "Adam learning rate of the parameter actor (Bester et al. on Platform: 1e-4).", POSITIVE
     )
-    grad_clip: float = setting(
-        10.0, "Clip each network's gradient norm to this; 0 turns clipping off (assumed: 10).", NON_NEGATIVE
-    )
-    batch_size: int = setting(128, "Transitions per gradient update (Bester et al.: 128).", at_least(1))
-    gamma: float = setting(0.9, "Discount factor (Bester et al. on Platform: 0.9).", interval(0, 1))
+    grad_clip: float = shared_setting("grad_clip", 10.0, "assumed: 10")
+    batch_size: int = shared_setting("batch_size", 128, "Bester et al.: 128")
+    gamma: float = shared_setting("gamma", 0.9, "Bester et al. on Platform: 0.9")
     tau_q: float = setting(
         0.1, "Soft target-update rate of the Q-network (Bester et al.: 0.1).", interval(0, 1, low_open=True)
     )
@@ -120,16 +123,9 @@ class PDQNConfig(AlgoConfig):
         "Mean reversion of the Ornstein-Uhlenbeck noise; 1 gives i.i.d. Gaussian noise.",
         interval(0, 1, low_open=True),
     )
-    buffer_size: int = setting(10_000, "Replay capacity (Bester et al. on Platform: 10 000).", at_least(1))
+    buffer_size: int = shared_setting("buffer_size", 10_000, "Bester et al. on Platform: 10 000")
     learning_starts: int = setting(
         500, "Samples in the replay buffer before the first update (assumed: 500).", at_least(0)
-    )
-    updates_per_step: float = setting(
-        1.0, "Update-to-data ratio: gradient updates (Q-network and actor) per environment sample.", POSITIVE
-    )
-    epoch_steps: int = setting(10_000, "Samples per epoch, the unit of logging and checkpoints.", at_least(1))
-    save_replay: bool = setting(
-        False, "Store the replay contents in checkpoints; otherwise a resumed run refills the buffer."
     )
 
     @classmethod
@@ -137,9 +133,7 @@ class PDQNConfig(AlgoConfig):
         # "paper": Bester et al.'s text as recalled here (not re-read; never their code); grad_clip, learning_starts,
         # explore_params and the conversion of 1000 episodes to 5 000 samples are assumptions (see the help).
         # "tuned": the same learning rates and targets with a smaller Q-network and batch, 64 batched env copies
-        # and a quarter of an update per sample. Single-seed probes of two minutes on this machine's shared core
-        # (not a benchmark): MP-DQN trained returns 0.93 by 14k samples, greedy 1.0 at 42-48k (two seeds); P-DQN
-        # 0.96 by 20k, greedy 0.94 at 44k. The paper preset took 10k samples to 0.95 but 4x the updates.
+        # and a quarter of an update per sample (how it learns: benchmarks/later_platform.md).
         return {
             "paper": cls(),
             "tuned": cls(
@@ -230,7 +224,7 @@ class PDQN(Algorithm):
             params=((h.total_param_size,), np.float32),  # every action's, after exploration: what Q learns on
         )
         self.replay = ReplayBuffer(cfg.buffer_size, fields)
-        self.loop = OffPolicyLoop(h, self.replay, cfg.gamma, mc_returns=cfg.beta > 0, tail_value=self._target_value)
+        self.loop = OffPolicyLoop(cfg, h, self.replay, mc_returns=cfg.beta > 0, tail_value=self._target_value)
         self._ou = OUNoise(cfg.ou_theta, cfg.ou_sigma)
 
     def _modules(self):
@@ -285,18 +279,7 @@ class PDQN(Algorithm):
 
     # -- learning --------------------------------------------------------------------------------
     def _run_epoch(self) -> dict[str, float]:
-        cfg = self.config
-        stats = self.loop.run_epoch(
-            self.vec_env,
-            self._explore,
-            self._update,
-            cfg.epoch_steps,
-            self.num_timesteps,
-            cfg.learning_starts,
-            cfg.updates_per_step,
-            self.np_rng,
-            self.config.flush_denormal,
-        )
+        stats = self.loop.run_epoch(self.vec_env, self._explore, self._update, self.num_timesteps, self.np_rng)
         stats["train/epsilon"] = self.epsilon(self.num_timesteps + stats["steps"])
         return stats
 

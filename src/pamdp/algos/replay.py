@@ -1,4 +1,4 @@
-"""The replay buffer shared by the off-policy algorithms (PASVG(0), PADDPG).
+"""The replay buffer shared by the off-policy algorithms (PASVG(0), PADDPG, P-DQN, HyAR).
 
 One preallocated NumPy array per field, written as a ring: the newest transition overwrites the oldest once
 ``capacity`` is reached. Arrays are created with ``np.empty``, which reserves address space without

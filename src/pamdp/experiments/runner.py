@@ -17,7 +17,6 @@ import json
 import multiprocessing
 import os
 import sys
-import threading
 import time
 import traceback
 from pathlib import Path
@@ -31,8 +30,6 @@ __all__ = [
     "train_run",
     "is_finished",
     "run_all",
-    "group_jobs",
-    "train_stack",
     "algorithm_class",
     "ALGORITHMS",
     "DEFAULT_PRESET",
@@ -127,12 +124,9 @@ def _prepare(spec: RunSpec, out: str | os.PathLike, log=print) -> tuple[Any, dic
     return model, None
 
 
-def _train(
-    model, spec: RunSpec, out: str | os.PathLike, progress_bar: bool, log=print, trained=None, callback=None
-) -> dict:
+def _train(model, spec: RunSpec, out: str | os.PathLike, progress_bar: bool, log=print, callback=None) -> dict:
     """Train a prepared model to ``spec``'s budget, save its final model and evaluate it.
 
-    ``trained``: called once training is over, before saving and evaluating (a seed stack's ``leave``).
     ``callback``: ``learn``'s, called after every epoch (and its checkpoint).
     """
     from pamdp.algos.checkpoints import FINAL_MODEL, atomic_write_text
@@ -147,8 +141,6 @@ def _train(
         eval_every=spec.eval_every,
         callback=callback,
     )
-    if trained is not None:
-        trained()
     model.save(out / FINAL_MODEL, replay=False)  # for acting; checkpoint.pt keeps the buffer for resuming
     log(f"trained {model.num_timesteps:,} steps in {time.time() - start:.0f} s; model in {out / FINAL_MODEL}")
     if spec.eval_episodes <= 0:
@@ -167,89 +159,6 @@ def train_run(spec: RunSpec, out: str | os.PathLike, progress_bar: bool = True, 
     return done if model is None else _train(model, spec, out, progress_bar, log, callback=callback)
 
 
-def stack_key(spec: RunSpec):
-    """Runs with the same key can share a seed stack (:mod:`pamdp.algos.stacking`); ``None``: this one cannot."""
-    from pamdp.algos.stacking import can_stack
-
-    cls = algorithm_class(spec.algo)
-    if cls is None or not can_stack(cls):
-        return None
-    if hasattr(cls, "_stack_refusal") and cls._stack_refusal(spec.config()[2]):
-        return None
-    return json.dumps(dataclasses.asdict(dataclasses.replace(spec, seed=0)), sort_keys=True, default=repr)
-
-
-def train_stack(specs: list[RunSpec], outs: list[str | os.PathLike], logs: list) -> list[Any]:
-    """Train runs that differ in their seed only in one seed stack (each resumed or skipped as by
-    :func:`train_run`); returns each run's evaluation, or the exception it failed with.
-
-    Runs the stack cannot take together (resumed at Adam steps it cannot align, see
-    :func:`pamdp.algos.stacking.step_class`) go in separate stacks, trained side by side in threads.
-    """
-    from pamdp.algos.stacking import SeedStack
-
-    results: list[Any] = [None] * len(specs)
-    models = {}
-    for i, (spec, out, log) in enumerate(zip(specs, outs, logs)):
-        try:
-            model, done = _prepare(spec, out, log)
-        except Exception as exc:  # noqa: BLE001 - this run fails, the others go on
-            results[i] = exc
-            continue
-        if model is None:
-            results[i] = done
-        else:
-            models[i] = model
-    if not models:
-        return results
-    # Runs resumed at different Adam steps cannot share a stack: each class of them gets one, all of them
-    # trained side by side in this process's threads.
-    from pamdp.algos.stacking import adam_step, step_class
-
-    classes: dict[int, list[int]] = {}
-    for i, model in models.items():
-        classes.setdefault(step_class(model), []).append(i)
-    training = set(models)  # the runs whose training is not over; set.discard is atomic and idempotent
-
-    def share() -> float:  # the process's CPU time goes to the runs still training in it
-        return float(max(len(training), 1))
-
-    def job(i):
-        def train(leave):
-            def trained():
-                training.discard(i)
-                leave()
-
-            try:
-                return _train(models[i], specs[i], outs[i], False, logs[i], trained=trained)
-            finally:
-                training.discard(i)
-
-        return train
-
-    def run_class(order: list[int]) -> None:
-        seeds = [specs[j].seed for j in order]
-        for i in order:
-            models[i]._cpu_share = share
-            if len(order) > 1:
-                logs[i](f"stacked with seeds {seeds}; {len(models)} runs in this process")
-            else:
-                logs[i](f"in a stack of its own (Adam step {adam_step(models[i])}); {len(models)} runs in this process")
-        try:
-            for i, outcome in zip(order, SeedStack([models[i] for i in order]).run([job(i) for i in order])):
-                results[i] = outcome
-        except Exception as exc:  # noqa: BLE001 - the stack itself failed: so did each of its runs
-            for i in order:
-                results[i] = exc
-
-    threads = [threading.Thread(target=run_class, args=(order,)) for order in classes.values()]
-    for t in threads:
-        t.start()
-    for t in threads:
-        t.join()
-    return results
-
-
 def _worker(spec: RunSpec, out: str, callback=None) -> dict:
     import torch
 
@@ -265,31 +174,6 @@ def _worker(spec: RunSpec, out: str, callback=None) -> dict:
         )
 
 
-def _stack_worker(specs: list[RunSpec], outs: list[str]) -> list[Any]:
-    """A process training a seed stack; a failed run's exception comes back as its traceback's text."""
-    import contextlib
-
-    import torch
-
-    from pamdp._memory import keep_freed_memory
-
-    keep_freed_memory()
-    torch.set_num_threads(1)
-    with contextlib.ExitStack() as files:
-        logs = []
-        for out in outs:
-            Path(out).mkdir(parents=True, exist_ok=True)
-            f = files.enter_context(open(Path(out) / "stdout.log", "a"))
-            logs.append(lambda msg, f=f: print(msg, file=f, flush=True))
-        results = train_stack(specs, outs, logs)
-    return [_Failed("".join(traceback.format_exception(r))) if isinstance(r, BaseException) else r for r in results]
-
-
-@dataclasses.dataclass
-class _Failed:
-    error: str
-
-
 @dataclasses.dataclass
 class RunOutcome:
     spec: RunSpec
@@ -299,99 +183,35 @@ class RunOutcome:
     seconds: float
 
 
-def group_jobs(jobs: list[tuple[RunSpec, str]], stack: int) -> list[list[tuple[RunSpec, str]]]:
-    """``jobs`` in groups of at most ``stack`` runs that can share a seed stack (a group of one runs alone).
-
-    The runs of a setting are split as evenly as ``stack`` allows: 5 seeds with ``stack = 3`` give 3 + 2.
-    """
-    if stack < 1:
-        raise ValueError(f"stack = {stack!r}; expected an integer >= 1")
-    by_key: dict[Any, list[tuple[RunSpec, str]]] = {}
-    slots: list[Any] = []  # a lone job, or the key of a setting's stackable jobs, in the order jobs come
-    for job in jobs:
-        key = stack_key(job[0]) if stack > 1 else None
-        if key is None:
-            slots.append([job])
-        else:
-            if key not in by_key:
-                slots.append(key)
-            by_key.setdefault(key, []).append(job)
-    groups: list[list[tuple[RunSpec, str]]] = []
-    for slot in slots:
-        if isinstance(slot, list):
-            groups.append(slot)
-            continue
-        members = by_key[slot]
-        n = -(-len(members) // stack)  # groups needed
-        size, extra = divmod(len(members), n)
-        start = 0
-        for g in range(n):
-            end = start + size + (g < extra)
-            groups.append(members[start:end])
-            start = end
-    return groups
-
-
-def run_all(jobs: list[tuple[RunSpec, str]], workers: int = 1, log=print, stack: int = 1) -> list[RunOutcome]:
-    """Run ``(spec, out_dir)`` jobs, ``workers`` at a time in separate processes (1: in this process).
-
-    ``stack``: seeds of one setting trained together in one process, for the algorithms that support it
-    (:mod:`pamdp.algos.stacking`); a worker then runs a stack of up to ``stack`` runs.
-    """
+def run_all(jobs: list[tuple[RunSpec, str]], workers: int = 1, log=print) -> list[RunOutcome]:
+    """Run ``(spec, out_dir)`` jobs, ``workers`` at a time in separate processes (1: in this process)."""
     outcomes: list[RunOutcome] = []
-    groups = group_jobs(jobs, stack)
-
-    def outcomes_of(group, results, t0) -> list[RunOutcome]:
-        done = []
-        for (spec, out), r in zip(group, results):
-            if isinstance(r, _Failed):
-                done.append(RunOutcome(spec, out, None, r.error, time.time() - t0))
-            else:
-                done.append(RunOutcome(spec, out, r, None, time.time() - t0))
-        return done
-
     if workers <= 1:
-        for group in groups:
+        for spec, out in jobs:
             t0 = time.time()
-            if len(group) > 1:
-                specs, outs = [s for s, _ in group], [o for _, o in group]
-                try:
-                    new = outcomes_of(group, _stack_worker(specs, outs), t0)
-                except Exception:
-                    error = traceback.format_exc()
-                    new = [RunOutcome(spec, out, None, error, time.time() - t0) for spec, out in group]
-            else:
-                spec, out = group[0]
-                try:
-                    new = [RunOutcome(spec, out, _worker(spec, out), None, time.time() - t0)]
-                except Exception:
-                    new = [RunOutcome(spec, out, None, traceback.format_exc(), time.time() - t0)]
-            for o in new:
-                outcomes.append(o)
-                log(_describe(o))
+            try:
+                o = RunOutcome(spec, out, _worker(spec, out), None, time.time() - t0)
+            except Exception:
+                o = RunOutcome(spec, out, None, traceback.format_exc(), time.time() - t0)
+            outcomes.append(o)
+            log(_describe(o))
         return outcomes
     ctx = multiprocessing.get_context("spawn")
 
-    def run_group(group) -> list[RunOutcome]:
-        # A process pool of its own per group: a worker that dies (killed, out of memory) breaks only its own
-        # pool, so it fails its own runs alone while the runs beside it go on.
+    def run_job(spec: RunSpec, out: str) -> RunOutcome:
+        # A process pool of its own per run: a worker that dies (killed, out of memory) breaks only its own
+        # pool, so it fails its own run alone while the runs beside it go on.
         t0 = time.time()
         try:
             with cf.ProcessPoolExecutor(max_workers=1, mp_context=ctx) as pool:
-                if len(group) > 1:
-                    specs, outs = [s for s, _ in group], [o for _, o in group]
-                    return outcomes_of(group, pool.submit(_stack_worker, specs, outs).result(), t0)
-                spec, out = group[0]
-                return [RunOutcome(spec, out, pool.submit(_worker, spec, out).result(), None, time.time() - t0)]
+                return RunOutcome(spec, out, pool.submit(_worker, spec, out).result(), None, time.time() - t0)
         except Exception as exc:
-            error = "".join(traceback.format_exception(exc))
-            return [RunOutcome(spec, out, None, error, time.time() - t0) for spec, out in group]
+            return RunOutcome(spec, out, None, "".join(traceback.format_exception(exc)), time.time() - t0)
 
     with cf.ThreadPoolExecutor(max_workers=workers) as threads:
-        for fut in cf.as_completed([threads.submit(run_group, group) for group in groups]):
-            for o in fut.result():
-                outcomes.append(o)
-                log(_describe(o))
+        for fut in cf.as_completed([threads.submit(run_job, spec, out) for spec, out in jobs]):
+            outcomes.append(fut.result())
+            log(_describe(outcomes[-1]))
     return outcomes
 
 

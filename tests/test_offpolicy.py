@@ -1,0 +1,37 @@
+"""The off-policy family module: the shared settings keep each algorithm's names, defaults and presets."""
+
+import dataclasses
+import json
+from pathlib import Path
+
+import pytest
+
+from pamdp.algos.hyar import HyARConfig
+from pamdp.algos.offpolicy import OffPolicyConfig
+from pamdp.algos.paddpg import PADDPGConfig
+from pamdp.algos.pasvg import PASVG0Config
+from pamdp.algos.pdqn import PDQNConfig
+
+CONFIGS = [PASVG0Config, PADDPGConfig, PDQNConfig, HyARConfig]
+# Every preset's settings (and the defaults), in their order, as written out by the code before OffPolicyConfig existed
+# (commit 763e0d8), so that checkpoints and config files of earlier runs mean what they meant.
+RECORDED = json.loads((Path(__file__).parent / "data" / "offpolicy_presets.json").read_text())
+
+
+@pytest.mark.parametrize("config_class", CONFIGS, ids=lambda c: c.__name__)
+def test_presets_and_defaults_are_the_recorded_ones(config_class):
+    now = {name: cfg.to_dict() for name, cfg in config_class.presets().items()}
+    now["(defaults)"] = config_class().to_dict()
+    assert now == RECORDED[config_class.__name__]
+    assert list(now) == list(RECORDED[config_class.__name__])  # the first preset is the default
+    for values in RECORDED[config_class.__name__].values():  # a recorded dict loads back as the same config
+        assert config_class.from_dict(values).to_dict() == values
+
+
+@pytest.mark.parametrize("config_class", CONFIGS, ids=lambda c: c.__name__)
+def test_a_shared_setting_declared_again_keeps_its_check(config_class):
+    shared = {f.name for f in dataclasses.fields(OffPolicyConfig)}
+    for name, bad in (("batch_size", 0), ("gamma", 1.5), ("buffer_size", 0), ("updates_per_step", 0.0)):
+        assert name in shared
+        with pytest.raises(ValueError, match=f"{config_class.__name__}.{name} = {bad!r}; expected"):
+            config_class(**{name: bad})
