@@ -1,6 +1,6 @@
 """``flush_denormal``: every algorithm's gradient updates flush subnormal floats to zero (they are many times
 slower in x86 arithmetic, and Adam's decaying moments reach them); the env steps never do, since the Half
-Field Offense simulation needs IEEE subnormals (``hfo_features._directions``)."""
+Field Offense simulation needs IEEE subnormals (``pamdp.envs.hfo.dynamics.direction_of``)."""
 
 import dataclasses
 
