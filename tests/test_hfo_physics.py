@@ -195,3 +195,11 @@ def test_stamina_model_drains_effort_after_long_dashing():
 def test_fullstate_rounding_keeps_six_significant_digits():
     for x in (12.3456789, -0.000123456789, 7999.99951, 0.0, 1e-250):
         assert dyn.fullstate_value(x) == float(f"{x:.6g}") or x == 1e-250
+
+
+@pytest.mark.parametrize("scale", [1.0, 1e-170, 1e-310])
+def test_velocity_direction_survives_underflow(scale):
+    # a held player's velocity decays by 0.4 a cycle for hundreds of cycles: its square underflows long before it
+    ux, uy, speed = dyn.direction_of(3.0 * scale, -4.0 * scale)
+    assert (ux, uy) == pytest.approx((0.6, -0.8), rel=1e-6) and speed == pytest.approx(5.0 * scale, rel=1e-6)
+    assert dyn.direction_of(0.0, 0.0) == (1.0, 0.0, 0.0)  # heading 0 at rest
