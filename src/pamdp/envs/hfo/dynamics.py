@@ -201,9 +201,9 @@ def round_command(value):
 
 # --- One copy's random stream ---------------------------------------------------------------
 # xoshiro256++ (Blackman & Vigna, https://prng.di.unimi.it/xoshiro256plusplus.c): four uint64 words per
-# copy, advanced in place. Drawing from N buffers refilled from N NumPy generators cost a third of the
-# batched step at N = 1024 (the refills in Python, the reads scattered over N rows); these 32 bytes per
-# copy sit beside its state. Each copy's words are seeded from its own generator (``seed_stream``).
+# copy, advanced in place, instead of buffers refilled from N NumPy generators in Python and read scattered
+# over N rows, which slowed the batched step (``benchmarks/hfo_speed.md``, notes). Each copy's words are
+# seeded from its own generator (``seed_stream``).
 @jit
 def _rotl(x, k):
     return (x << np.uint64(k)) | (x >> np.uint64(64 - k))
