@@ -19,6 +19,7 @@ import time
 import traceback
 from pathlib import Path
 
+from pamdp.algos.checkpoints import _atomic_write
 from pamdp.experiments.runner import RunOutcome, RunSpec, _describe, _worker
 
 __all__ = ["run_all_ray", "RETRIES"]
@@ -52,11 +53,8 @@ def _pack(directory: Path) -> dict[str, bytes]:
 
 def _write(target: Path, offset: int, data: bytes) -> None:
     """Put ``data`` at ``offset`` of ``target``: a whole new file (atomically) at 0, an appended tail past it."""
-    target.parent.mkdir(parents=True, exist_ok=True)
     if offset == 0:
-        tmp = target.with_name(f".{target.name}.tmp")
-        tmp.write_bytes(data)
-        tmp.replace(target)
+        _atomic_write(target, lambda f: f.write(data), target.name)
         return
     size = target.stat().st_size if target.exists() else 0
     if size < offset:
