@@ -27,7 +27,7 @@ from pamdp.algos.onpolicy import advantage_batch, update_tensors
 from pamdp.algos.patrpo import PATRPO, PATRPOConfig
 
 sys.path.insert(0, str(Path(__file__).parent))
-from _record import machine  # noqa: E402
+from _record import machine, write_record  # noqa: E402
 
 # (label, env id, settings on top of the paper preset): the platform and soccer experiments' PATRPO arms
 CASES = [
@@ -100,7 +100,7 @@ def main(argv=None) -> None:
         print(rows[-1], flush=True)
     args_text = " ".join(argv if argv is not None else sys.argv[1:])
     command = f"taskset -c 0 python benchmarks/bench_fvp_speed.py {args_text}"
-    text = "\n".join(
+    write_record(
         [
             "# PATRPO's Fisher-vector products: Gauss-Newton vs double back-propagation",
             "",
@@ -118,12 +118,9 @@ def main(argv=None) -> None:
             "An update is `_update_policy`: the surrogate's gradient, the product's set-up, the conjugate-gradient"
             " products, the line search and the statistics. The parameter gap is the largest difference between"
             " the two methods' updated parameters, over the largest step component (float32 rounding).",
-            "",
-        ]
+        ],
+        args.out,
     )
-    if args.out:
-        Path(args.out).write_text(text)
-    print(text)
 
 
 if __name__ == "__main__":
