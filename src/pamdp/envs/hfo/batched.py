@@ -56,12 +56,7 @@ class HalfFieldOffenseVectorEnv(BatchedVectorEnv):
         self._seeded = np.array([s is not None for s in copy_seeds(seed, self.num_envs)])
         return super().reset(seed=seed, options=options)
 
-    @property
-    def np_randoms(self) -> tuple:
-        """Each copy's generator; assign a sequence of ``num_envs`` of them to replace them all."""
-        return self.streams.generators
-
-    @np_randoms.setter
+    @BatchedVectorEnv.np_randoms.setter
     def np_randoms(self, generators) -> None:
         BatchedVectorEnv.np_randoms.fset(self, generators)
         self._follow_generators()
