@@ -76,7 +76,7 @@ def _rows(path: Path) -> list[dict]:
         return list(csv.DictReader(f))
 
 
-STEPS, EPOCH_STEPS = 1600, 200
+STEPS, EPOCH_STEPS = 1200, 200
 
 NODE_LOSS = textwrap.dedent(
     f"""
