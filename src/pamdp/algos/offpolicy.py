@@ -64,9 +64,12 @@ class OffPolicyConfig:
 
     An algorithm's config inherits it beside :class:`~pamdp.algos.settings.AlgoConfig`, which brings the checks
     and the settings of every algorithm (``class PADDPGConfig(OffPolicyConfig, AlgoConfig)``): each base is one
-    level up, and this one holds fields only. An algorithm whose paper gives another default declares the
-    setting again with :func:`shared_setting`, which keeps the help and the check written here. Each config also
-    declares ``learning_starts``, the samples in the replay before the first update (HyAR's is its warm-up).
+    level up, where a chain (``OffPolicyConfig(AlgoConfig)``) would put the algorithm two levels below
+    ``AlgoConfig``, and a nested settings object would change the flat names that config files, the command
+    line and checkpoints use. This base holds fields only. An algorithm whose paper gives another default
+    declares the setting again with :func:`shared_setting`, which keeps the help and the check written here.
+    Each config also declares ``learning_starts``, the samples in the replay before the first update (HyAR's is
+    its warm-up).
     """
 
     num_envs: int = setting(
