@@ -42,7 +42,7 @@ def test_train_writes_run_directory_and_evaluation(tmp_path, capsys):
     assert len(rows(out)) == 3
     # Other settings in the same directory are refused, naming what differs.
     assert main(["train", "patrpo", "--total-steps", "1500", "--out", str(out), "--delta", "0.5", *TINY]) == 2
-    assert "other config" in capsys.readouterr().err
+    assert "other settings (delta: 0.02 in the run, 0.5 asked)" in capsys.readouterr().err
 
 
 def test_config_file_and_flags(tmp_path):

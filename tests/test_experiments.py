@@ -106,15 +106,21 @@ def test_a_failing_run_is_reported_and_the_others_finish(tmp_path, capsys):
 [[runs]]
 label = "broken"
 algo = "patrpo"
-env = "pamdp/NoSuchEnv-v0"
+env = "pamdp/HalfFieldOffense-v0"
+env_kwargs = {{ profile = "no_such_profile" }}   # of the right type: refused by the env as the run starts
 {TINY_SETTINGS}
 """
     exp = write_experiment(tmp_path / "mixed.toml", broken)
     out = tmp_path / "results"
     assert main(["reproduce", str(exp), "--out", str(out), "--seeds", "0"]) == 1
     err = capsys.readouterr().err
-    assert "FAILED" in err and "NoSuchEnv" in err and "1 of 2 runs failed" in err
+    assert "FAILED" in err and "no_such_profile" in err and "1 of 2 runs failed" in err
     assert (out / "mixed" / "small_delta" / "seed0" / "evaluation.json").exists()
+    # An env that is not registered is refused before any run starts.
+    exp.write_text(exp.read_text().replace('env = "pamdp/HalfFieldOffense-v0"', 'env = "pamdp/NoSuchEnv-v0"'))
+    assert main(["reproduce", str(exp), "--out", str(tmp_path / "other"), "--seeds", "0"]) == 2
+    assert "env 'pamdp/NoSuchEnv-v0' is not registered" in capsys.readouterr().err
+    assert not (tmp_path / "other").exists()
 
 
 def test_resume_after_a_killed_worker(tmp_path):
@@ -153,7 +159,8 @@ def test_status_estimates_the_training_left_from_each_runs_own_pace():
     from pamdp.experiments.status import RunStatus, format_status, remaining_seconds
 
     def run(label, seed, state, steps, seconds):
-        return RunStatus(label, seed, "", state, steps, 1000, seconds, None, None, None, None)
+        pace = seconds / steps if steps else None
+        return RunStatus(label, seed, "", state, steps, 1000, seconds, None, None, None, None, pace)
 
     statuses = [
         run("a", 0, "done", 1000, 100.0),  # 0.1 s a sample; finished, nothing left
@@ -346,3 +353,24 @@ def test_curves_are_drawn_over_epochs_as_the_paper_unless_epoch_sizes_differ(tmp
     assert "training epochs" in svg
     svg = write_report([tmp_path / "a", tmp_path / "b"], tmp_path / "fig", x="samples")["svg"].read_text()
     assert "environment samples" in svg
+
+
+def test_status_paces_an_off_policy_run_by_its_epochs_after_warm_up(tmp_path):
+    """Epochs filling the replay buffer (no updates) take a second where the rest take a minute: they are no pace."""
+    from pamdp.experiments.status import remaining_seconds, run_status
+
+    exp = load_experiment(write_experiment(tmp_path / "tiny.toml"))
+    spec = dataclasses.replace(exp.specs(None, 1.0, None)[0], total_steps=100_000)
+    out = tmp_path / "run"
+    out.mkdir()
+    rows = ["time/total_timesteps,time/epoch_cpu_seconds,train/updates"]
+    rows += [f"{10_000 * (i + 1)},1.0,0" for i in range(3)]  # warm-up
+    rows += ["40000,30.0,5000"]  # warm-up ends mid-epoch: half the updates of a full epoch
+    rows += [f"{10_000 * (i + 5)},60.0,10000" for i in range(2)]
+    (out / "progress.csv").write_text("\n".join(rows) + "\n")
+    status = run_status(spec, out)
+    assert status.seconds_per_step == pytest.approx(60.0 / 10_000)  # not (3 + 30 + 120) / 60 000
+    assert remaining_seconds([status])[0] == pytest.approx(40_000 * 60.0 / 10_000)
+    (out / "progress.csv").write_text("\n".join(rows[:4]) + "\n")  # warm-up only: no pace to go by yet
+    assert run_status(spec, out).seconds_per_step is None
+    assert remaining_seconds([run_status(spec, out)])[1] == {"small delta": 1}

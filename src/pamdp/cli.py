@@ -14,13 +14,81 @@ import argparse
 import dataclasses
 import datetime as dt
 import json
+import math
 import sys
+import types
 import typing
 from pathlib import Path
 
 from pamdp import __version__
 from pamdp._memory import keep_freed_memory
-from pamdp.experiments.runner import ALGORITHMS, RunSpec, algorithm_class, default_preset, train_run
+from pamdp.experiments.runner import ALGORITHMS, RunSpec, algorithm_class, default_preset, env_creator, train_run
+
+MAX_STEPS = 10**12  # a budget beyond this is a typing slip (10^12 steps take decades on one core)
+MAX_SEED = 2**32 - 1
+
+
+class _Parser(argparse.ArgumentParser):
+    """Options spelled out in full (``--delt`` is no ``--delta``), and a refusal in one line naming the value."""
+
+    def __init__(self, *args, **kwargs):
+        kwargs.setdefault("allow_abbrev", False)
+        super().__init__(*args, **kwargs)
+
+    def error(self, message):
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+    def parse_args(self, args=None, namespace=None):
+        """As argparse's, but an unknown option is refused by the command it was given to, not by ``pamdp``."""
+        parsed, extra = self.parse_known_args(args, namespace)
+        if extra:
+            prog = " ".join(filter(None, (self.prog, getattr(parsed, "command", None))))
+            self.exit(2, f"{prog}: error: unrecognized arguments: {' '.join(extra)} (see {prog} --help)\n")
+        return parsed
+
+
+def _items(text: str) -> list[str]:
+    """The items of a comma-separated list; an empty one (``64,,32``, ``64,``) is a slip, not a separator."""
+    items = [t.strip() for t in text.split(",")]
+    if any(not t for t in items):
+        raise argparse.ArgumentTypeError(f"{text!r} has an empty item; expected comma-separated values such as 64,64")
+    return items
+
+
+def _whole(text: str) -> int | None:
+    """``text`` as an integer, also written as an integral float (``1e6``) or with underscores; else ``None``."""
+    try:
+        return int(text)
+    except ValueError:
+        pass
+    try:
+        value = float(text)
+    except ValueError:
+        return None
+    return int(value) if math.isfinite(value) and value == int(value) else None
+
+
+def _integer(low: int, high: int | None = None, what: str = "an integer"):
+    """An argparse type: an integer from ``low`` to ``high`` (``1e6`` accepted)."""
+    expected = f"{what} >= {low:,}" if high is None else f"{what} from {low:,} to {high:,}"
+
+    def parse(text: str) -> int:
+        value = _whole(text)
+        if value is None or value < low or (high is not None and value > high):
+            raise argparse.ArgumentTypeError(f"{text!r}; expected {expected}")
+        return value
+
+    return parse
+
+
+def _positive_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"{text!r}; expected a positive finite number such as 0.1")
+    return value
 
 
 def _parse_value(text: str, hint):
@@ -28,8 +96,8 @@ def _parse_value(text: str, hint):
     origin = typing.get_origin(hint)
     if origin is tuple:
         (item,) = {a for a in typing.get_args(hint) if a is not Ellipsis}
-        return [_parse_value(t, item) for t in text.split(",") if t.strip()]
-    if origin in (typing.Union, __import__("types").UnionType):
+        return [_parse_value(t, item) for t in _items(text)]
+    if origin in (typing.Union, types.UnionType):
         if text.lower() == "none":
             return None
         hint = next(t for t in typing.get_args(hint) if t is not type(None))
@@ -39,29 +107,29 @@ def _parse_value(text: str, hint):
         if text.lower() in ("0", "false", "no", "off"):
             return False
         raise argparse.ArgumentTypeError(f"{text!r} is not a boolean; expected true or false")
+    if hint is int:
+        value = _whole(text)
+        if value is None:
+            raise argparse.ArgumentTypeError(f"{text!r} is not a valid int; expected an integer such as 64")
+        return value
     try:
         return hint(text)
     except ValueError as exc:
         raise argparse.ArgumentTypeError(f"{text!r} is not a valid {hint.__name__}") from exc
 
 
-def _positive_int(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        value = 0
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"{text!r}; expected an integer >= 1")
-    return value
+_positive_int = _integer(1)
+_count = _integer(0)
+_seed = _integer(0, MAX_SEED, "a seed")
 
 
 def _seed_list(text: str) -> list[int]:
-    try:
-        seeds = [int(s) for s in text.split(",")]
-    except ValueError:
-        seeds = [-1]
-    if any(s < 0 for s in seeds):
+    seeds = [_whole(s) for s in text.split(",")]
+    if any(s is None or not 0 <= s <= MAX_SEED for s in seeds):
         raise argparse.ArgumentTypeError(f"{text!r}; expected comma-separated seeds >= 0, such as 0,1,2")
+    twice = sorted({s for s in seeds if seeds.count(s) > 1})
+    if twice:  # two runs of one seed would write one run directory
+        raise argparse.ArgumentTypeError(f"{text!r} names seed {twice[0]} twice; expected each seed once")
     return seeds
 
 
@@ -113,7 +181,7 @@ def _read_config_file(path: str) -> dict:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="pamdp", description="Reinforcement learning in parameterized action spaces.")
+    parser = _Parser(prog="pamdp", description="Reinforcement learning in parameterized action spaces.")
     parser.add_argument("--version", action="version", version=f"pamdp {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
 
@@ -126,12 +194,12 @@ def build_parser() -> argparse.ArgumentParser:
         p = algos.add_parser(name, help=ALGORITHMS[name].help)
         p.add_argument("--env", default="pamdp/Platform-v0", help="registered env id (default: %(default)s)")
         p.add_argument("--env-kwargs", type=_json_object, default=None, help="JSON object of env constructor arguments")
-        p.add_argument("--seed", type=int, default=None, help="random seed (default: the config file's, else 0)")
+        p.add_argument("--seed", type=_seed, default=None, help="random seed (default: the config file's, else 0)")
         p.add_argument(
             "--total-steps",
-            type=int,
+            type=_integer(1, MAX_STEPS, "a number of steps"),
             default=None,
-            help=f"environment steps (default: {ALGORITHMS[name].total_steps:,})",
+            help=f"environment steps, 1e6 or 1000000 (default: {ALGORITHMS[name].total_steps:,})",
         )
         p.add_argument(
             "--out", default=None, help="run directory (default: runs/ALGO-ENV-seedN-TIME); reuse it to resume"
@@ -144,11 +212,11 @@ def build_parser() -> argparse.ArgumentParser:
         )
         p.add_argument("--config", default=None, help="TOML or JSON file of settings")
         p.add_argument(
-            "--eval-episodes", type=int, default=1000, help="greedy evaluation episodes at the end (0: none)"
+            "--eval-episodes", type=_count, default=1000, help="greedy evaluation episodes at the end (0: none)"
         )
         p.add_argument(
             "--eval-every",
-            type=int,
+            type=_count,
             default=0,
             help="epochs between greedy evaluations of 100 episodes during training, logged as eval/* (0: none)",
         )
@@ -157,16 +225,22 @@ def build_parser() -> argparse.ArgumentParser:
 
     ev = sub.add_parser("evaluate", help="evaluate a trained model (a run directory or a model file)")
     ev.add_argument("model", help="run directory written by `pamdp train`, or a saved model file")
-    ev.add_argument("--episodes", type=int, default=1000, help="episodes to play (default: %(default)s)")
-    ev.add_argument("--seed", type=int, default=None, help="env seed (default: 10000 + the training seed, as train's)")
+    ev.add_argument("--episodes", type=_positive_int, default=1000, help="episodes to play (default: %(default)s)")
+    ev.add_argument(
+        "--seed", type=_seed, default=None, help="env seed (default: 10000 + the training seed, as train's)"
+    )
     ev.add_argument("--stochastic", action="store_true", help="sample actions instead of the greedy ones")
     ev.add_argument("--json", action="store_true", help="print one JSON object")
 
     rp = sub.add_parser("reproduce", help="run one of the paper's experiments (all settings and seeds) and plot it")
     rp.add_argument("name", help="platform, step-size, kl-estimators, soccer, or an experiment TOML file")
     rp.add_argument("--seeds", type=_seed_list, default=None, help="comma-separated seeds (default: the experiment's)")
-    rp.add_argument("--runs", default=None, help="comma-separated run labels to run (default: all), e.g. --runs PATRPO")
-    rp.add_argument("--scale", type=float, default=1.0, help="multiply the step budget, e.g. 0.1 for a quick look")
+    rp.add_argument(
+        "--runs", type=_items, default=None, help="comma-separated run labels to run (default: all), e.g. --runs PATRPO"
+    )
+    rp.add_argument(
+        "--scale", type=_positive_float, default=1.0, help="multiply the step budget, e.g. 0.1 for a quick look"
+    )
     rp.add_argument(
         "--workers", type=_positive_int, default=1, help="runs side by side in processes (one torch thread each)"
     )
@@ -194,7 +268,7 @@ def build_parser() -> argparse.ArgumentParser:
     rd = sub.add_parser("render", help="write one episode to a GIF (a trained model, or random actions in an env)")
     rd.add_argument("source", help="run directory, model file, or a registered env id (random actions)")
     rd.add_argument("--out", default="episode.gif", help="GIF path (default: %(default)s)")
-    rd.add_argument("--seed", type=int, default=0, help="env seed (default: %(default)s)")
+    rd.add_argument("--seed", type=_seed, default=0, help="env seed (default: %(default)s)")
     return parser
 
 
@@ -205,17 +279,11 @@ def _train_spec(args, cls) -> RunSpec:
     file_values = _read_config_file(args.config) if args.config else {}
     file_preset = file_values.pop("preset", None)
     preset = args.preset or file_preset
-    seed = args.seed if args.seed is not None else int(file_values.pop("seed", 0))
+    seed = args.seed if args.seed is not None else file_values.pop("seed", 0)  # the config checks its type
     file_values.pop("seed", None)
     flags = {k[4:]: v for k, v in vars(args).items() if k.startswith("cfg_") and v is not None}
     total = args.total_steps if args.total_steps is not None else ALGORITHMS[args.algo].total_steps
-    if total < 0:
-        raise ValueError(f"--total-steps {total}; expected a non-negative number of steps")
-    if args.eval_every < 0:
-        raise ValueError(f"--eval-every {args.eval_every}; expected a non-negative number of epochs (0: none)")
     settings = {**file_values, **flags}
-    if args.env_kwargs is not None and not isinstance(args.env_kwargs, dict):
-        raise ValueError(f"--env-kwargs {args.env_kwargs!r}; expected a JSON object")
     env_kwargs = tuple(sorted((args.env_kwargs or {}).items()))
     return RunSpec(
         args.algo,
@@ -234,13 +302,20 @@ def _train_spec(args, cls) -> RunSpec:
 def cmd_train(args) -> int:
     cls = algorithm_class(args.algo)
     spec = _train_spec(args, cls)
-    spec.config()  # validate the settings before creating any directory
+    spec.check()  # the settings and the env's arguments, before any directory is created
     stamp = dt.datetime.now().strftime("%Y%m%d-%H%M%S")
     out = Path(args.out or f"runs/{args.algo}-{args.env.split('/')[-1]}-seed{spec.seed}-{stamp}")
     try:
         result = train_run(spec, out, progress_bar=not args.no_progress, log=lambda m: print(m, file=sys.stderr))
     except KeyboardInterrupt:
-        print(f"\ninterrupted; the last checkpoint is in {out}: run the same command to resume", file=sys.stderr)
+        from pamdp.algos.checkpoints import CHECKPOINT
+
+        if (out / CHECKPOINT).exists():
+            print(f"\ninterrupted; the last checkpoint is in {out}: run the same command to resume", file=sys.stderr)
+        else:
+            print(
+                "\ninterrupted before the first checkpoint; nothing to resume: run it again to start", file=sys.stderr
+            )
         return 130
     if result:
         print(_format_evaluation(result))
@@ -254,10 +329,10 @@ def cmd_reproduce(args) -> int:
 
     exp = load_experiment(args.name)
     seeds = args.seeds
-    labels = [label.strip() for label in args.runs.split(",")] if args.runs is not None else None
+    labels = args.runs
     jobs = [(spec, str(exp.run_dir(args.out, spec))) for spec in exp.specs(seeds, args.scale, labels)]
     for spec, _ in jobs:
-        spec.config()  # every setting is checked before the first run starts
+        spec.check()  # every setting and env argument is checked before the first run starts
     if args.status:
         from pamdp.experiments.status import format_status, run_status
 
@@ -295,9 +370,10 @@ def _print_report(report: dict) -> None:
 
 
 # -- evaluate, render ----------------------------------------------------------------------------
-def _format_evaluation(result: dict) -> str:
+def _format_evaluation(result: dict, policy: str = "greedy") -> str:
+    """One line: ``policy`` (greedy, or stochastic) return, length, and on HFO the goal rate."""
     text = (
-        f"greedy return over {result['episodes']} episodes: {result['mean_return']:.4f} +- {result['std_return']:.4f}"
+        f"{policy} return over {result['episodes']} episodes: {result['mean_return']:.4f} +- {result['std_return']:.4f}"
     )
     text += f" (mean length {result['mean_length']:.1f} steps)"
     if "goal_rate" in result:
@@ -312,8 +388,9 @@ def cmd_evaluate(args) -> int:
 
     model = load_model(args.model)
     seed = args.seed if args.seed is not None else 10_000 + model.config.seed
+    policy = "stochastic" if args.stochastic else "greedy"
     result = evaluate(model, episodes=args.episodes, seed=seed, deterministic=not args.stochastic)
-    print(json.dumps(result) if args.json else _format_evaluation(result))
+    print(json.dumps({**result, "policy": policy}) if args.json else _format_evaluation(result, policy))
     return 0
 
 
@@ -325,11 +402,14 @@ def cmd_render(args) -> int:
     from pamdp.envs.rendering import record_episode
 
     if args.source in gymnasium.registry:
-        env, policy = gymnasium.make(args.source, render_mode="rgb_array"), None
+        env_id, env_kwargs, policy = args.source, {}, None
     else:
         model = load_model(args.source)
-        env = gymnasium.make(model.env_id, render_mode="rgb_array", **model.env_kwargs)
-        policy = model.predict
+        env_id, env_kwargs, policy = model.env_id, model.env_kwargs, model.predict
+    modes = getattr(env_creator(env_id), "metadata", {}).get("render_modes", [])
+    if "rgb_array" not in modes:
+        raise ValueError(f"env {env_id!r} draws no frames (render modes {modes}); expected one with 'rgb_array'")
+    env = gymnasium.make(env_id, render_mode="rgb_array", **env_kwargs)
     path, total = record_episode(env, policy, args.out, seed=args.seed)
     print(f"wrote {path} (return {total:.4f})")
     return 0
@@ -348,8 +428,15 @@ def main(argv: list[str] | None = None) -> int:
     }
     try:
         return handlers[args.command](args)
-    except (ValueError, FileNotFoundError) as exc:
+    except ValueError as exc:
         print(f"pamdp {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+    except OSError as exc:  # a missing file, a read-only or full disk: the path and the system's reason
+        if exc.filename is None:
+            message = str(exc)
+        else:
+            message = f"{exc.filename}: {exc.strerror or exc}; expected a readable file or a writable directory"
+        print(f"pamdp {args.command}: error: {message}", file=sys.stderr)
         return 2
 
 

@@ -10,6 +10,7 @@ observations) and ``_modules``/``_optimizers`` (what a checkpoint holds). Its se
 
 from __future__ import annotations
 
+import math
 import os
 import time
 from collections.abc import Callable
@@ -34,6 +35,14 @@ if TYPE_CHECKING:
     from typing_extensions import Self  # typing.Self from Python 3.11
 
 __all__ = ["Algorithm"]
+
+
+def _count(name: str, value: object, low: int) -> int:
+    """``value`` as an integer >= ``low`` (an integral float such as ``1e6`` too), else a ``ValueError`` naming it."""
+    number = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_))
+    if not (number and math.isfinite(value) and value == int(value) and value >= low):
+        raise ValueError(f"{name} = {value!r}; expected an integer >= {low}")
+    return int(value)
 
 
 def _alone() -> float:
@@ -126,10 +135,17 @@ class Algorithm:
     # -- public API --------------------------------------------------------------------------
     def predict(self, obs, deterministic: bool = True):
         """The action for one observation (the env's action tuple) or a batch (a vector env's action)."""
-        obs = np.asarray(obs, dtype=np.float32)
-        single = obs.ndim == 1
-        if obs.shape[-1] != self.obs_dim or obs.ndim not in (1, 2):
-            raise ValueError(f"observation of shape {obs.shape}; expected ({self.obs_dim},) or (N, {self.obs_dim})")
+        expected = f"expected an array of shape ({self.obs_dim},) or (N, {self.obs_dim})"
+        shown = "" if isinstance(obs, np.ndarray) else f" {obs!r:.60}"  # an array's shape says it in one line
+        try:
+            array = np.asarray(obs, dtype=np.float32)
+        except (TypeError, ValueError) as exc:
+            raise ValueError(f"observation{shown}; {expected}") from exc
+        if array.ndim not in (1, 2) or array.shape[-1] != self.obs_dim:
+            raise ValueError(f"observation{shown} of shape {array.shape}; {expected}")
+        if not isinstance(deterministic, (bool, np.bool_)):
+            raise ValueError(f"deterministic = {deterministic!r}; expected True or False")
+        obs, single = array, array.ndim == 1
         if not np.isfinite(obs).all():
             where = np.argwhere(~np.isfinite(obs))[0].tolist()
             raise ValueError(
@@ -164,9 +180,10 @@ class Algorithm:
         """
         from tqdm.auto import tqdm
 
-        if total_timesteps < 0:
-            raise ValueError(f"total_timesteps = {total_timesteps!r}; expected a non-negative integer")
-        if eval_every < 0 or (eval_every > 0 and eval_episodes < 1):
+        total_timesteps = _count("total_timesteps", total_timesteps, 0)
+        checkpoint_every = _count("checkpoint_every", checkpoint_every, 1)
+        eval_every, eval_episodes = _count("eval_every", eval_every, 0), _count("eval_episodes", eval_episodes, 0)
+        if eval_every > 0 and eval_episodes < 1:
             raise ValueError(
                 f"eval_every = {eval_every!r}, eval_episodes = {eval_episodes!r}; expected eval_every >= 0 "
                 "and, when it is positive, eval_episodes >= 1"

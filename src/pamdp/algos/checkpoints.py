@@ -87,13 +87,25 @@ def _resolve_model_path(path: str | os.PathLike) -> Path:
     return path
 
 
+def _load_failure(exc: Exception) -> str:
+    """What ``torch.load`` found wrong, without its advice to retry with ``weights_only=False``: that would run
+    whatever code the file holds."""
+    advice = ("weights_only", "Weights only", "file an issue", "documentation of torch.load")
+    lines = [line.strip() for line in str(exc).splitlines()]
+    found = [line for line in lines if line and not any(a in line for a in advice)]
+    return f"{type(exc).__name__}: {found[0].split('. ')[0]}" if found else type(exc).__name__
+
+
 def read_checkpoint(path: str | os.PathLike) -> dict:
     """Read a checkpoint with ``weights_only=True``; a file that is not one raises a clear ``ValueError``."""
     path = _resolve_model_path(path)
     try:
         payload = torch.load(path, map_location="cpu", weights_only=True)
     except Exception as exc:
-        raise ValueError(f"{path} is not a readable pamdp checkpoint ({type(exc).__name__}: {exc})") from exc
+        raise ValueError(
+            f"{path} is not a readable pamdp checkpoint ({_load_failure(exc)}); expected a file written by pamdp's "
+            "save, which holds tensors and plain data only"
+        ) from exc
     if not isinstance(payload, dict) or payload.get("format") != FORMAT:
         raise ValueError(f"{path} is not a pamdp checkpoint (no '{FORMAT}' header)")
     return payload

@@ -102,7 +102,8 @@ class Logger:
                 self.rows = [r for r in csv.DictReader(f) if float(r["time/total_timesteps"]) <= resume_step]
         if resume_step == 0:
             self.rows = []
-        self.writer = SummaryWriter(str(self.run_dir / "tb"), purge_step=resume_step or None)
+        # TensorBoard drops the events at steps >= purge_step: those after the checkpoint, not its own epoch's
+        self.writer = SummaryWriter(str(self.run_dir / "tb"), purge_step=resume_step + 1 if resume_step else None)
 
     def record(self, stats: dict[str, float], step: int) -> None:
         for key, value in stats.items():

@@ -94,13 +94,11 @@ def load_experiment(name_or_path: str | os.PathLike) -> Experiment:
         raise ValueError(
             f"unknown experiment {name_or_path!r}; expected one of {', '.join(available_experiments())} or a TOML file"
         )
-    data = tomllib.loads(path.read_text())
-    missing = {"env", "total_steps", "seeds", "runs"} - set(data)
-    if missing:
-        raise ValueError(f"experiment file {path} lacks {sorted(missing)}")
-    for i, run in enumerate(data["runs"]):
-        if not {"label", "algo"} <= set(run):
-            raise ValueError(f"experiment file {path}: run {i} needs a label and an algo, got {run}")
+    try:
+        data = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as exc:
+        raise ValueError(f"experiment file {path} is not valid TOML: {exc}") from exc
+    _check_experiment(path, data)
     return Experiment(
         path.stem,
         data.get("description", ""),
@@ -112,3 +110,57 @@ def load_experiment(name_or_path: str | os.PathLike) -> Experiment:
         dict(data.get("env_kwargs", {})),
         int(data.get("eval_every", 0)),
     )
+
+
+MAX_STEPS = 10**12  # as ``pamdp train --total-steps``: a budget beyond this is a typing slip
+_KEYS = {"description", "env", "total_steps", "seeds", "eval_episodes", "eval_every", "env_kwargs", "runs"}
+_RUN_KEYS = {"label", "algo", "preset", "settings", "env", "env_kwargs"}
+
+
+def _whole(value, low: int, high: int | None = None) -> bool:
+    """Whether a TOML value is an integer from ``low`` to ``high`` (``1e6`` included: users write budgets so)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or value != value:  # NaN
+        return False
+    return value == int(value) and low <= value and (high is None or value <= high)
+
+
+def _check_experiment(path: Path, data: dict) -> None:
+    """Refuse what an experiment file gets wrong, naming the key, its value and what was expected: a misspelt key
+    would otherwise be ignored, and a seed given twice would write one run directory twice."""
+
+    def refuse(what: str, value, expected: str):
+        raise ValueError(f"experiment file {path}: {what} = {value!r}; expected {expected}")
+
+    missing = {"env", "total_steps", "seeds", "runs"} - set(data)
+    if missing:
+        raise ValueError(f"experiment file {path} lacks {sorted(missing)}")
+    for key in sorted(set(data) - _KEYS):
+        refuse(key, data[key], "only the keys " + ", ".join(sorted(_KEYS)))
+    if not _whole(data["total_steps"], 1, MAX_STEPS):
+        refuse("total_steps", data["total_steps"], f"a whole number of steps from 1 to {MAX_STEPS:.0e}")
+    seeds = data["seeds"]
+    if not isinstance(seeds, list) or not seeds or not all(_whole(s, 0) and isinstance(s, int) for s in seeds):
+        refuse("seeds", seeds, "a list of integer seeds >= 0")
+    if len(set(seeds)) < len(seeds):
+        refuse("seeds", seeds, "each seed once")
+    for key in ("eval_episodes", "eval_every"):
+        if key in data and not (isinstance(data[key], int) and _whole(data[key], 0)):
+            refuse(key, data[key], "an integer >= 0")
+    runs = data["runs"]
+    if not isinstance(runs, list) or not runs or not all(isinstance(run, dict) for run in runs):
+        refuse("runs", runs, "one or more [[runs]] tables")
+    if "env_kwargs" in data and not isinstance(data["env_kwargs"], dict):
+        refuse("env_kwargs", data["env_kwargs"], "a table of the env's constructor arguments")
+    dirs: dict[str, str] = {}
+    for i, run in enumerate(runs):
+        if not {"label", "algo"} <= set(run):
+            raise ValueError(f"experiment file {path}: run {i} needs a label and an algo, got {run}")
+        for key in sorted(set(run) - _RUN_KEYS):
+            refuse(f"runs[{i}].{key}", run[key], "only the keys " + ", ".join(sorted(_RUN_KEYS)))
+        for key in ("settings", "env_kwargs"):
+            if key in run and not isinstance(run[key], dict):
+                refuse(f"runs[{i}].{key}", run[key], "a table")
+        slug = _slug(str(run["label"]))
+        if slug in dirs:
+            refuse(f"runs[{i}].label", run["label"], f"a label whose directory differs from {dirs[slug]!r}'s ({slug})")
+        dirs[slug] = run["label"]

@@ -22,6 +22,7 @@ __all__ = [
     "final_values",
     "seeds_label",
     "x_axis",
+    "draw_curves",
     "plot_curves",
     "results_table",
     "write_report",
@@ -47,31 +48,62 @@ def find_groups(roots: list[str | os.PathLike]) -> dict[str, list[Path]]:
 
     A run's label is the one its ``run.json`` records (an experiment's ``PASVG(0)``, whose directory is
     ``PASVG_0_``), else the name of the directory holding its seeds (or its own name, for a run given alone).
+    Runs are averaged together only if they share their label, algorithm and env (with its arguments): where
+    runs of one label differ in those, each kind is a group of its own, named ``label (algo on env)``.
     """
-    groups: dict[str, list[Path]] = {}
+    found: dict[tuple[str, tuple[str, str]], list[Path]] = {}
     for root in map(Path, roots):
         if not root.exists():
             raise FileNotFoundError(f"no such directory: {root}")
         runs = [root] if (root / "progress.csv").exists() else sorted(p.parent for p in root.rglob("progress.csv"))
         for run in runs:
-            groups.setdefault(_recorded_label(run) or (run.parent.name if run != root else run.name), []).append(run)
-    if not groups:
+            recorded = _recorded(run)
+            label = str(recorded.get("label") or "") or (run.parent.name if run != root else run.name)
+            found.setdefault((label, _kind(recorded)), []).append(run)
+    if not found:
         raise FileNotFoundError(f"no run directories (with progress.csv) under {', '.join(map(str, roots))}")
-    return groups
+    kinds: dict[str, int] = {}
+    for label, _ in found:
+        kinds[label] = kinds.get(label, 0) + 1
+    return {
+        (label if kinds[label] == 1 else f"{label} ({' on '.join(kind)})"): runs
+        for (label, kind), runs in found.items()
+    }
 
 
-def _recorded_label(run: Path) -> str:
+def _recorded(run: Path) -> dict:
+    """A run's ``run.json`` (``{}`` where it has none, or one that is not a JSON object)."""
     try:
-        return str(json.loads((run / "run.json").read_text()).get("label") or "")
-    except (OSError, ValueError, AttributeError):  # no run.json, or not a JSON object
-        return ""
+        recorded = json.loads((run / "run.json").read_text())
+    except (OSError, ValueError):
+        return {}
+    return recorded if isinstance(recorded, dict) else {}
+
+
+def _kind(recorded: dict) -> tuple[str, str]:
+    """What a run is a run of: its algorithm, and its env with the env's arguments."""
+    env = str(recorded.get("env") or "an unrecorded env")
+    if recorded.get("env_kwargs"):
+        env += " " + json.dumps(recorded["env_kwargs"], sort_keys=True)
+    return str(recorded.get("algo") or "an unrecorded algorithm"), env
 
 
 def _read_progress(run: Path, metric: str) -> tuple[np.ndarray, np.ndarray]:
-    with open(run / "progress.csv", newline="") as f:
-        rows = list(csv.DictReader(f))
-    steps = np.array([float(r["time/total_timesteps"]) for r in rows])
-    values = np.array([float(r[metric]) if r.get(metric) not in (None, "") else np.nan for r in rows])
+    path = run / "progress.csv"
+    with open(path, newline="") as f:
+        reader = csv.DictReader(f)
+        rows = list(reader)
+        columns = reader.fieldnames or []
+    if "time/total_timesteps" not in columns:
+        raise ValueError(
+            f"{path} has no column 'time/total_timesteps' (columns: {', '.join(columns) or 'none'}); "
+            "expected a progress.csv written by pamdp train"
+        )
+    try:
+        steps = np.array([float(r["time/total_timesteps"]) for r in rows])
+        values = np.array([float(r[metric]) if r.get(metric) not in (None, "") else np.nan for r in rows])
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{path}: {exc}; expected numbers in every column pamdp train writes") from exc
     return steps, values
 
 
@@ -148,17 +180,13 @@ def x_axis(aggs: dict[str, dict[str, np.ndarray]], x: str = "auto") -> tuple[str
     return label, {k: a["epoch"].astype(float) for k, a in aggs.items()}
 
 
-def plot_curves(
-    groups: dict[str, list[Path]], path: str | os.PathLike, title: str = "", metric: str = METRIC, x: str = "auto"
-) -> list[Path]:
-    """Mean +- std learning curves of every group, written as ``path`` with ``.png`` and ``.svg`` suffixes.
-
-    ``x``: ``epochs`` (the paper's axis), ``samples``, or ``auto`` (see :func:`x_axis`).
-    """
+def draw_curves(groups: dict[str, list[Path]], title: str = "", metric: str = METRIC, x: str = "auto"):
+    """The matplotlib figure of :func:`plot_curves`."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import MaxNLocator
 
     aggs = {label: aggregate(runs, metric) for label, runs in groups.items()}
     xlabel, xs = x_axis(aggs, x)
@@ -168,8 +196,13 @@ def plot_curves(
         ok = np.isfinite(agg["mean"])  # a metric logged every few epochs only (greedy evaluations)
         xv, mean, std = xs[label][ok], agg["mean"][ok], agg["std"][ok]
         name = f"{label} ({seeds_label(agg, len(runs))})"
-        line = ax.plot(xv, mean, label=name, linewidth=1.4, marker="." if ok.sum() < 40 else None)[0]
+        few = ok.sum() < 40  # points drawn as dots, so that a short run's curve (one epoch, even) shows
+        line = ax.plot(xv, mean, label=name, linewidth=1.4, marker="o" if few else None, markersize=3)[0]
         ax.fill_between(xv, mean - std, mean + std, color=line.get_color(), alpha=0.2)
+    # From 0, so that a curve of one point spans no zero-width range, whose ticks would crowd into each other
+    ax.set_xlim(left=0.0)
+    if xlabel.startswith("training epochs"):
+        ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_xlabel(xlabel)
     ax.set_ylabel(LABELS.get(metric, metric))
     if title:
@@ -177,6 +210,19 @@ def plot_curves(
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, frameon=False)
     fig.tight_layout()
+    return fig
+
+
+def plot_curves(
+    groups: dict[str, list[Path]], path: str | os.PathLike, title: str = "", metric: str = METRIC, x: str = "auto"
+) -> list[Path]:
+    """Mean +- std learning curves of every group, written as ``path`` with ``.png`` and ``.svg`` suffixes.
+
+    ``x``: ``epochs`` (the paper's axis), ``samples``, or ``auto`` (see :func:`x_axis`).
+    """
+    import matplotlib.pyplot as plt
+
+    fig = draw_curves(groups, title, metric, x)
     path = Path(path)
     written = []
     for suffix in (".png", ".svg"):
@@ -194,7 +240,7 @@ def results_table(groups: dict[str, list[Path]]) -> str:
         "|---|---|---|---|---|---|",
     ]
     for label, runs in groups.items():
-        evals = [json.loads((r / "evaluation.json").read_text()) for r in runs if (r / "evaluation.json").exists()]
+        evals = [_evaluation(r / "evaluation.json") for r in runs if (r / "evaluation.json").exists()]
         finals, epochs = final_values(runs)
         last = "-"
         if len(finals):
@@ -213,6 +259,17 @@ def results_table(groups: dict[str, list[Path]]) -> str:
             greedy, goal, to_goal = "not evaluated", "-", "-"
         lines.append(f"| {label} | {len(runs)} | {greedy} | {goal} | {to_goal} | {last} |")
     return "\n".join(lines)
+
+
+def _evaluation(path: Path) -> dict:
+    """A run's ``evaluation.json``, refused with its path where it lacks what the table shows."""
+    try:
+        result = json.loads(path.read_text())
+    except ValueError as exc:
+        raise ValueError(f"{path} is not valid JSON ({exc}); expected the evaluation.json pamdp train writes") from exc
+    if not isinstance(result, dict) or not isinstance(result.get("mean_return"), (int, float)):
+        raise ValueError(f"{path} holds no mean_return; expected the evaluation.json pamdp train writes")
+    return result
 
 
 def write_report(

@@ -12,28 +12,42 @@ a failed run with its error while the others finish.
 from __future__ import annotations
 
 import concurrent.futures as cf
+import contextlib
+import csv
 import dataclasses
+import fcntl
+import inspect
 import json
 import multiprocessing
 import os
+import socket
 import sys
 import time
 import traceback
+import typing
 from pathlib import Path
 from typing import Any
 
 from pamdp.algos import ALGORITHMS, DEFAULT_PRESET, algorithm_class, default_preset
+from pamdp.algos.settings import type_name, type_ok
 
 __all__ = [
     "RunSpec",
     "default_preset",
     "train_run",
+    "run_lock",
+    "check_env_kwargs",
+    "env_creator",
     "is_finished",
     "run_all",
     "algorithm_class",
     "ALGORITHMS",
     "DEFAULT_PRESET",
 ]
+
+LOCK_FILE = ".lock"
+# What a run directory holds before its first checkpoint: starting it again from step 0 loses nothing.
+_BEFORE_FIRST_CHECKPOINT = {"run.json", "progress.csv", "tb", "stdout.log", LOCK_FILE}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -59,6 +73,98 @@ class RunSpec:
         base = cls.config_class.preset(preset)
         return cls, preset, cls.config_class.from_dict({**dict(self.settings), "seed": self.seed}, base=base)
 
+    def check(self):
+        """:meth:`config`, after checking the env's id and arguments against its constructor: everything a run
+        needs before anything is written."""
+        check_env_kwargs(self.env, dict(self.env_kwargs))
+        return self.config()
+
+
+def env_creator(env_id: str):
+    """The class (or function) that makes a registered env; an unregistered id is refused with a ``ValueError``
+    (see :func:`pamdp.algos.vector_env.env_spec`)."""
+    import gymnasium
+
+    import pamdp  # noqa: F401  (registers pamdp's envs)
+    from pamdp.algos.vector_env import env_spec
+
+    creator = env_spec(env_id).entry_point
+    return gymnasium.envs.registration.load_env_creator(creator) if isinstance(creator, str) else creator
+
+
+def check_env_kwargs(env_id: str, env_kwargs: dict) -> None:
+    """Refuse env arguments that the env's constructor does not take, or whose type differs from its annotation
+    (or its default's type, where it has none): ``{"deterministic": "no"}`` would otherwise switch the option on.
+
+    An unregistered ``env_id`` is refused too (see :func:`pamdp.algos.vector_env.env_spec`).
+    """
+    if not env_kwargs:
+        env_creator(env_id)
+        return
+    creator = env_creator(env_id)
+    try:
+        params = inspect.signature(creator).parameters
+    except (TypeError, ValueError):  # a callable without a signature: nothing to check against
+        return
+    try:
+        hints = typing.get_type_hints(creator.__init__ if inspect.isclass(creator) else creator)
+    except (NameError, TypeError):  # annotations naming what cannot be imported: the defaults still say
+        hints = {}
+    takes_any = any(p.kind is inspect.Parameter.VAR_KEYWORD for p in params.values())
+    named = {n: p for n, p in params.items() if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)}
+    for name, value in env_kwargs.items():
+        if name not in named:
+            if takes_any:
+                continue
+            raise ValueError(
+                f"env {env_id!r} takes no argument {name!r}; expected some of {', '.join(sorted(named)) or 'none'}"
+            )
+        default = named[name].default
+        hint = hints.get(name, type(default) if default not in (inspect.Parameter.empty, None) else None)
+        if hint is not None and not type_ok(value, hint):
+            raise ValueError(f"env {env_id!r} argument {name} = {value!r}; expected {type_name(hint)}")
+
+
+@contextlib.contextmanager
+def run_lock(out: str | os.PathLike):
+    """Hold ``out``'s lock file (``out/.lock``, an exclusive ``flock``) for the block: one writer per run directory.
+
+    A second process asking for it is refused at once with a ``ValueError`` naming the holder. The directory
+    (and its missing parents) is created; if the block fails before writing anything into it, they are removed
+    again, so a refused run leaves nothing behind. The lock goes with its process, however that ends.
+    """
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"{out} is a file; expected a run directory (a new one, or one to resume)")
+    created = [p for p in (out, *out.parents) if not p.exists()]  # deepest first
+    out.mkdir(parents=True, exist_ok=True)
+    lock_existed = (out / LOCK_FILE).exists()
+    lock = open(out / LOCK_FILE, "a+")
+    try:
+        fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        lock.seek(0)
+        holder = lock.read().strip() or "another process"
+        lock.close()
+        raise ValueError(
+            f"{out} is in use: {holder} is writing that run; wait for it to end or use another directory"
+        ) from None
+    try:
+        lock.seek(0)
+        lock.truncate()
+        lock.write(f"pamdp process {os.getpid()} on {socket.gethostname()}\n")
+        lock.flush()
+        yield
+    except BaseException:  # what this made and nothing has written into goes again
+        if not lock_existed:
+            os.remove(out / LOCK_FILE)
+        for directory in created:
+            with contextlib.suppress(OSError):  # not empty: the run wrote into it
+                directory.rmdir()
+        raise
+    finally:
+        lock.close()
+
 
 def is_finished(out: str | Path, spec: RunSpec) -> bool:
     """Whether ``out`` holds ``spec``'s final model for its whole budget (and its evaluation, if it asks for one).
@@ -80,12 +186,60 @@ def is_finished(out: str | Path, spec: RunSpec) -> bool:
     return spec.eval_episodes <= 0 or (out / "evaluation.json").exists()
 
 
+def _read_run_json(path: Path) -> dict:
+    """A run's ``run.json`` (``{}`` where there is none); one that is not a JSON object is refused, naming it."""
+    if not path.exists():
+        return {}
+    try:
+        recorded = json.loads(path.read_text())
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"{path} is not valid JSON ({exc.msg}); expected the run.json pamdp train writes") from exc
+    if not isinstance(recorded, dict):
+        raise ValueError(f"{path} holds a {type(recorded).__name__}; expected the run.json pamdp train writes")
+    return recorded
+
+
+def _differences(recorded: dict, asked: dict) -> list[str]:
+    """What differs between a recorded run and the one asked for, setting by setting: ``delta: 0.01 in the
+    run, 0.05 asked``."""
+    differ = []
+    for key in ("env", "env_kwargs"):
+        if recorded.get(key) != asked[key]:
+            differ.append(f"{key}: {recorded.get(key)!r} in the run, {asked[key]!r} asked")
+    old, new = recorded.get("config", {}), asked["config"]
+    for name in sorted(set(old) | set(new)):
+        if old.get(name) != new.get(name):
+            differ.append(f"{name}: {old.get(name)!r} in the run, {new.get(name)!r} asked")
+    return differ
+
+
+def _check_fresh_directory(out: Path) -> None:
+    """Refuse to start a run from step 0 in a directory whose contents that would replace or mix with."""
+    present = sorted(os.listdir(out)) if out.is_dir() else []
+    progress = out / "progress.csv"
+    if progress.exists():
+        with open(progress, newline="") as f:
+            epochs = sum(1 for _ in csv.DictReader(f))
+        if epochs:
+            raise ValueError(
+                f"{out} holds a progress.csv of {epochs} epochs but no checkpoint to resume from; starting again "
+                "would replace that log: move the directory away to start again, or use another directory"
+            )
+    # (temporary files are an atomic write's, cut short by a kill)
+    foreign = [name for name in present if name not in _BEFORE_FIRST_CHECKPOINT and not name.endswith(".tmp")]
+    if foreign:
+        raise ValueError(
+            f"{out} holds {', '.join(foreign)} and no pamdp checkpoint; expected a new or empty directory, "
+            "or a run directory to resume"
+        )
+
+
 def _prepare(spec: RunSpec, out: str | os.PathLike, log=print) -> tuple[Any, dict | None]:
     """The model to train for ``spec`` in ``out`` (new or resumed) and ``None``, or ``None`` and the evaluation of
-    a run already finished."""
+    a run already finished. The caller holds ``out``'s :func:`run_lock`."""
     from pamdp.algos.checkpoints import CHECKPOINT, FINAL_MODEL, atomic_write_text
 
-    cls, preset, config = spec.config()
+    cls, preset, config = spec.check()
     out = Path(out)
     run_info = {
         "algo": spec.algo,
@@ -99,15 +253,20 @@ def _prepare(spec: RunSpec, out: str | os.PathLike, log=print) -> tuple[Any, dic
         run_info["label"] = spec.label
     run_file, eval_file = out / "run.json", out / "evaluation.json"
     if (out / CHECKPOINT).exists() or (out / FINAL_MODEL).exists():
-        as_written = json.loads(run_file.read_text()) if run_file.exists() else {}
+        as_written = _read_run_json(run_file)
+        if as_written.get("algo") != spec.algo:  # before its settings, which another algorithm does not know
+            raise ValueError(
+                f"{out} holds a run of algorithm {as_written.get('algo')!r}, not {spec.algo!r}; "
+                "resume it with that algorithm or use another output directory"
+            )
         recorded = dict(as_written)  # compared below with the defaults of settings added since filled in
         if "config" in recorded:  # settings added since the run started count as their defaults
             recorded["config"] = cls.config_class.from_dict(recorded["config"]).to_dict()
         recorded.setdefault("env_kwargs", {})
-        differ = sorted(k for k in ("algo", "env", "env_kwargs", "config") if recorded.get(k) != run_info[k])
+        differ = _differences(recorded, run_info)
         if differ:
             raise ValueError(
-                f"{out} holds a run with other {', '.join(differ)}; "
+                f"{out} holds a run with other settings ({'; '.join(differ)}); "
                 "resume it with the same settings or use another output directory"
             )
         if is_finished(out, spec):
@@ -116,9 +275,15 @@ def _prepare(spec: RunSpec, out: str | os.PathLike, log=print) -> tuple[Any, dic
                 atomic_write_text(run_file, json.dumps({**as_written, "label": spec.label}, indent=2))
             return None, json.loads(eval_file.read_text()) if eval_file.exists() else {}
         model = cls.load(out / CHECKPOINT if (out / CHECKPOINT).exists() else out / FINAL_MODEL)
+        if model.num_timesteps > spec.total_steps:  # training cannot be undone; its evaluation stays as it is
+            raise ValueError(
+                f"{out} holds a run trained for {model.num_timesteps:,} steps, more than the {spec.total_steps:,} "
+                f"asked; give a budget of at least {as_written.get('total_steps', model.num_timesteps):,} steps "
+                "(more extends the run) or use another output directory"
+            )
         log(f"resuming {out} at step {model.num_timesteps:,} of {spec.total_steps:,}")
     else:
-        out.mkdir(parents=True, exist_ok=True)
+        _check_fresh_directory(out)
         model = cls(spec.env, config, env_kwargs=dict(spec.env_kwargs))
     atomic_write_text(run_file, json.dumps({**run_info, "command": sys.argv}, indent=2))
     return model, None
@@ -155,8 +320,9 @@ def train_run(spec: RunSpec, out: str | os.PathLike, progress_bar: bool = True, 
 
     ``callback``: called after every epoch (and its checkpoint) with the model and the epoch's statistics.
     """
-    model, done = _prepare(spec, out, log)
-    return done if model is None else _train(model, spec, out, progress_bar, log, callback=callback)
+    with run_lock(out):
+        model, done = _prepare(spec, out, log)
+        return done if model is None else _train(model, spec, out, progress_bar, log, callback=callback)
 
 
 def _worker(spec: RunSpec, out: str, callback=None) -> dict:

@@ -40,14 +40,7 @@ class RunStatus:
     greedy_return: float | None  # the final greedy evaluation, once done
     goal_rate: float | None
     idle_seconds: float | None  # since progress.csv was last written; small while a run is training
-    recent_seconds_per_step: float | None = None  # over the last RECENT_EPOCHS epochs
-
-    @property
-    def seconds_per_step(self) -> float | None:
-        """The run's pace: training seconds a sample over its last epochs, else over all of them."""
-        if self.recent_seconds_per_step is not None:
-            return self.recent_seconds_per_step
-        return self.train_seconds / self.steps if self.steps > 0 and self.train_seconds > 0 else None
+    seconds_per_step: float | None = None  # the run's pace, from :func:`recent_pace`; None before it has one
 
 
 def _float(value) -> float | None:
@@ -65,6 +58,27 @@ def epoch_seconds(row: dict) -> float:
     return cpu if cpu is not None else (_float(row.get("time/epoch_seconds")) or 0.0)
 
 
+def recent_pace(rows: list[dict]) -> float | None:
+    """Training seconds per sample over a run's last ``RECENT_EPOCHS`` epochs at its full rate of updates.
+
+    An off-policy run's first epochs fill its replay buffer and update little or not at all (``train/updates``):
+    they are many times faster than the rest, so they are left out, and a run that has had none but such
+    epochs has no pace yet (``None``). Epochs that log no updates (on-policy runs) all count.
+    """
+    ends = [_float(row.get("time/total_timesteps")) or 0.0 for row in rows]
+    samples = [end - start for start, end in zip([0.0, *ends], ends)]
+    updates = [_float(row.get("train/updates")) for row in rows]
+    steady = list(range(len(rows)))
+    if any(u is not None for u in updates):
+        rates = [(u or 0.0) / n if n > 0 else 0.0 for u, n in zip(updates, samples)]
+        if max(rates) <= 0:
+            return None
+        steady = [i for i, rate in enumerate(rates) if rate >= 0.9 * max(rates)]  # updates come in whole batches
+    last = steady[-RECENT_EPOCHS:]
+    span, spent = sum(samples[i] for i in last), sum(epoch_seconds(rows[i]) for i in last)
+    return spent / span if span > 0 and spent > 0 else None
+
+
 def run_status(spec: RunSpec, out: str | Path, now: float | None = None) -> RunStatus:
     """The state of ``spec``'s run in directory ``out``."""
     from pamdp.algos.checkpoints import CHECKPOINT, FINAL_MODEL
@@ -79,11 +93,7 @@ def run_status(spec: RunSpec, out: str | Path, now: float | None = None) -> RunS
         if rows:
             steps = int(_float(rows[-1].get("time/total_timesteps")) or 0)
             last_return = _float(rows[-1].get("charts/episodic_return"))
-            last = rows[-RECENT_EPOCHS:]
-            before = rows[-RECENT_EPOCHS - 1] if len(rows) > RECENT_EPOCHS else {}
-            span = steps - int(_float(before.get("time/total_timesteps")) or 0)
-            spent = sum(epoch_seconds(row) for row in last)
-            recent = spent / span if span > 0 and spent > 0 else None
+            recent = recent_pace(rows)
         idle = (time.time() if now is None else now) - progress.stat().st_mtime
     greedy = goal = None
     if is_finished(out, spec):
