@@ -4,24 +4,15 @@ batched or stepped in turn, and the spaces of whatever a user passed (an id, an 
 from __future__ import annotations
 
 import importlib
-import importlib.util
 
 import gymnasium
 from gymnasium import spaces
 
-__all__ = ["env_spec", "make_vector_env", "describe_env", "auto_batch_min"]
+__all__ = ["env_spec", "make_vector_env", "describe_env", "AUTO_BATCH_MIN"]
 
-# A batched env on its NumPy backend pays NumPy's per-call cost on every inner loop iteration, whatever its
-# number of copies: below about this many copies, scalar envs stepped one after the other are faster.
-AUTO_BATCH_MIN = 48
-# With Numba (pamdp[fast]) the batched envs run compiled kernels and win from two copies on (the measurements:
-# benchmarks/platform_speed.md, benchmarks/hfo_speed.md).
-AUTO_BATCH_MIN_NUMBA = 2
-
-
-def auto_batch_min() -> int:
-    """The number of copies from which ``"auto"`` steps an env's batched version."""
-    return AUTO_BATCH_MIN_NUMBA if importlib.util.find_spec("numba") is not None else AUTO_BATCH_MIN
+# A batched env steps its copies in one compiled loop and beats scalar copies stepped in turn from two copies on
+# (benchmarks/platform_speed.md, benchmarks/hfo_speed.md); a single copy is scalar.
+AUTO_BATCH_MIN = 2
 
 
 def env_spec(env_id: str) -> gymnasium.envs.registration.EnvSpec:
@@ -52,14 +43,14 @@ def make_vector_env(
     env_id: str, num_envs: int, env_kwargs: dict | None = None, mode: str = "auto"
 ) -> gymnasium.vector.VectorEnv:
     """``num_envs`` copies of the env: ``"batched"`` (its ``vector_entry_point``), ``"sync"`` (scalar copies
-    stepped in turn) or ``"auto"`` (batched from :func:`auto_batch_min` copies on, when the env has a batched
+    stepped in turn) or ``"auto"`` (batched from ``AUTO_BATCH_MIN`` copies on, when the env has a batched
     version).
     """
     if mode not in ("auto", "batched", "sync"):
         raise ValueError(f"vector env mode {mode!r}; expected 'auto', 'batched' or 'sync'")
     spec = env_spec(env_id)
     batched = spec.vector_entry_point is not None and (
-        mode == "batched" or (mode == "auto" and num_envs >= auto_batch_min())
+        mode == "batched" or (mode == "auto" and num_envs >= AUTO_BATCH_MIN)
     )
     if mode == "batched" and spec.vector_entry_point is None:
         raise ValueError(f"{env_id} has no batched version (no vector_entry_point); use 'sync'")
