@@ -4,12 +4,15 @@ the loss of a worker node (a real two-node Ray cluster on 127.0.0.1, see :mod:`r
 import csv
 import json
 import re
+import sys
 import textwrap
 from pathlib import Path
 
 import pytest
-from pamdp.experiments.ray_backend import _Inbox, _Mirror
 from ray_cluster import run_on_local_cluster
+
+from pamdp.experiments.ray_backend import _Inbox, _Mirror
+from pamdp.experiments.runner import run_lock
 
 
 class _Rounds:
@@ -54,7 +57,7 @@ def test_the_driver_copy_follows_rewrites_and_appends_and_refuses_an_older_attem
             f.write(f"epoch {epoch}\n")
         assert a.send()
         _same_files(first, out)
-    assert not (out / ".lock").exists(), "the worker's lock file stays on the worker"
+    assert "on worker" not in (out / ".lock").read_text(), "the worker's lock file stays on the worker"
     sent = a.mirror._scan()
     assert sent == [], "nothing changed, nothing to send"
 
@@ -69,6 +72,22 @@ def test_the_driver_copy_follows_rewrites_and_appends_and_refuses_an_older_attem
     assert (out / "stdout.log").read_text() == "epoch 1\nepoch 2\nepoch 3\nresumed\n"
     _same_files(second, out)
     inbox.close()
+
+
+def test_a_sweep_holds_its_run_directories_against_other_writers_until_it_ends(tmp_path):
+    out = tmp_path / "run"
+    with run_lock(out):  # a local `pamdp train` writing there
+        with pytest.raises(ValueError, match=r"is in use: pamdp process \d+ on "):
+            _Inbox().open(str(out))
+    inbox = _Inbox()
+    attempt, _ = inbox.open(str(out))
+    with pytest.raises(ValueError, match="is in use"), run_lock(out):
+        pass
+    inbox.close()
+    assert not inbox.write(str(out), attempt, [("progress.csv", 0, b"late\n")]), "the sweep is over"
+    assert not (out / "progress.csv").exists()
+    with run_lock(out):  # free again
+        pass
 
 
 def _rows(path: Path) -> list[dict]:
@@ -121,6 +140,7 @@ NODE_LOSS = textwrap.dedent(
 )
 
 
+@pytest.mark.skipif(sys.platform != "linux", reason="Ray runs multi-node clusters on Linux only")
 def test_a_sweep_survives_the_loss_of_a_worker_node_and_its_run_resumes_from_its_checkpoint(tmp_path):
     pytest.importorskip("ray")
     done = run_on_local_cluster(NODE_LOSS, tmp_path, timeout=240)

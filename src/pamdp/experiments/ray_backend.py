@@ -12,6 +12,7 @@ epoch is counted twice. Needs the ``ray`` extra: ``pip install pamdp[ray]``.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import sys
 import tempfile
@@ -20,7 +21,7 @@ import traceback
 from pathlib import Path
 
 from pamdp.algos.checkpoints import _atomic_write
-from pamdp.experiments.runner import RunOutcome, RunSpec, _describe, _worker
+from pamdp.experiments.runner import RunOutcome, RunSpec, _describe, _worker, run_lock
 
 __all__ = ["run_all_ray", "RETRIES"]
 
@@ -68,14 +69,19 @@ def _write(target: Path, offset: int, data: bytes) -> None:
 class _Inbox:
     """The one writer of the run directories, an actor on the driver's node.
 
-    Each attempt at a run opens it and gets a token; a write with an older attempt's token (from a worker
-    that Ray gave up on but that still runs) is refused, so a run directory has one writer at a time.
+    It holds each run directory's lock (:func:`pamdp.experiments.runner.run_lock`) from the run's first attempt
+    until the sweep ends, so no other pamdp process writes into it meanwhile. Each attempt at a run opens it
+    and gets a token; a write with an older attempt's token (from a worker that Ray gave up on but that still
+    runs) is refused, so a run directory has one writer at a time.
     """
 
     def __init__(self):
         self.attempts: dict[str, int] = {}
+        self.locks = contextlib.ExitStack()
 
     def open(self, out: str) -> tuple[int, dict[str, bytes]]:
+        if out not in self.attempts:
+            self.locks.enter_context(run_lock(out))  # refused with the holder's name if another process has it
         self.attempts[out] = self.attempts.get(out, 0) + 1
         return self.attempts[out], _pack(Path(out))
 
@@ -89,6 +95,7 @@ class _Inbox:
     def close(self) -> None:
         """Let the run directories go (the sweep is over): no attempt writes any more."""
         self.attempts.clear()
+        self.locks.close()
 
 
 class _Mirror:
