@@ -24,7 +24,7 @@ from gymnasium import spaces
 from gymnasium.vector import AutoresetMode
 
 from pamdp._version import __version__
-from pamdp.algos.checkpoints import CHECKPOINT, FORMAT, atomic_save, own_storage, read_checkpoint
+from pamdp.algos.checkpoints import CHECKPOINT, FORMAT, atomic_save, read_checkpoint
 from pamdp.algos.logger import Logger
 from pamdp.algos.settings import AlgoConfig
 from pamdp.algos.vector_env import describe_env, make_vector_env
@@ -260,8 +260,8 @@ class Algorithm:
             "num_timesteps": self.num_timesteps,
             "epoch": self.epoch,
             "rng": {"numpy": self.np_rng.bit_generator.state, "torch": self.torch_gen.get_state()},
-            "modules": own_storage({k: m.state_dict() for k, m in self._modules().items()}),
-            "optimizers": own_storage({k: o.state_dict() for k, o in self._optimizers().items()}),
+            "modules": {k: m.state_dict() for k, m in self._modules().items()},
+            "optimizers": {k: o.state_dict() for k, o in self._optimizers().items()},
             "extra": self._extra_state(replay),
         }
         atomic_save(payload, path)

@@ -61,20 +61,6 @@ def atomic_write_text(path: str | os.PathLike, text: str) -> None:
     _atomic_write(path, lambda f: f.write(text.encode()), "run.json")
 
 
-def own_storage(obj):
-    """``obj`` with every tensor that views a larger storage copied out: ``torch.save`` writes a view's whole
-    storage, which for a stacked seed's weights (pamdp.algos.stacking) holds every seed's."""
-    if isinstance(obj, torch.Tensor):
-        if obj.untyped_storage().nbytes() != obj.nbytes or not obj.is_contiguous():
-            return obj.clone(memory_format=torch.contiguous_format)
-        return obj
-    if isinstance(obj, dict):
-        return {k: own_storage(v) for k, v in obj.items()}
-    if isinstance(obj, list | tuple):
-        return type(obj)(own_storage(v) for v in obj)
-    return obj
-
-
 def _resolve_model_path(path: str | os.PathLike) -> Path:
     path = Path(path)
     if path.is_dir():
