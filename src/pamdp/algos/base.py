@@ -45,10 +45,6 @@ def _count(name: str, value: object, low: int) -> int:
     return int(value)
 
 
-def _alone() -> float:
-    return 1.0
-
-
 class Algorithm:
     """Base class of pamdp's algorithms; see the module docstring for what a subclass provides."""
 
@@ -83,7 +79,6 @@ class Algorithm:
             torch.manual_seed(config.seed)
             self._build()
         self._vec_env: gymnasium.vector.VectorEnv | None = None
-        self._cpu_share: Callable[[], float] = _alone  # runs sharing this process's CPU time (seed stacks)
 
     # -- to be provided by each algorithm ----------------------------------------------------
     def _build(self) -> None:
@@ -214,8 +209,7 @@ class Algorithm:
                         "time/total_timesteps": float(self.num_timesteps),
                         "time/epoch_seconds": elapsed,
                         # CPU time of this process: unlike the wall clock, it stops while the run is suspended
-                        # (shared equally by the seeds stacked in this process, see pamdp.algos.stacking)
-                        "time/epoch_cpu_seconds": (time.process_time() - cpu0) / self._cpu_share(),
+                        "time/epoch_cpu_seconds": time.process_time() - cpu0,
                         "charts/SPS": (self.num_timesteps - start_steps) / (time.perf_counter() - start_time),
                     }
                 )
