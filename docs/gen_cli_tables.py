@@ -53,13 +53,11 @@ def main() -> int:
     args = parser.parse_args()
     text = DOC.read_text()
     new = render(text)
-    if args.check:
-        if new != text:
-            print(f"{DOC} is out of date: run python docs/gen_cli_tables.py", file=sys.stderr)
-            return 1
-        return 0
-    DOC.write_text(new)
-    return 0
+    if new != text and args.check:
+        print(f"{DOC} is out of date: run python docs/gen_cli_tables.py", file=sys.stderr)
+    elif new != text:
+        DOC.write_text(new)
+    return int(new != text and args.check)
 
 
 if __name__ == "__main__":

@@ -139,6 +139,13 @@ def test_env_arguments_of_the_wrong_name_or_type_are_refused(kwargs, expected, t
     assert not (tmp_path / "runs").exists()
 
 
+def test_env_arguments_are_checked_for_a_model_made_in_python_too():
+    from pamdp.algos.pdqn import PDQN
+
+    with pytest.raises(ValueError, match="argument deterministic = 'no'; expected bool"):
+        PDQN("pamdp/HalfFieldOffense-v0", env_kwargs={"deterministic": "no"})
+
+
 def write_run(path, algo, env, returns, label=None):
     """A run directory as pamdp train leaves it: run.json and one progress.csv row per epoch."""
     path.mkdir(parents=True)
@@ -192,6 +199,18 @@ def test_a_curve_of_one_epoch_shows_as_a_point_on_ticks_that_do_not_overlap(x, t
     assert all(line.get_marker() == "o" and left < line.get_xdata()[0] < right for line in ax.lines)
 
 
+def test_ctrl_c_in_reproduce_says_how_to_go_on_instead_of_a_traceback(tmp_path, monkeypatch, capsys):
+    import pamdp.experiments.runner as runner
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(runner, "run_all", interrupted)
+    assert main(["reproduce", "step-size", "--seeds", "0", "--out", str(tmp_path)]) == 130
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[-1] == "pamdp reproduce: interrupted; run the same command to resume (finished runs are skipped)"
+
+
 # -- lost or overwritten data -----------------------------------------------------------------------------------
 
 
@@ -239,6 +258,7 @@ def test_a_log_without_a_checkpoint_is_not_replaced_by_a_new_run(trained, tmp_pa
         (["--env-kwargs", '{"nope": 1}'], "env 'pamdp/Platform-v0' takes no argument 'nope'"),
         (["--out", "{file}/run"], "{file}/run: Not a directory"),
         (["--out", "{file}"], "{file} is a file; expected a run directory"),
+        (["--out", "/sys/pamdp-test-run/r"], "/sys/pamdp-test-run: "),  # sysfs takes no new directory
     ],
 )
 def test_a_refused_run_leaves_nothing_behind(extra, expected, tmp_path, capsys):

@@ -22,7 +22,7 @@ from pathlib import Path
 
 from pamdp import __version__
 from pamdp._memory import keep_freed_memory
-from pamdp.experiments.runner import ALGORITHMS, RunSpec, algorithm_class, default_preset, env_creator, train_run
+from pamdp.experiments.runner import ALGORITHMS, RunSpec, algorithm_class, default_preset, train_run
 
 MAX_STEPS = 10**12  # a budget beyond this is a typing slip (10^12 steps take decades on one core)
 MAX_SEED = 2**32 - 1
@@ -399,6 +399,7 @@ def cmd_render(args) -> int:
 
     import pamdp  # noqa: F401  (registers the envs)
     from pamdp.algos.checkpoints import load_model
+    from pamdp.algos.vector_env import env_creator
     from pamdp.envs.rendering import record_episode
 
     if args.source in gymnasium.registry:
@@ -428,6 +429,10 @@ def main(argv: list[str] | None = None) -> int:
     }
     try:
         return handlers[args.command](args)
+    except KeyboardInterrupt:  # train says where its checkpoint is; the others stop as they are
+        resume = "; run the same command to resume (finished runs are skipped)" if args.command == "reproduce" else ""
+        print(f"\npamdp {args.command}: interrupted{resume}", file=sys.stderr)
+        return 130
     except ValueError as exc:
         print(f"pamdp {args.command}: error: {exc}", file=sys.stderr)
         return 2

@@ -4,11 +4,15 @@ batched or stepped in turn, and the spaces of whatever a user passed (an id, an 
 from __future__ import annotations
 
 import importlib
+import inspect
+import typing
 
 import gymnasium
 from gymnasium import spaces
 
-__all__ = ["env_spec", "make_vector_env", "describe_env", "AUTO_BATCH_MIN"]
+from pamdp.algos.settings import type_name, type_ok
+
+__all__ = ["env_spec", "env_creator", "check_env_kwargs", "make_vector_env", "describe_env", "AUTO_BATCH_MIN"]
 
 # A batched env steps its copies in one compiled loop and beats scalar copies stepped in turn from two copies on
 # (benchmarks/platform_speed.md, benchmarks/hfo_speed.md); a single copy is scalar.
@@ -58,10 +62,51 @@ def make_vector_env(
     return gymnasium.make_vec(env_id, num_envs=num_envs, vectorization_mode=vectorization_mode, **(env_kwargs or {}))
 
 
+def env_creator(env_id: str):
+    """The class (or function) that makes a registered env; an unregistered id is refused with a ``ValueError``
+    (see :func:`env_spec`)."""
+    creator = env_spec(env_id).entry_point
+    return gymnasium.envs.registration.load_env_creator(creator) if isinstance(creator, str) else creator
+
+
+def check_env_kwargs(env_id: str, env_kwargs: dict) -> None:
+    """Refuse env arguments that the env's constructor does not take, or whose type differs from its annotation
+    (or its default's type, where it has none): ``{"deterministic": "no"}`` would otherwise switch the option on.
+
+    An unregistered ``env_id`` is refused too (see :func:`env_spec`).
+    """
+    if not env_kwargs:
+        env_creator(env_id)
+        return
+    creator = env_creator(env_id)
+    try:
+        params = inspect.signature(creator).parameters
+    except (TypeError, ValueError):  # a callable without a signature: nothing to check against
+        return
+    try:
+        hints = typing.get_type_hints(creator.__init__ if inspect.isclass(creator) else creator)
+    except (NameError, TypeError):  # annotations naming what cannot be imported: the defaults still say
+        hints = {}
+    takes_any = any(p.kind is inspect.Parameter.VAR_KEYWORD for p in params.values())
+    named = {n: p for n, p in params.items() if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)}
+    for name, value in env_kwargs.items():
+        if name not in named:
+            if takes_any:
+                continue
+            raise ValueError(
+                f"env {env_id!r} takes no argument {name!r}; expected some of {', '.join(sorted(named)) or 'none'}"
+            )
+        default = named[name].default
+        hint = hints.get(name, type(default) if default not in (inspect.Parameter.empty, None) else None)
+        if hint is not None and not type_ok(value, hint):
+            raise ValueError(f"env {env_id!r} argument {name} = {value!r}; expected {type_name(hint)}")
+
+
 def describe_env(env, env_kwargs: dict | None = None) -> tuple[str | None, dict, spaces.Space, spaces.Space]:
     """``(env_id, env_kwargs, single observation space, single action space)`` of what a user passed."""
     if isinstance(env, str):
         spec = env_spec(env)
+        check_env_kwargs(env, env_kwargs or {})
         probe = gymnasium.make(env, **(env_kwargs or {}))
         obs_space, act_space = probe.observation_space, probe.action_space
         probe.close()

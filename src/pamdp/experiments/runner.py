@@ -16,7 +16,6 @@ import contextlib
 import csv
 import dataclasses
 import fcntl
-import inspect
 import json
 import multiprocessing
 import os
@@ -24,20 +23,17 @@ import socket
 import sys
 import time
 import traceback
-import typing
 from pathlib import Path
 from typing import Any
 
 from pamdp.algos import ALGORITHMS, DEFAULT_PRESET, algorithm_class, default_preset
-from pamdp.algos.settings import type_name, type_ok
+from pamdp.algos.vector_env import check_env_kwargs
 
 __all__ = [
     "RunSpec",
     "default_preset",
     "train_run",
     "run_lock",
-    "check_env_kwargs",
-    "env_creator",
     "is_finished",
     "run_all",
     "algorithm_class",
@@ -78,51 +74,6 @@ class RunSpec:
         needs before anything is written."""
         check_env_kwargs(self.env, dict(self.env_kwargs))
         return self.config()
-
-
-def env_creator(env_id: str):
-    """The class (or function) that makes a registered env; an unregistered id is refused with a ``ValueError``
-    (see :func:`pamdp.algos.vector_env.env_spec`)."""
-    import gymnasium
-
-    import pamdp  # noqa: F401  (registers pamdp's envs)
-    from pamdp.algos.vector_env import env_spec
-
-    creator = env_spec(env_id).entry_point
-    return gymnasium.envs.registration.load_env_creator(creator) if isinstance(creator, str) else creator
-
-
-def check_env_kwargs(env_id: str, env_kwargs: dict) -> None:
-    """Refuse env arguments that the env's constructor does not take, or whose type differs from its annotation
-    (or its default's type, where it has none): ``{"deterministic": "no"}`` would otherwise switch the option on.
-
-    An unregistered ``env_id`` is refused too (see :func:`pamdp.algos.vector_env.env_spec`).
-    """
-    if not env_kwargs:
-        env_creator(env_id)
-        return
-    creator = env_creator(env_id)
-    try:
-        params = inspect.signature(creator).parameters
-    except (TypeError, ValueError):  # a callable without a signature: nothing to check against
-        return
-    try:
-        hints = typing.get_type_hints(creator.__init__ if inspect.isclass(creator) else creator)
-    except (NameError, TypeError):  # annotations naming what cannot be imported: the defaults still say
-        hints = {}
-    takes_any = any(p.kind is inspect.Parameter.VAR_KEYWORD for p in params.values())
-    named = {n: p for n, p in params.items() if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)}
-    for name, value in env_kwargs.items():
-        if name not in named:
-            if takes_any:
-                continue
-            raise ValueError(
-                f"env {env_id!r} takes no argument {name!r}; expected some of {', '.join(sorted(named)) or 'none'}"
-            )
-        default = named[name].default
-        hint = hints.get(name, type(default) if default not in (inspect.Parameter.empty, None) else None)
-        if hint is not None and not type_ok(value, hint):
-            raise ValueError(f"env {env_id!r} argument {name} = {value!r}; expected {type_name(hint)}")
 
 
 @contextlib.contextmanager
