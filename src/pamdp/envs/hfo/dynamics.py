@@ -112,8 +112,8 @@ TRIG_BODY, COS_BODY, SIN_BODY = range(38, 41)
 STATE_SIZE = 41
 
 # --- Settings vector (built by :func:`settings`) -----------------------------------------------
-_PLAYER_RAND, _BALL_RAND, _KICK_RAND, _N_FEATURES, _MAX_DIST, _OOB_X, _OOB_Y = range(7)
-_TIMEOUT_TERMINAL, _TERMINAL_DELTAS, _FIRST_STEP_REWARD, _UNIFORM_BODY = range(7, 11)
+_PLAYER_RAND, _BALL_RAND, _KICK_RAND, _MAX_DIST, _OOB_X, _OOB_Y = range(6)
+_TIMEOUT_TERMINAL, _TERMINAL_DELTAS, _FIRST_STEP_REWARD, _UNIFORM_BODY = range(6, 10)
 
 
 @dataclass(frozen=True)
@@ -170,7 +170,7 @@ def settings(
     """The settings vector the compiled functions read: noise levels, the feature profile, the reward's flags."""
     noise = (0.0, 0.0, 0.0) if deterministic else (PLAYER_RAND, BALL_RAND, KICK_RAND)
     return np.array(
-        [*noise, profile.n_features, profile.max_dist, profile.oob_x, profile.oob_y,
+        [*noise, profile.max_dist, profile.oob_x, profile.oob_y,
          timeout_terminal, terminal_deltas, first_step_reward, uniform_body],
         dtype=np.float64,
     )  # fmt: skip
