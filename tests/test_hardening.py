@@ -228,7 +228,7 @@ def test_a_finished_run_is_not_retrained_to_a_smaller_budget(trained, tmp_path, 
     run = copy_of(trained, tmp_path)
     evaluation = (run / "evaluation.json").read_bytes()
     argv = ["train", "patrpo", "--total-steps", "500", "--out", str(run), "--eval-episodes", "3", *TINY]
-    assert "more than the 500 asked; give a budget of at least 1,000 steps" in refusal(argv, capsys)
+    assert "more than the 500 asked; give its own budget of 1,000 steps to resume or skip it" in refusal(argv, capsys)
     assert (run / "evaluation.json").read_bytes() == evaluation
 
 
@@ -266,6 +266,17 @@ def test_a_refused_run_leaves_nothing_behind(extra, expected, tmp_path, capsys):
     extra = [e.replace("{file}", str(tmp_path / "file")) for e in extra]
     argv = ["train", "patrpo", "--total-steps", "300", "--out", str(tmp_path / "runs" / "r"), *extra, *TINY]
     assert expected.replace("{file}", str(tmp_path / "file")) in refusal(argv, capsys)
+    assert sorted(os.listdir(tmp_path)) == ["file"]
+
+
+@pytest.mark.parametrize("command", ["reproduce", "plot"])
+def test_an_output_directory_under_a_file_is_refused_in_one_line(command, trained, tmp_path, capsys):
+    (tmp_path / "file").write_text("")
+    out = str(tmp_path / "file" / "results")
+    argv = ["reproduce", "step-size", "--scale", "0.0001", "--seeds", "0", "--out", out]
+    assert str(tmp_path / "file") in refusal(
+        argv if command == "reproduce" else ["plot", str(trained), "--out", out], capsys
+    )
     assert sorted(os.listdir(tmp_path)) == ["file"]
 
 

@@ -328,6 +328,9 @@ def cmd_reproduce(args) -> int:
     from pamdp.experiments.plots import write_report
 
     exp = load_experiment(args.name)
+    file = next((p for p in (Path(args.out), *Path(args.out).parents) if p.exists() and not p.is_dir()), None)
+    if file is not None:  # else every run would fail alike, each with its traceback
+        raise ValueError(f"--out {args.out}: {file} is a file; expected a results directory (new, or one to go on in)")
     seeds = args.seeds
     labels = args.runs
     jobs = [(spec, str(exp.run_dir(args.out, spec))) for spec in exp.specs(seeds, args.scale, labels)]

@@ -229,8 +229,8 @@ def _prepare(spec: RunSpec, out: str | os.PathLike, log=print) -> tuple[Any, dic
         if model.num_timesteps > spec.total_steps:  # training cannot be undone; its evaluation stays as it is
             raise ValueError(
                 f"{out} holds a run trained for {model.num_timesteps:,} steps, more than the {spec.total_steps:,} "
-                f"asked; give a budget of at least {as_written.get('total_steps', model.num_timesteps):,} steps "
-                "(more extends the run) or use another output directory"
+                f"asked; give its own budget of {as_written.get('total_steps', model.num_timesteps):,} steps to "
+                "resume or skip it (more extends it), or use another output directory"
             )
         log(f"resuming {out} at step {model.num_timesteps:,} of {spec.total_steps:,}")
     else:
