@@ -122,6 +122,16 @@ def test_stochastic_evaluation_is_labelled_stochastic(trained, capsys):
     assert capsys.readouterr().out.startswith("greedy return over 4 episodes")
 
 
+def test_evaluate_seeds_its_env_as_train_does_unless_told(trained, capsys):
+    """docs/cli.md: ``--seed`` defaults to 10000 + the training seed (0 here), the seed of train's own evaluation."""
+    results = []
+    for extra in ([], ["--seed", "10000"], ["--seed", "3"]):
+        capsys.readouterr()
+        assert main(["evaluate", str(trained), "--episodes", "6", "--stochastic", "--json", *extra]) == 0
+        results.append(json.loads(capsys.readouterr().out))
+    assert results[0] == results[1] and results[0] != results[2]
+
+
 @pytest.mark.parametrize(
     "kwargs, expected",
     [
