@@ -29,7 +29,8 @@ class _Rounds:
         self.mirror = _Mirror(None, self.out, attempt, run_dir)
 
     def send(self) -> bool:
-        return self.inbox.write(self.out, self.mirror.attempt, self.mirror._scan())
+        self.sent = self.mirror._scan()
+        return self.inbox.write(self.out, self.mirror.attempt, self.sent)
 
 
 def _tree(directory: Path) -> list[Path]:
@@ -57,6 +58,12 @@ def test_the_driver_copy_follows_rewrites_and_appends_and_refuses_an_older_attem
             f.write(f"epoch {epoch}\n")
         assert a.send()
         _same_files(first, out)
+        if epoch > 1:  # the logs go as their new tails, the checkpoint whole
+            assert sorted(a.sent) == [
+                ("checkpoint.pt", 0, bytes([epoch]) * (100 - epoch)),
+                ("stdout.log", 8 * (epoch - 1), f"epoch {epoch}\n".encode()),
+                ("tb/events.1", 9 * (epoch - 1), f"scalar {epoch};".encode()),
+            ]
     assert "on worker" not in (out / ".lock").read_text(), "the worker's lock file stays on the worker"
     sent = a.mirror._scan()
     assert sent == [], "nothing changed, nothing to send"
