@@ -8,7 +8,7 @@ measured ``--repeats`` times:
   learning at the preset's update-to-data ratio (``learn()``'s own loop).
 
 Times are the worker process's CPU time (``time.process_time``, one torch thread), so other jobs on a shared
-machine slow the figures less than they would a wall clock. The row "paper, autograd update" runs PASVG(0)'s
+machine slow the figures less than they would a wall clock. The row "paper (autograd update)" runs PASVG(0)'s
 paper preset on its autograd update instead of the hand-written one (``_dense = None``), which says whether
 the hand-written update still pays.
 
@@ -39,7 +39,7 @@ from pathlib import Path
 # (algorithm, preset, settings on top of the preset, label)
 CASES = [
     ("PASVG0", "paper", {}, "paper"),
-    ("PASVG0", "paper", {"autograd": True}, "paper, autograd update"),
+    ("PASVG0", "paper", {"autograd": True}, "paper (autograd update)"),
     ("PASVG0", "tuned", {}, "tuned"),
     ("PADDPG", "paper", {}, "paper"),
     ("PADDPG", "hausknecht_stone", {}, "hausknecht_stone"),
