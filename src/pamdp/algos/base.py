@@ -34,7 +34,36 @@ from pamdp.spaces import HybridActionSpace
 if TYPE_CHECKING:
     from typing_extensions import Self  # typing.Self from Python 3.11
 
-__all__ = ["Algorithm"]
+__all__ = ["Algorithm", "resolve_device"]
+
+
+def resolve_device(name: str) -> torch.device:
+    """The torch device a ``device`` setting names on this machine: ``"auto"`` is CUDA when available, else the
+    CPU; CUDA asked for where there is none (or a ``cuda:N`` beyond the GPUs there are) is a ``ValueError``."""
+    if name == "auto":
+        return torch.device("cuda" if torch.cuda.is_available() else "cpu")
+    device = torch.device(name)
+    if device.type == "cuda":
+        if not torch.cuda.is_available():
+            raise ValueError(
+                f"device = {name!r}, but CUDA is not available on this machine (torch {torch.__version__}); "
+                "expected 'auto' or 'cpu' here"
+            )
+        if device.index is not None and device.index >= torch.cuda.device_count():
+            raise ValueError(
+                f"device = {name!r}, but this machine has {torch.cuda.device_count()} CUDA device(s); "
+                f"expected 'cuda' or 'cuda:N' with N < {torch.cuda.device_count()}"
+            )
+    return device
+
+
+def _available(name: str) -> bool:
+    """Whether a ``device`` setting can be had on this machine."""
+    try:
+        resolve_device(name)
+    except ValueError:
+        return False
+    return True
 
 
 def _count(name: str, value: object, low: int) -> int:
@@ -71,13 +100,17 @@ class Algorithm:
         self.action_space = act_space
         self.hybrid = HybridActionSpace.from_gym(act_space)
         self.obs_dim = int(obs_space.shape[0])
+        self.device = resolve_device(config.device)
         self.num_timesteps = 0
         self.epoch = 0
         self.np_rng = np.random.default_rng(config.seed)
-        self.torch_gen = torch.Generator().manual_seed(config.seed)
+        # on the device, so that sampling there draws there; on the CPU the same stream as ever
+        self.torch_gen = torch.Generator(device=self.device).manual_seed(config.seed)
         with torch.random.fork_rng():
             torch.manual_seed(config.seed)
-            self._build()
+            self._build()  # on the CPU: the same initial weights whatever the device
+        for module in self._modules().values():
+            module.to(self.device)  # in place: the optimisers built beside them keep their parameters
         self._vec_env: gymnasium.vector.VectorEnv | None = None
 
     # -- to be provided by each algorithm ----------------------------------------------------
@@ -124,8 +157,12 @@ class Algorithm:
                 raise ValueError(f"vector env with autoreset mode {mode!r}; pamdp expects {AutoresetMode.NEXT_STEP!r}")
         return self._vec_env
 
+    def _from_numpy(self, array: np.ndarray) -> torch.Tensor:
+        """``array`` as a tensor on the algorithm's device (the same memory on the CPU)."""
+        return torch.from_numpy(array).to(self.device)
+
     def _obs_tensor(self, obs) -> torch.Tensor:
-        return torch.as_tensor(np.asarray(obs, dtype=np.float32))
+        return torch.as_tensor(np.asarray(obs, dtype=np.float32), device=self.device)
 
     # -- public API --------------------------------------------------------------------------
     def predict(self, obs, deterministic: bool = True):
@@ -147,8 +184,8 @@ class Algorithm:
                 f"observation with a non-finite value {obs[tuple(where)]} at index {where}; expected numbers"
             )
         with torch.no_grad():
-            a, x = self._act(torch.as_tensor(obs.reshape(-1, self.obs_dim)), deterministic)
-        a, x = a.numpy(), x.numpy()
+            a, x = self._act(self._obs_tensor(obs.reshape(-1, self.obs_dim)), deterministic)
+        a, x = a.cpu().numpy(), x.cpu().numpy()
         return self.hybrid.to_env(a[0], x[0]) if single else self.hybrid.to_env_batch(a, x)
 
     def learn(
@@ -253,7 +290,11 @@ class Algorithm:
             "env_kwargs": self.env_kwargs,
             "num_timesteps": self.num_timesteps,
             "epoch": self.epoch,
-            "rng": {"numpy": self.np_rng.bit_generator.state, "torch": self.torch_gen.get_state()},
+            "rng": {
+                "numpy": self.np_rng.bit_generator.state,
+                "torch": self.torch_gen.get_state(),
+                "torch_device": self.device.type,
+            },
             "modules": {k: m.state_dict() for k, m in self._modules().items()},
             "optimizers": {k: o.state_dict() for k, o in self._optimizers().items()},
             "extra": self._extra_state(replay),
@@ -261,19 +302,24 @@ class Algorithm:
         atomic_save(payload, path)
 
     @classmethod
-    def load(cls, path: str | os.PathLike, env=None) -> Self:
+    def load(cls, path: str | os.PathLike, env=None, device: str | None = None) -> Self:
         """Load a model saved by :meth:`save`, or the final model of a run directory written by ``pamdp train``.
 
-        ``env`` (an id, env or vector env) replaces the env recorded in the file.
+        ``env`` (an id, env or vector env) replaces the env recorded in the file. ``device`` (a ``device``
+        setting) is where the model goes; by default the saved setting where this machine has it, else the CPU,
+        so a model trained on a GPU loads on a machine without one.
         """
         payload = read_checkpoint(path)
         if payload["algo"] != cls.__name__:
             raise ValueError(f"{path} holds a {payload['algo']} model, not a {cls.__name__} one")
-        return cls._from_payload(payload, env)
+        return cls._from_payload(payload, env, device)
 
     @classmethod
-    def _from_payload(cls, payload: dict, env=None) -> Self:
+    def _from_payload(cls, payload: dict, env=None, device: str | None = None) -> Self:
         config = cls.config_class.from_dict(payload["config"])
+        if device is None:
+            device = config.device if _available(config.device) else "cpu"
+        config = cls.config_class.from_dict({"device": device}, base=config)
         if env is None:
             if payload["env_id"] is None:
                 raise ValueError("this model was trained on an unregistered env; pass env= to load it")
@@ -289,5 +335,8 @@ class Algorithm:
         algo.num_timesteps = int(payload["num_timesteps"])
         algo.epoch = int(payload["epoch"])
         algo.np_rng.bit_generator.state = payload["rng"]["numpy"]
-        algo.torch_gen.set_state(payload["rng"]["torch"])
+        # a generator's state is the device's own kind (the CPU's Mersenne Twister, CUDA's Philox): a model moved
+        # to another kind of device keeps the seed's fresh stream there
+        if payload["rng"].get("torch_device", "cpu") == algo.device.type:
+            algo.torch_gen.set_state(payload["rng"]["torch"])
         return algo

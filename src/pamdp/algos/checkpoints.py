@@ -83,7 +83,8 @@ def _load_failure(exc: Exception) -> str:
 
 
 def read_checkpoint(path: str | os.PathLike) -> dict:
-    """Read a checkpoint with ``weights_only=True``; a file that is not one raises a clear ``ValueError``."""
+    """Read a checkpoint with ``weights_only=True``, its tensors on the CPU (whatever device saved them, so a model
+    trained on a GPU reads where there is none); a file that is not one raises a clear ``ValueError``."""
     path = _resolve_model_path(path)
     try:
         payload = torch.load(path, map_location="cpu", weights_only=True)
@@ -97,11 +98,12 @@ def read_checkpoint(path: str | os.PathLike) -> dict:
     return payload
 
 
-def load_model(path: str | os.PathLike, env=None):
-    """Load any pamdp model (file or run directory), whichever of the registered algorithms wrote it."""
+def load_model(path: str | os.PathLike, env=None, device: str | None = None):
+    """Load any pamdp model (file or run directory), whichever of the registered algorithms wrote it, onto
+    ``device`` (as :meth:`Algorithm.load <pamdp.algos.base.Algorithm.load>` chooses it by default)."""
     payload = read_checkpoint(path)
     name = payload["algo"]
     cls = class_named(name)
     if cls is None:
         raise ValueError(f"{path} was written by unknown algorithm {name!r}; expected one of {', '.join(MODULE_OF)}")
-    return cls._from_payload(payload, env)
+    return cls._from_payload(payload, env, device)

@@ -248,7 +248,7 @@ class ActionRepresentation(nn.Module):
         """The representation loss on a batch, and its three terms (reconstruction, KL, state change) as floats."""
         mean, log_std = self.encode(obs, a, x)
         std = log_std.exp()
-        eps = torch.randn(mean.shape, generator=generator, dtype=mean.dtype)
+        eps = torch.randn(mean.shape, generator=generator, dtype=mean.dtype, device=mean.device)
         h = self._trunk(obs, a, mean + std * eps)
         mask = self.mask[a]
         recon = ((torch.tanh(self.param_head(h)) - x) ** 2 * mask).sum(-1).mean()
@@ -260,7 +260,7 @@ class ActionRepresentation(nn.Module):
 
 def latent_bounds(latents: torch.Tensor, percent: float) -> tuple[torch.Tensor, torch.Tensor]:
     """Per dimension, the ``(50 -+ percent / 2)``-th percentiles of ``latents`` (N, D): the central ``percent`` %."""
-    q = torch.tensor([0.5 - percent / 200.0, 0.5 + percent / 200.0], dtype=latents.dtype)
+    q = torch.tensor([0.5 - percent / 200.0, 0.5 + percent / 200.0], dtype=latents.dtype, device=latents.device)
     low, high = torch.quantile(latents, q, dim=0)
     return low, torch.maximum(high, low + 1e-6)
 
@@ -320,7 +320,7 @@ class HyAR(Algorithm):
             h.max_param_size,
             latent=((self.latent_size,), np.float32),  # the latent action that was decoded and executed
         )
-        self.replay = ReplayBuffer(cfg.buffer_size, fields)
+        self.replay = ReplayBuffer(cfg.buffer_size, fields, self.device)
         self.loop = OffPolicyLoop(cfg, h, self.replay)
         self.pretrained = False  # the warm-up round of representation training is done
         self.n_updates = 0  # TD3 updates so far (the policy delay and the representation rounds count them)
@@ -359,24 +359,24 @@ class HyAR(Algorithm):
 
     def _noisy(self, u: torch.Tensor) -> torch.Tensor:
         noise = self.np_rng.normal(0.0, self.config.exploration_noise, size=u.shape).astype(np.float32)
-        return (u + torch.from_numpy(noise)).clamp(-1.0, 1.0)
+        return (u + self._from_numpy(noise)).clamp(-1.0, 1.0)
 
     def _explore(self, obs: torch.Tensor, step: int, episode_start: np.ndarray):
         if step < self.config.warmup_steps:  # uniformly random hybrid actions; latents are filled in after warm-up
             n, h = len(obs), self.hybrid
-            a = torch.from_numpy(self.np_rng.integers(h.n_actions, size=n))
+            a = self._from_numpy(self.np_rng.integers(h.n_actions, size=n))
             x = self.np_rng.uniform(-1.0, 1.0, size=(n, h.max_param_size)).astype(np.float32)
-            x = torch.from_numpy(x) * self.rep.mask[a]
+            x = self._from_numpy(x) * self.rep.mask[a]
             return a, x, {"latent": np.zeros((n, self.latent_size), dtype=np.float32)}
         latent = self.actor.to_latent(self._noisy(self.actor(obs).clamp(-1.0, 1.0)))
         eps = self.epsilon(step)
         if eps > 0:  # a uniformly drawn action's embedding in place of the actor's, the parameters' latent kept
-            drawn = torch.from_numpy(self.np_rng.random(len(obs)) < eps)
-            k = torch.from_numpy(self.np_rng.integers(self.hybrid.n_actions, size=len(obs)))
+            drawn = self._from_numpy(self.np_rng.random(len(obs)) < eps)
+            k = self._from_numpy(self.np_rng.integers(self.hybrid.n_actions, size=len(obs)))
             e = torch.where(drawn[:, None], self.rep.embedding[k], latent[:, : self.config.embed_dim])
             latent = torch.cat([e, latent[:, self.config.embed_dim :]], dim=-1)
         a, x = self.rep.decode(obs, latent)
-        return a, x, {"latent": latent.numpy()}
+        return a, x, {"latent": latent.cpu().numpy()}
 
     def epsilon(self, step: int) -> float:
         """The chance of a drawn embedding after ``step`` samples: linear from epsilon_start to epsilon_end."""
@@ -435,8 +435,8 @@ class HyAR(Algorithm):
         n, data = len(self.replay), self.replay.data
         for start in range(0, n, 4096):
             s = slice(start, min(n, start + 4096))
-            obs, a, x = (torch.from_numpy(data[k][s]) for k in ("obs", "a", "x"))
-            data["latent"][s] = self.rep.latent(obs, a, x).numpy()
+            obs, a, x = (self._from_numpy(data[k][s]) for k in ("obs", "a", "x"))
+            data["latent"][s] = self.rep.latent(obs, a, x).cpu().numpy()
 
     @torch.no_grad()
     def relabel(self, b: dict[str, torch.Tensor]) -> tuple[torch.Tensor, float]:
@@ -473,7 +473,7 @@ class HyAR(Algorithm):
         latent, relabelled = self.relabel(b)
         with torch.no_grad():
             u_next = self.actor_target(next_obs).clamp(-1.0, 1.0)
-            noise = torch.randn(u_next.shape, generator=self.torch_gen) * cfg.target_noise
+            noise = torch.randn(u_next.shape, generator=self.torch_gen, device=self.device) * cfg.target_noise
             u_next = (u_next + noise.clamp(-cfg.target_noise_clip, cfg.target_noise_clip)).clamp(-1.0, 1.0)
             q1_next, q2_next = self.critic_target(next_obs, self.actor_target.to_latent(u_next))
             y = b["reward"] + cfg.gamma * (~b["terminated"]).float() * torch.minimum(q1_next, q2_next)

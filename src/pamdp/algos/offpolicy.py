@@ -339,9 +339,11 @@ class OffPolicyLoop:
         n_updates = n_valid = 0
         while n_valid < n_samples:
             obs = np.asarray(self.obs, dtype=np.float32)
-            with torch.no_grad():
-                a, x, extras = act(torch.from_numpy(obs), start_step + n_valid, self.episode_start)
-            a, x = a.numpy(), x.numpy()
+            with torch.no_grad():  # the observations to the algorithm's device, the actions back
+                a, x, extras = act(
+                    torch.from_numpy(obs).to(self.buffer.device), start_step + n_valid, self.episode_start
+                )
+            a, x = a.cpu().numpy(), x.cpu().numpy()
             next_obs, reward, terminated, truncated, info = self.env.step(self.hybrid.to_env_batch(a, x))
             valid = ~self.prev_done
             done = (terminated | truncated) & valid

@@ -71,8 +71,11 @@ class Rollout:
     ) -> dict[str, np.ndarray]:
         """Step ``env`` with ``(a, x) ~ policy`` until ``n_samples`` valid samples; ``(T, N, ...)`` arrays of
         :attr:`KEYS` (``t``: the step within the episode; ``terminated`` and ``done`` are false when not valid).
+
+        The policy runs on ``torch_gen``'s device (the algorithm's) and the env on the CPU: a step moves the
+        observations there and the actions back, nothing else.
         """
-        n = env.num_envs
+        n, device = env.num_envs, torch_gen.device
         if self.state is None:
             obs, _ = env.reset(seed=int(np_rng.integers(2**31 - 1)))
             self.state = (obs, np.zeros(n, dtype=bool), np.zeros(n, dtype=np.int64))
@@ -82,11 +85,12 @@ class Rollout:
         n_valid = 0
         while n_valid < n_samples:
             with torch.no_grad():
-                a, x = policy(torch.as_tensor(np.asarray(obs, dtype=np.float32))).sample(torch_gen)
-            next_obs, reward, terminated, truncated, info = env.step(hybrid.to_env_batch(a.numpy(), x.numpy()))
+                a, x = policy(torch.as_tensor(np.asarray(obs, dtype=np.float32), device=device)).sample(torch_gen)
+            a, x = a.cpu().numpy(), x.cpu().numpy()
+            next_obs, reward, terminated, truncated, info = env.step(hybrid.to_env_batch(a, x))
             valid = ~prev_done
             done = (terminated | truncated) & valid
-            row = (obs, a.numpy(), x.numpy(), reward, terminated & valid, done, valid, next_obs, t_ep)
+            row = (obs, a, x, reward, terminated & valid, done, valid, next_obs, t_ep)
             for k, v in zip(self.KEYS, row):
                 rows[k].append(np.array(v))
             self.tracker.step(np.asarray(reward, dtype=np.float64), done, valid, info)
@@ -138,21 +142,25 @@ def advantage_batch(
     return data, explained_var
 
 
-def update_tensors(data: dict[str, np.ndarray]) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
-    """The policy update's tensors ``(obs, a, x, adv)`` of an :func:`advantage_batch` (observations and
-    advantages in float32, the networks' precision)."""
+def update_tensors(
+    data: dict[str, np.ndarray], device: torch.device | str = "cpu"
+) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
+    """The policy update's tensors ``(obs, a, x, adv)`` of an :func:`advantage_batch` on ``device`` (observations
+    and advantages in float32, the networks' precision)."""
     return (
-        torch.as_tensor(np.asarray(data["obs"], dtype=np.float32)),
-        torch.as_tensor(data["a"]),
-        torch.as_tensor(data["x"]),
-        torch.as_tensor(data["adv"], dtype=torch.float32),
+        torch.as_tensor(np.asarray(data["obs"], dtype=np.float32), device=device),
+        torch.as_tensor(data["a"], device=device),
+        torch.as_tensor(data["x"], device=device),
+        torch.as_tensor(data["adv"], dtype=torch.float32, device=device),
     )
 
 
 def network_values(value: torch.nn.Module, obs: np.ndarray) -> np.ndarray:
-    """A value network's ``V(s)`` of a batch of observations, as float64 for GAE."""
+    """A value network's ``V(s)`` of a batch of observations (computed on the network's device), as float64 for
+    GAE."""
+    device = next(value.parameters()).device
     with torch.no_grad():
-        return value(torch.as_tensor(np.asarray(obs, dtype=np.float32))).double().numpy()
+        return value(torch.as_tensor(np.asarray(obs, dtype=np.float32), device=device)).double().cpu().numpy()
 
 
 class LinearFeatureBaseline:

@@ -177,7 +177,7 @@ class PADDPG(Algorithm):
             mc_returns=cfg.beta > 0,  # the loop fills them only when asked to compute Monte-Carlo returns
             out=((self.out_size,), np.float32),  # the output vector the critic sees (after exploration)
         )
-        self.replay = ReplayBuffer(cfg.buffer_size, fields)
+        self.replay = ReplayBuffer(cfg.buffer_size, fields, self.device)
         self.loop = OffPolicyLoop(cfg, h, self.replay, mc_returns=cfg.beta > 0, tail_value=self._target_value)
         self._ou = OUNoise(cfg.ou_theta, cfg.ou_sigma)
 
@@ -218,7 +218,7 @@ class PADDPG(Algorithm):
     def _epsilon_greedy(self, out: torch.Tensor, eps: float) -> torch.Tensor:
         random = self.np_rng.random(len(out)) < eps
         uniform = self.np_rng.uniform(-1.0, 1.0, size=out.shape).astype(np.float32)
-        return torch.where(torch.from_numpy(random)[:, None], torch.from_numpy(uniform), out)
+        return torch.where(self._from_numpy(random)[:, None], self._from_numpy(uniform), out)
 
     def _explore(self, obs: torch.Tensor, step: int, episode_start: np.ndarray):
         cfg = self.config
@@ -226,16 +226,16 @@ class PADDPG(Algorithm):
         if cfg.ou_sigma > 0:
             ou = self._ou((len(obs), self.out_size - self.hybrid.n_actions), episode_start, self.np_rng)
             noise = np.concatenate([np.zeros((len(obs), self.hybrid.n_actions)), ou], axis=1)
-            out = out + torch.from_numpy(noise.astype(np.float32))
+            out = out + self._from_numpy(noise.astype(np.float32))
         out = self._epsilon_greedy(out.clamp(-1.0, 1.0), self.epsilon(step))
         a, x = self.actor.action(out)
-        return a, x, {"out": out.numpy()}
+        return a, x, {"out": out.cpu().numpy()}
 
     def _target_value(self, obs: np.ndarray) -> np.ndarray:
         """``Q'(s, mu'(s))``, the bootstrap of a truncated episode's Monte-Carlo return."""
         with torch.no_grad():
-            o = torch.from_numpy(obs)
-            return self.critic_target(o, self.actor_target(o).clamp(-1.0, 1.0)).numpy()
+            o = self._from_numpy(obs)
+            return self.critic_target(o, self.actor_target(o).clamp(-1.0, 1.0)).cpu().numpy()
 
     def _run_epoch(self) -> dict[str, float]:
         stats = self.loop.run_epoch(self.vec_env, self._explore, self._update, self.num_timesteps, self.np_rng)

@@ -193,7 +193,8 @@ class PAPPO(Algorithm):
         )
         data, explained_var = advantage_batch(batch, self._values, cfg.gamma, cfg.gae_lambda, cfg.normalize_advantages)
         with subnormals_flushed(cfg.flush_denormal):
-            stats = self._update(*update_tensors(data), torch.as_tensor(data["returns"], dtype=torch.float32))
+            returns = torch.as_tensor(data["returns"], dtype=torch.float32, device=self.device)
+            stats = self._update(*update_tensors(data, self.device), returns)
         stats.update(self.rollout.epoch_stats(data["a"], self.hybrid.n_actions, explained_var))
         return stats
 
@@ -209,7 +210,8 @@ class PAPPO(Algorithm):
         sums: dict[str, float] = {}
         updates, stopped_at_kl = 0, False
         for _ in range(cfg.n_epochs):
-            for idx in torch.tensor_split(torch.randperm(n, generator=self.torch_gen), n_minibatches):
+            perm = torch.randperm(n, generator=self.torch_gen, device=self.device)
+            for idx in torch.tensor_split(perm, n_minibatches):
                 dist = self.policy(obs[idx])
                 if cfg.target_kl > 0:
                     with torch.no_grad():

@@ -173,7 +173,7 @@ class PASVG0Config(OffPolicyConfig, AlgoConfig):
 
 def gumbel_noise(shape: tuple[int, ...], generator: torch.Generator) -> torch.Tensor:
     """Standard Gumbel samples ``-log(-log U)`` from ``generator`` (torch's own sampler uses the global RNG)."""
-    u = torch.rand(shape, generator=generator).clamp_(1e-10, 1.0 - 1e-7)
+    u = torch.rand(shape, generator=generator, device=generator.device).clamp_(1e-10, 1.0 - 1e-7)
     return -torch.log(-torch.log(u))
 
 
@@ -238,8 +238,8 @@ class GumbelHybridPolicy(nn.Module):
         ``critic(obs_k, onehots, x)`` is ``Q(s, k, x_k)`` for every ``k`` in one batched pass.
         """
         batch, K = len(obs), self.n_actions
-        index = torch.arange(K).expand(batch, K)
-        onehots = torch.eye(K, dtype=obs.dtype).expand(batch, K, K)
+        index = torch.arange(K, device=obs.device).expand(batch, K)
+        onehots = torch.eye(K, dtype=obs.dtype, device=obs.device).expand(batch, K, K)
         obs_k = obs.unsqueeze(-2).expand(batch, K, obs.shape[-1])
         return obs_k, onehots, self.params(obs_k, index, onehots, eta_x.unsqueeze(-2))
 
@@ -338,7 +338,7 @@ class PASVG0(Algorithm):
             eta_a=((K,), np.float32),
             eta_x=((m,), np.float32),
         )
-        self.replay = ReplayBuffer(cfg.buffer_size, fields)
+        self.replay = ReplayBuffer(cfg.buffer_size, fields, self.device)
         self.loop = OffPolicyLoop(cfg, h, self.replay)
         self._bind_networks()
 
@@ -388,7 +388,7 @@ class PASVG0(Algorithm):
 
     def _noise(self, batch: int) -> tuple[torch.Tensor, torch.Tensor]:
         eta_a = gumbel_noise((batch, self.hybrid.n_actions), self.torch_gen)
-        eta_x = torch.randn((batch, self.hybrid.max_param_size), generator=self.torch_gen)
+        eta_x = torch.randn((batch, self.hybrid.max_param_size), generator=self.torch_gen, device=self.device)
         return eta_a, eta_x
 
     def _act(self, obs, deterministic):
@@ -403,13 +403,13 @@ class PASVG0(Algorithm):
         index, a_in, x = self.policy(obs, eta_a, eta_x, cfg.temperature, cfg.straight_through)
         if cfg.explore_epsilon > 0:  # drawn only when on, so that the paper's preset keeps its random stream
             n, K = len(obs), self.hybrid.n_actions
-            flip = torch.rand(n, generator=self.torch_gen) < cfg.explore_epsilon
-            uniform = torch.randint(K, (n,), generator=self.torch_gen)
+            flip = torch.rand(n, generator=self.torch_gen, device=self.device) < cfg.explore_epsilon
+            uniform = torch.randint(K, (n,), generator=self.torch_gen, device=self.device)
             onehot = F.one_hot(uniform, K).to(a_in.dtype)
             index = torch.where(flip, uniform, index)
             a_in = torch.where(flip[:, None], onehot, a_in)
             x = torch.where(flip[:, None], self.policy.params(obs, uniform, onehot, eta_x), x)
-        return index, x, {"a_in": a_in.numpy(), "eta_a": eta_a.numpy(), "eta_x": eta_x.numpy()}
+        return index, x, {"a_in": a_in.cpu().numpy(), "eta_a": eta_a.cpu().numpy(), "eta_x": eta_x.cpu().numpy()}
 
     def _run_epoch(self) -> dict[str, float]:
         return self.loop.run_epoch(self.vec_env, self._explore, self._update, self.num_timesteps, self.np_rng)

@@ -190,7 +190,7 @@ class PATRPO(Algorithm):
         )
         data, explained_var = advantage_batch(batch, self._values, cfg.gamma, cfg.gae_lambda, cfg.normalize_advantages)
         with subnormals_flushed(cfg.flush_denormal):
-            stats = self._update_policy(*update_tensors(data))
+            stats = self._update_policy(*update_tensors(data, self.device))
             stats["losses/value_loss"] = self._fit_baseline(data["obs"], data["t"], data["returns"])
         stats.update(self.rollout.epoch_stats(data["a"], self.hybrid.n_actions, explained_var))
         return stats
@@ -253,7 +253,7 @@ class PATRPO(Algorithm):
         cfg = self.config
         n_fvp = max(1, int(round(cfg.fvp_subsample * len(obs))))
         if n_fvp < len(obs):
-            sub = torch.randperm(len(obs), generator=self.torch_gen)[:n_fvp]
+            sub = torch.randperm(len(obs), generator=self.torch_gen, device=self.device)[:n_fvp]
             obs, a, x, old = obs[sub], a[sub], x[sub], old[sub]
         method = cfg.fvp
         if method == "auto":
@@ -275,10 +275,10 @@ class PATRPO(Algorithm):
         cfg = self.config
         if cfg.baseline == "linear":
             return self.linear_baseline.fit(obs, t, returns)
-        obs_t, ret_t = self._obs_tensor(obs), torch.as_tensor(returns, dtype=torch.float32)
+        obs_t, ret_t = self._obs_tensor(obs), torch.as_tensor(returns, dtype=torch.float32, device=self.device)
         n = len(ret_t)
         for _ in range(cfg.vf_epochs):
-            perm = torch.randperm(n, generator=self.torch_gen)
+            perm = torch.randperm(n, generator=self.torch_gen, device=self.device)
             for start in range(0, n, cfg.vf_batch_size):
                 idx = perm[start : start + cfg.vf_batch_size]
                 loss = (self.value(obs_t[idx]) - ret_t[idx]).pow(2).mean()

@@ -216,14 +216,14 @@ class PDQN(Algorithm):
         self.q_target = copy.deepcopy(self.q_net).requires_grad_(False)
         self.actor_optimizer = torch.optim.Adam(self.actor.parameters(), lr=cfg.actor_lr, fused=True)
         self.q_optimizer = torch.optim.Adam(self.q_net.parameters(), lr=cfg.q_lr, fused=True)
-        self.blocks = torch.as_tensor(param_blocks(h))
+        self.blocks = torch.as_tensor(param_blocks(h), device=self.device)
         fields = transition_fields(
             self.obs_dim,
             h.max_param_size,
             mc_returns=cfg.beta > 0,
             params=((h.total_param_size,), np.float32),  # every action's, after exploration: what Q learns on
         )
-        self.replay = ReplayBuffer(cfg.buffer_size, fields)
+        self.replay = ReplayBuffer(cfg.buffer_size, fields, self.device)
         self.loop = OffPolicyLoop(cfg, h, self.replay, mc_returns=cfg.beta > 0, tail_value=self._target_value)
         self._ou = OUNoise(cfg.ou_theta, cfg.ou_sigma)
 
@@ -254,10 +254,10 @@ class PDQN(Algorithm):
 
     def _epsilon_greedy(self, a: torch.Tensor, params: torch.Tensor, eps: float):
         """With probability ``eps`` a uniform discrete action (with ``explore_params``, uniform parameters for it)."""
-        random = torch.from_numpy(self.np_rng.random(len(a)) < eps)
-        a = torch.where(random, torch.from_numpy(self.np_rng.integers(self.hybrid.n_actions, size=len(a))), a)
+        random = self._from_numpy(self.np_rng.random(len(a)) < eps)
+        a = torch.where(random, self._from_numpy(self.np_rng.integers(self.hybrid.n_actions, size=len(a))), a)
         if self.config.explore_params:
-            uniform = torch.from_numpy(self.np_rng.uniform(-1.0, 1.0, size=params.shape).astype(np.float32))
+            uniform = self._from_numpy(self.np_rng.uniform(-1.0, 1.0, size=params.shape).astype(np.float32))
             params = torch.where(random[:, None] & self.blocks[a], uniform, params)
         return a, params
 
@@ -267,15 +267,15 @@ class PDQN(Algorithm):
         a = self.q_net(obs, params.clamp(-1.0, 1.0)).argmax(-1)  # the greedy choice, before any noise
         if cfg.ou_sigma > 0:
             noise = self._ou(tuple(params.shape), episode_start, self.np_rng)
-            params = params + torch.from_numpy(noise.astype(np.float32))
+            params = params + self._from_numpy(noise.astype(np.float32))
         a, params = self._epsilon_greedy(a, params.clamp(-1.0, 1.0), self.epsilon(step))
-        return a, self.actor.select(params, a), {"params": params.numpy()}
+        return a, self.actor.select(params, a), {"params": params.cpu().numpy()}
 
     def _target_value(self, obs: np.ndarray) -> np.ndarray:
         """``max_k Q'_k(s, x'(s))``, the bootstrap of a truncated episode's Monte-Carlo return."""
         with torch.no_grad():
-            o = torch.from_numpy(obs)
-            return self.q_target(o, self.actor_target(o).clamp(-1.0, 1.0)).max(-1).values.numpy()
+            o = self._from_numpy(obs)
+            return self.q_target(o, self.actor_target(o).clamp(-1.0, 1.0)).max(-1).values.cpu().numpy()
 
     # -- learning --------------------------------------------------------------------------------
     def _run_epoch(self) -> dict[str, float]:

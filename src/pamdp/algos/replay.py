@@ -54,14 +54,16 @@ class ReplayBuffer:
     Args:
         capacity: the most transitions held; older ones are overwritten.
         fields: name -> (shape of one item, dtype).
+        device: where :meth:`sample`'s batches go (the algorithm's device); the contents stay in host memory.
     """
 
-    def __init__(self, capacity: int, fields: FieldSpec):
+    def __init__(self, capacity: int, fields: FieldSpec, device: torch.device | str = "cpu"):
         if capacity < 1:
             raise ValueError(f"capacity = {capacity!r}; expected an integer >= 1")
         if not fields:
             raise ValueError("a replay buffer needs at least one field")
         self.capacity = int(capacity)
+        self.device = torch.device(device)
         self.fields = {name: (tuple(shape), np.dtype(dtype)) for name, (shape, dtype) in fields.items()}
         self.data = {name: np.empty((self.capacity, *shape), dtype) for name, (shape, dtype) in self.fields.items()}
         self.added = 0  # transitions ever added; the next one goes to slot added % capacity
@@ -103,11 +105,12 @@ class ReplayBuffer:
         self.data[name][counters[keep] % self.capacity] = values[keep]
 
     def sample(self, batch_size: int, rng: np.random.Generator) -> dict[str, torch.Tensor]:
-        """``batch_size`` transitions drawn uniformly with replacement, as tensors sharing no memory with the buffer."""
+        """``batch_size`` transitions drawn uniformly with replacement, as tensors on :attr:`device` sharing no memory
+        with the buffer."""
         if len(self) == 0:
             raise ValueError("cannot sample from an empty replay buffer")
         idx = rng.integers(0, len(self), size=batch_size)
-        return {name: torch.from_numpy(arr[idx]) for name, arr in self.data.items()}
+        return {name: torch.from_numpy(arr[idx]).to(self.device) for name, arr in self.data.items()}
 
     # -- checkpoints ------------------------------------------------------------------------------
     def state_dict(self, include_data: bool) -> dict:
@@ -128,5 +131,5 @@ class ReplayBuffer:
             if name not in self.data:
                 raise ValueError(f"replay state has unknown field {name!r}")
             n = len(tensor)
-            self.data[name][:n] = tensor.numpy()
+            self.data[name][:n] = tensor.cpu().numpy()
         self.added = int(state["added"]) if n == self.capacity else int(n or 0)

@@ -11,6 +11,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import numbers
+import re
 import types
 import typing
 from collections.abc import Callable
@@ -29,6 +30,7 @@ __all__ = [
     "POSITIVE",
     "NON_NEGATIVE",
     "LAYERS",
+    "DEVICE",
 ]
 
 
@@ -62,6 +64,7 @@ def one_of(choices) -> Check:
 POSITIVE = Check(lambda v: v > 0, "a positive number")
 NON_NEGATIVE = Check(lambda v: v >= 0, "a non-negative number")
 LAYERS = Check(lambda v: len(v) > 0 and all(h > 0 for h in v), "one or more positive layer sizes")
+DEVICE = Check(lambda v: re.fullmatch(r"auto|cpu|cuda(:[0-9]+)?", v) is not None, "'auto', 'cpu', 'cuda' or 'cuda:N'")
 
 
 def setting(default: Any, help: str, check: Check | None = None) -> Any:
@@ -94,6 +97,12 @@ class AlgoConfig:
         "How env copies are stepped: batched (one compiled loop over copies), sync (scalar copies in turn) or auto "
         "(batched from 2 copies on, where the env has a batched version).",
         one_of(("auto", "batched", "sync")),
+    )
+    device: str = setting(
+        "auto",
+        "Where the networks, optimisers and updates run: auto (CUDA when available, else the CPU), cpu, cuda or "
+        "cuda:N; the envs step on the CPU either way (what a GPU buys: benchmarks/gpu_speed.md).",
+        DEVICE,
     )
 
     def __post_init__(self):
