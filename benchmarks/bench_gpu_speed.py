@@ -12,8 +12,9 @@ batch on each device, the policy restored between repeats.
 
     python benchmarks/bench_gpu_speed.py --out benchmarks/gpu_speed.md
 
-runs in a few minutes where there is a GPU; ``--devices cpu --samples 500 --warmup 200 --update-samples 5000``
-is a quick check of the script on a machine without one.
+takes some minutes where there is a GPU, most of them in the off-policy algorithms' CPU column (about 100 samples a
+second each with the paper's networks); ``--envs Platform`` and ``--envs HFO`` split it in two. ``--devices cpu
+--samples 300 --warmup 100 --repeats 1 --update-samples 2000`` is a quick check of the script without a GPU.
 """
 
 from __future__ import annotations
