@@ -46,6 +46,8 @@ def tensors_of(algo) -> dict[str, torch.Tensor]:
     for name, opt in algo._optimizers().items():
         for i, state in enumerate(opt.state.values()):
             found.update({f"{name}.state{i}.{k}": v for k, v in state.items() if isinstance(v, torch.Tensor)})
+    if hasattr(algo, "replay"):  # the off-policy algorithms' replay contents live on the device too
+        found.update({f"replay.{k}": v for k, v in algo.replay.data.items()})
     return found
 
 
@@ -140,7 +142,7 @@ def test_on_cuda_every_tensor_is_there_and_training_runs(name):
         assert torch.equal(tensors_of(algo)[key].cpu(), value), key
     algo.learn(200, progress_bar=False)
     assert {k: v.device.type for k, v in tensors_of(algo).items() if v.device.type != "cuda"} == {}
-    if hasattr(algo, "replay"):  # the off-policy algorithms' samples go to the device
+    if hasattr(algo, "replay"):  # sampled on the device from contents held there
         assert algo.replay.sample(4, algo.np_rng)["obs"].device.type == "cuda"
 
 

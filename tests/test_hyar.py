@@ -130,10 +130,10 @@ def test_warm_up_acts_uniformly_and_its_latents_are_reencoded():
     m.learn(2000, progress_bar=False)
     assert m.pretrained and m.n_updates > 0
     n = 3000  # the warm-up transitions: their stored latents were re-encoded after the pre-training
-    d = {k: torch.from_numpy(v[:n]) for k, v in m.replay.data.items()}
+    d = {k: v[:n] for k, v in m.replay.data.items()}
     with torch.no_grad():
         encoded = m.rep.latent(d["obs"], d["a"], d["x"])
-    torch.testing.assert_close(torch.from_numpy(m.replay.data["latent"][:n]), encoded)  # no round since (vae_updates 0)
+    torch.testing.assert_close(m.replay.data["latent"][:n], encoded)  # no round since (vae_updates 0)
     assert torch.all(m.actor.high > m.actor.low) and torch.equal(m.actor.low, m.actor_target.low)
 
 

@@ -75,7 +75,7 @@ def test_actor_chasing_an_unbounded_critic_stays_in_bounds(bound):
     for _ in range(200):
         model._update()
     with torch.no_grad():
-        out = model.actor(torch.from_numpy(model.replay.data["obs"][:100]))
+        out = model.actor(model.replay.data["obs"][:100])
     assert out.mean() > 0.9, bound  # pushed up to the bound...
     assert out.max() <= (1.0 if bound == "squash" else 1.05), bound  # ...and not (much) past it
 
@@ -133,14 +133,14 @@ def test_epoch_stores_monte_carlo_returns_and_explores():
     model.learn(400, progress_bar=False, callback=lambda m, s: stats.append(s))
     n = len(model.replay)
     assert n == model.num_timesteps
-    r, mc, term = (model.replay.data[k][:n] for k in ("reward", "mc", "terminated"))
+    r, mc, term = (model.replay.data[k][:n].numpy() for k in ("reward", "mc", "terminated"))
     # The last step of a terminated episode has return-to-go = its reward; most episodes have ended.
     np.testing.assert_allclose(mc[term], r[term], rtol=1e-6)
     assert np.isfinite(mc).mean() > 0.9
     assert np.all(mc[np.isfinite(mc)] >= r[np.isfinite(mc)] - 1e-6)  # Platform's rewards are non-negative
-    out = model.replay.data["out"][:n]
+    out = model.replay.data["out"][:n].numpy()
     assert np.abs(out).max() <= 1.0
-    np.testing.assert_array_equal(out[:, :3].argmax(1), model.replay.data["a"][:n])
+    np.testing.assert_array_equal(out[:, :3].argmax(1), model.replay.data["a"][:n].numpy())
     assert stats[-1]["train/updates"] > 0 and stats[-1]["train/epsilon"] < 1.0
     for key in ("losses/critic_loss", "losses/actor_loss", "train/q_mean", "train/action_freq_0"):
         assert np.isfinite(stats[-1][key]), key

@@ -192,10 +192,10 @@ def test_epoch_stores_valid_transitions_with_their_noise_and_learns():
     model.learn(400, progress_bar=False, callback=lambda m, s: stats.append(s))
     n = len(model.replay)
     assert n == model.num_timesteps >= 400  # autoreset steps are not stored
-    a, a_in, eta_a = (model.replay.data[k][:n] for k in ("a", "a_in", "eta_a"))
+    a, a_in, eta_a = (model.replay.data[k][:n].numpy() for k in ("a", "a_in", "eta_a"))
     np.testing.assert_array_equal(a_in.argmax(1), a)
     np.testing.assert_array_equal(a_in.max(1), 1.0)  # straight-through: the critic sees one-hots
-    assert np.all(np.isfinite(eta_a)) and np.abs(model.replay.data["eta_x"][:n]).max() > 0
+    assert np.all(np.isfinite(eta_a)) and model.replay.data["eta_x"][:n].abs().max() > 0
     assert stats[-1]["train/updates"] > 0
     for key in ("losses/critic_loss", "losses/actor_loss", "train/q_mean", "train/action_freq_2"):
         assert np.isfinite(stats[-1][key]), key
@@ -205,14 +205,14 @@ def test_epoch_stores_valid_transitions_with_their_noise_and_learns():
     k = len(fresh.replay)
     with torch.no_grad():
         index, _, x = fresh.policy(
-            torch.from_numpy(fresh.replay.data["obs"][:k]),
-            torch.from_numpy(fresh.replay.data["eta_a"][:k]),
-            torch.from_numpy(fresh.replay.data["eta_x"][:k]),
+            fresh.replay.data["obs"][:k],
+            fresh.replay.data["eta_a"][:k],
+            fresh.replay.data["eta_x"][:k],
             1.0,
             True,
         )
-    np.testing.assert_array_equal(index.numpy(), fresh.replay.data["a"][:k])
-    np.testing.assert_allclose(x.numpy(), fresh.replay.data["x"][:k], atol=1e-6)
+    np.testing.assert_array_equal(index.numpy(), fresh.replay.data["a"][:k].numpy())
+    np.testing.assert_allclose(x.numpy(), fresh.replay.data["x"][:k].numpy(), atol=1e-6)
 
 
 def test_same_seed_gives_identical_first_epoch():
@@ -260,7 +260,7 @@ def test_save_load_predict_round_trip(tmp_path, save_replay):
             np.testing.assert_array_equal(x, y)
     assert len(loaded.replay) == (len(model.replay) if save_replay else 0)
     if save_replay:
-        np.testing.assert_array_equal(loaded.replay.data["eta_a"][:200], model.replay.data["eta_a"][:200])
+        assert torch.equal(loaded.replay.data["eta_a"][:200], model.replay.data["eta_a"][:200])
     loaded.learn(200, progress_bar=False)  # resumes: refills (or keeps) the buffer and goes on
     assert loaded.num_timesteps >= 400
     model.save(tmp_path / "acting.pt", replay=False)  # what a run directory's final_model.pt holds
@@ -278,15 +278,15 @@ def test_explore_epsilon_draws_uniform_actions_with_their_own_parameters():
         model.policy.pi_d[-1].bias.copy_(torch.tensor([30.0, 0.0, 0.0]))
     model.learn(2000, progress_bar=False)
     n = len(model.replay)
-    a = model.replay.data["a"][:n]
+    a = model.replay.data["a"][:n].numpy()
     others = np.mean(a != 0)
     assert abs(others - eps * 2 / 3) < 4 * np.sqrt(eps * 2 / 3 / n), (others, n)
-    np.testing.assert_array_equal(model.replay.data["a_in"][:n].argmax(1), a)
-    obs, eta_x = (torch.from_numpy(model.replay.data[k][:n]) for k in ("obs", "eta_x"))
+    np.testing.assert_array_equal(model.replay.data["a_in"][:n].numpy().argmax(1), a)
+    obs, eta_x = (model.replay.data[k][:n] for k in ("obs", "eta_x"))
     onehot = torch.nn.functional.one_hot(torch.from_numpy(a), 3).float()
     with torch.no_grad():
         x = model.policy.params(obs, torch.from_numpy(a), onehot, eta_x)
-    np.testing.assert_allclose(x.numpy(), model.replay.data["x"][:n], atol=1e-6)
+    np.testing.assert_allclose(x.numpy(), model.replay.data["x"][:n].numpy(), atol=1e-6)
 
 
 def test_twin_critics_learn_towards_the_smaller_target(tmp_path):

@@ -212,7 +212,7 @@ def test_replay_holds_what_q_saw_and_monte_carlo_returns():
     model = PDQN("pamdp/Platform-v0", dataclasses.replace(SMALL, beta=0.5, ou_sigma=0.2, ou_theta=1.0))
     model.learn(400, progress_bar=False)
     n = len(model.replay)
-    d = {k: v[:n] for k, v in model.replay.data.items()}
+    d = {k: v[:n].numpy() for k, v in model.replay.data.items()}
     assert np.abs(d["params"]).max() <= 1.0
     np.testing.assert_array_equal(d["x"][:, 0], d["params"][np.arange(n), d["a"]])
     term = d["terminated"]
@@ -269,7 +269,7 @@ def test_resume_from_a_checkpoint(tmp_path):
     assert (resumed.num_timesteps, resumed.epoch) == (model.num_timesteps, model.epoch)
     assert len(resumed.replay) == len(model.replay) and resumed.loop.update_credit == model.loop.update_credit
     n = len(model.replay)
-    np.testing.assert_array_equal(resumed.replay.data["params"][:n], model.replay.data["params"][:n])
+    assert torch.equal(resumed.replay.data["params"][:n], model.replay.data["params"][:n])
     steps = resumed.q_optimizer.state_dict()["state"][0]["step"]
     assert steps == model.q_optimizer.state_dict()["state"][0]["step"] > 0
 

@@ -38,13 +38,25 @@ def test_wraps_around_and_keeps_the_newest():
     assert buf.data["a"][19 % 5 - 1] == 21
 
 
+def test_a_batch_with_a_short_field_is_refused_and_writes_nothing():
+    buf = ReplayBuffer(2, FIELDS)  # full: a partial write would overwrite live transitions
+    buf.add(**rows([0, 1]))
+    bad = rows([2, 3])
+    bad["eta"] = bad["eta"][:1]
+    with pytest.raises(ValueError, match="field 'eta' has 1 rows; expected 2"):
+        buf.add(**bad)
+    assert buf.added == 2
+    np.testing.assert_array_equal(buf.data["a"], [0, 1])
+    np.testing.assert_array_equal(buf.data["obs"], [[0, 0], [1, -1]])
+
+
 def test_write_skips_overwritten_transitions():
     buf = ReplayBuffer(4, {"r": ((), np.float32), "mc": ((), np.float32)})
     first = buf.add(r=np.ones(3), mc=np.full(3, np.nan))
     buf.add(r=np.ones(2), mc=np.full(2, np.nan))  # overwrites transition 0
     buf.write("mc", first, np.array([7.0, 8.0, 9.0]))
     np.testing.assert_array_equal(buf.data["mc"][[1, 2]], [8.0, 9.0])
-    assert np.isnan(buf.data["mc"][0])  # now transition 4's slot: left alone
+    assert torch.isnan(buf.data["mc"][0])  # now transition 4's slot: left alone
 
 
 def test_sampling_returns_stored_rows_from_the_given_rng():

@@ -435,8 +435,7 @@ class HyAR(Algorithm):
         n, data = len(self.replay), self.replay.data
         for start in range(0, n, 4096):
             s = slice(start, min(n, start + 4096))
-            obs, a, x = (self._from_numpy(data[k][s]) for k in ("obs", "a", "x"))
-            data["latent"][s] = self.rep.latent(obs, a, x).cpu().numpy()
+            data["latent"][s] = self.rep.latent(data["obs"][s], data["a"][s], data["x"][s])
 
     @torch.no_grad()
     def relabel(self, b: dict[str, torch.Tensor]) -> tuple[torch.Tensor, float]:

@@ -1,9 +1,12 @@
 """The replay buffer shared by the off-policy algorithms (PASVG(0), PADDPG, P-DQN, HyAR).
 
-One preallocated NumPy array per field, written as a ring: the newest transition overwrites the oldest once
-``capacity`` is reached. Arrays are created with ``np.empty``, which reserves address space without
-touching it, so the paper's capacity of 10^7 costs memory only as it fills (10^7 Platform transitions
-hold about 0.9 GB once full) and never allocates a Python object per slot.
+One preallocated tensor per field on the algorithm's device, written as a ring: the newest transition
+overwrites the oldest once ``capacity`` is reached. The contents live where the update runs, so sampling a
+minibatch is an index on the device, not a copy from host memory for every update; each environment step
+sends its new transitions there once. On the CPU the tensors are created with ``torch.empty``, which reserves
+address space without touching it, so the paper's capacity of 10^7 costs memory only as it fills (10^7
+Platform transitions hold about 0.9 GB once full) and never allocates a Python object per slot; on a GPU
+the whole capacity is allocated at once.
 
 Fields are declared by the algorithm (``{"obs": ((9,), np.float32), "eta_a": ((3,), np.float32), ...}``),
 so algorithm-specific extras such as PASVG(0)'s recorded noise ``eta`` or PADDPG's Monte-Carlo returns
@@ -49,12 +52,12 @@ def transition_fields(obs_dim: int, max_param_size: int, mc_returns: bool = Fals
 
 
 class ReplayBuffer:
-    """A ring buffer of transitions in preallocated NumPy arrays.
+    """A ring buffer of transitions in preallocated tensors on one device.
 
     Args:
         capacity: the most transitions held; older ones are overwritten.
-        fields: name -> (shape of one item, dtype).
-        device: where :meth:`sample`'s batches go (the algorithm's device); the contents stay in host memory.
+        fields: name -> (shape of one item, NumPy dtype).
+        device: where the contents live and :meth:`sample`'s batches are drawn (the algorithm's device).
     """
 
     def __init__(self, capacity: int, fields: FieldSpec, device: torch.device | str = "cpu"):
@@ -65,11 +68,31 @@ class ReplayBuffer:
         self.capacity = int(capacity)
         self.device = torch.device(device)
         self.fields = {name: (tuple(shape), np.dtype(dtype)) for name, (shape, dtype) in fields.items()}
-        self.data = {name: np.empty((self.capacity, *shape), dtype) for name, (shape, dtype) in self.fields.items()}
+        self.data = {
+            name: torch.empty((self.capacity, *shape), dtype=_torch_dtype(dtype), device=self.device)
+            for name, (shape, dtype) in self.fields.items()
+        }
+        # On the CPU, NumPy views of the same memory do the indexing: for the few rows of a step or a minibatch,
+        # torch's per-call overhead would cost more than the copy itself.
+        self._host = {name: t.numpy() for name, t in self.data.items()} if self.device.type == "cpu" else None
         self.added = 0  # transitions ever added; the next one goes to slot added % capacity
 
     def __len__(self) -> int:
         return min(self.added, self.capacity)
+
+    def _rows(self, name: str, value, n: int) -> np.ndarray:
+        value = np.asarray(value)
+        if len(value) != n:
+            raise ValueError(f"field {name!r} has {len(value)} rows; expected {n}")
+        return value.reshape((n, *self.fields[name][0]))
+
+    def _put(self, name: str, counters: np.ndarray, rows: np.ndarray) -> None:
+        slots = np.asarray(counters, dtype=np.int64) % self.capacity
+        if self._host is not None:
+            self._host[name][slots] = rows
+        else:
+            rows = torch.from_numpy(np.ascontiguousarray(rows, self.fields[name][1]))
+            self.data[name][torch.from_numpy(slots).to(self.device)] = rows.to(self.device)
 
     def add(self, **batch: np.ndarray) -> np.ndarray:
         """Append a batch (every field, same leading length ``n``); returns the insertion counters used.
@@ -85,12 +108,9 @@ class ReplayBuffer:
             self.added += n - self.capacity
             n = self.capacity
         counters = np.arange(self.added, self.added + n)
-        slots = counters % self.capacity
-        for name, value in batch.items():
-            value = np.asarray(value)
-            if len(value) != n:
-                raise ValueError(f"field {name!r} has {len(value)} rows; expected {n}")
-            self.data[name][slots] = value.reshape((n, *self.fields[name][0]))
+        rows = {name: self._rows(name, value, n) for name, value in batch.items()}  # all checked before any write
+        for name, value in rows.items():
+            self._put(name, counters, value)
         self.added += n
         return counters
 
@@ -102,23 +122,27 @@ class ReplayBuffer:
         """Set field ``name`` of already stored transitions, skipping any that have been overwritten."""
         counters, values = np.asarray(counters), np.asarray(values)
         keep = self.holds(counters)
-        self.data[name][counters[keep] % self.capacity] = values[keep]
+        self._put(name, counters[keep], self._rows(name, values[keep], int(keep.sum())))
 
     def sample(self, batch_size: int, rng: np.random.Generator) -> dict[str, torch.Tensor]:
         """``batch_size`` transitions drawn uniformly with replacement, as tensors on :attr:`device` sharing no memory
-        with the buffer."""
+        with the buffer (the indices come from ``rng``, so a seeded run draws the same batches on any device)."""
         if len(self) == 0:
             raise ValueError("cannot sample from an empty replay buffer")
         idx = rng.integers(0, len(self), size=batch_size)
-        return {name: torch.from_numpy(arr[idx]).to(self.device) for name, arr in self.data.items()}
+        if self._host is not None:
+            return {name: torch.from_numpy(arr[idx]) for name, arr in self._host.items()}
+        idx = torch.from_numpy(idx).to(self.device)
+        return {name: tensor[idx] for name, tensor in self.data.items()}
 
     # -- checkpoints ------------------------------------------------------------------------------
     def state_dict(self, include_data: bool) -> dict:
-        """Plain data for a checkpoint; the contents only with ``include_data`` (they can be gigabytes)."""
+        """Plain data for a checkpoint (on the CPU); the contents only with ``include_data`` (they can be
+        gigabytes)."""
         state: dict = {"added": self.added, "has_data": bool(include_data)}
         if include_data:
             n = len(self)
-            state["data"] = {name: torch.from_numpy(arr[:n].copy()) for name, arr in self.data.items()}
+            state["data"] = {name: tensor[:n].cpu().clone() for name, tensor in self.data.items()}
         return state
 
     def load_state_dict(self, state: dict) -> None:
@@ -131,5 +155,10 @@ class ReplayBuffer:
             if name not in self.data:
                 raise ValueError(f"replay state has unknown field {name!r}")
             n = len(tensor)
-            self.data[name][:n] = tensor.cpu().numpy()
+            self.data[name][:n] = tensor.to(self.device, self.data[name].dtype)
         self.added = int(state["added"]) if n == self.capacity else int(n or 0)
+
+
+def _torch_dtype(dtype) -> torch.dtype:
+    """The torch dtype of a NumPy dtype (``np.bool_`` -> ``torch.bool``, ``np.float32`` -> ``torch.float32``)."""
+    return torch.from_numpy(np.empty(0, dtype)).dtype
