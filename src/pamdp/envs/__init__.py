@@ -2,6 +2,10 @@
 
 - ``pamdp/Platform-v0``: Masson, Ranchod & Konidaris' Platform (``platform/``).
 - ``pamdp/HalfFieldOffense-v0``: Half Field Offense 1v0, empty goal (``hfo/``).
+- ``pamdp/Goal-v0`` and ``pamdp/HardGoal-v0``: Robot Soccer Goal and HyAR's Hard Goal (``goal/``).
+- ``pamdp/CatchPoint-v0``: HyAR's Catch Point (``catch_point/``).
+- ``pamdp/HardMove-v0``: HyAR's Hard Move with ``n`` actuators, 4 to 10 (``hard_move/``).
+- ``pamdp/Moving-v0`` and ``pamdp/Sliding-v0``: gym-hybrid's two domains (``gym_hybrid/``).
 
 Each domain's folder holds its dynamics (compiled by Numba), its scalar ``gymnasium.Env`` and its batched
 ``gymnasium.vector.VectorEnv``, registered as its ``vector_entry_point``, so ``gymnasium.make_vec(id,
@@ -22,6 +26,33 @@ _REGISTRATIONS = {
     "pamdp/HalfFieldOffense-v0": dict(
         entry_point="pamdp.envs.hfo.env:HalfFieldOffenseEnv",
         vector_entry_point="pamdp.envs.hfo.batched:HalfFieldOffenseVectorEnv",
+    ),
+    # Goal, Hard Goal, Moving and Sliding end their episodes by their own step limits (the specs: no TimeLimit).
+    "pamdp/Goal-v0": dict(
+        entry_point="pamdp.envs.goal.env:GoalEnv",
+        vector_entry_point="pamdp.envs.goal.batched:GoalVectorEnv",
+    ),
+    "pamdp/HardGoal-v0": dict(
+        entry_point="pamdp.envs.goal.env:HardGoalEnv",
+        vector_entry_point="pamdp.envs.goal.batched:HardGoalVectorEnv",
+    ),
+    "pamdp/CatchPoint-v0": dict(
+        entry_point="pamdp.envs.catch_point.env:CatchPointEnv",
+        vector_entry_point="pamdp.envs.catch_point.batched:CatchPointVectorEnv",
+        max_episode_steps=25,
+    ),
+    "pamdp/HardMove-v0": dict(
+        entry_point="pamdp.envs.hard_move.env:HardMoveEnv",
+        vector_entry_point="pamdp.envs.hard_move.batched:HardMoveVectorEnv",
+        max_episode_steps=30,
+    ),
+    "pamdp/Moving-v0": dict(
+        entry_point="pamdp.envs.gym_hybrid.env:MovingEnv",
+        vector_entry_point="pamdp.envs.gym_hybrid.batched:MovingVectorEnv",
+    ),
+    "pamdp/Sliding-v0": dict(
+        entry_point="pamdp.envs.gym_hybrid.env:SlidingEnv",
+        vector_entry_point="pamdp.envs.gym_hybrid.batched:SlidingVectorEnv",
     ),
 }
 
