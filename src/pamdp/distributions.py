@@ -21,10 +21,28 @@ from dataclasses import dataclass
 import torch
 import torch.nn.functional as F
 
-__all__ = ["HybridDistribution", "KL_ESTIMATORS", "kl_divergence"]
+__all__ = ["HybridDistribution", "KL_ESTIMATORS", "MASKED", "kl_divergence", "masked_logits"]
 
 KL_ESTIMATORS = ("joint_sample", "chain_sample", "chain_analytic")
 _LOG_2PI = math.log(2.0 * math.pi)
+# What a masked action's logit (or Q-value) becomes: finite, so that softmax gives it probability 0 exactly and
+# p * log p stays 0 (not 0 * -inf = NaN), and far below any logit or return the networks produce.
+MASKED = -1e9
+
+
+def masked_logits(logits: torch.Tensor, mask: torch.Tensor | None) -> torch.Tensor:
+    """``logits`` ``(B, K)`` with the actions that ``mask`` (bool ``(B, K)``, True = allowed) forbids set to
+    :data:`MASKED`; ``None`` allows everything (``logits`` itself is returned).
+
+    Softmax, log-softmax, entropies and KLs of the result are those of the categorical restricted to the allowed
+    actions, with no NaN and no gradient into the masked entries; ``argmax`` and ``max`` pick among the allowed
+    (so the same function masks Q-values). A row allowing nothing is left as it is (every action allowed).
+    """
+    if mask is None:
+        return logits
+    mask = mask.to(torch.bool)
+    mask = mask | ~mask.any(dim=-1, keepdim=True)
+    return torch.where(mask, logits, torch.full_like(logits, MASKED))
 
 
 @dataclass

@@ -8,11 +8,20 @@ import inspect
 import typing
 
 import gymnasium
+import numpy as np
 from gymnasium import spaces
 
 from pamdp.algos.settings import type_name, type_ok
 
-__all__ = ["env_spec", "env_creator", "check_env_kwargs", "make_vector_env", "describe_env", "AUTO_BATCH_MIN"]
+__all__ = [
+    "env_spec",
+    "env_creator",
+    "check_env_kwargs",
+    "make_vector_env",
+    "describe_env",
+    "info_action_masks",
+    "AUTO_BATCH_MIN",
+]
 
 # A batched env steps its copies in one compiled loop and beats scalar copies stepped in turn from two copies on
 # (benchmarks/platform_speed.md, benchmarks/hfo_speed.md); a single copy is scalar.
@@ -120,3 +129,26 @@ def describe_env(env, env_kwargs: dict | None = None) -> tuple[str | None, dict,
         raise ValueError(f"env must be a registered env id, a gymnasium.Env or a VectorEnv; got {env!r}")
     spec = env.spec
     return (spec.id if spec else None), dict(spec.kwargs if spec else {}), *spaces_of
+
+
+def info_action_masks(infos: dict, num_envs: int, n_actions: int) -> np.ndarray:
+    """The discrete actions allowed in each copy's current state, bool ``(num_envs, n_actions)``, from a vector
+    env's infos (Gymnasium's dict of arrays: ``infos["action_mask"]`` ``(N, K)`` beside ``infos["_action_mask"]``,
+    which copies report one).
+
+    True means the action has an effect now. A copy that reports no mask, or a mask allowing nothing, gets all
+    actions allowed; a mask of another shape is a ``ValueError``.
+    """
+    masks = np.ones((num_envs, n_actions), dtype=bool)
+    if "action_mask" not in infos:
+        return masks
+    reported = np.asarray(infos["action_mask"])
+    if reported.shape != (num_envs, n_actions):
+        raise ValueError(
+            f"info['action_mask'] of shape {reported.shape}; expected ({num_envs}, {n_actions}) (one bool per "
+            "env copy and discrete action)"
+        )
+    has = np.asarray(infos.get("_action_mask", np.ones(num_envs, dtype=bool)), dtype=bool)
+    has &= reported.any(axis=1)
+    masks[has] = reported[has].astype(bool)
+    return masks
