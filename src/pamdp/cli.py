@@ -22,6 +22,7 @@ from pathlib import Path
 
 from pamdp import __version__
 from pamdp._memory import keep_freed_memory
+from pamdp.algos import preset_names
 from pamdp.experiments.runner import ALGORITHMS, RunSpec, algorithm_class, default_preset, train_run
 
 MAX_STEPS = 10**12  # a budget beyond this is a typing slip (10^12 steps take decades on one core)
@@ -207,8 +208,8 @@ def build_parser() -> argparse.ArgumentParser:
         p.add_argument(
             "--preset",
             default=None,
-            choices=list(cls.config_class.presets()),
-            help=f"settings preset (default: {default_preset(cls.config_class)})",
+            choices=preset_names(cls.config_class),
+            help=f"settings preset (default: the env's where it has one, else {default_preset(cls.config_class)})",
         )
         p.add_argument("--config", default=None, help="TOML or JSON file of settings")
         p.add_argument(

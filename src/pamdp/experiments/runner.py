@@ -26,7 +26,7 @@ import traceback
 from pathlib import Path
 from typing import Any
 
-from pamdp.algos import ALGORITHMS, DEFAULT_PRESET, algorithm_class, default_preset
+from pamdp.algos import ALGORITHMS, DEFAULT_PRESET, algorithm_class, default_preset, preset_config
 from pamdp.algos.vector_env import check_env_kwargs
 
 __all__ = [
@@ -65,8 +65,8 @@ class RunSpec:
         cls = algorithm_class(self.algo)
         if cls is None:
             raise ValueError(f"algorithm {self.algo!r} is not available in this install")
-        preset = self.preset or default_preset(cls.config_class)
-        base = cls.config_class.preset(preset)
+        preset = self.preset or default_preset(cls.config_class, self.env)
+        base = preset_config(cls.config_class, preset)
         return cls, preset, cls.config_class.from_dict({**dict(self.settings), "seed": self.seed}, base=base)
 
     def check(self):
