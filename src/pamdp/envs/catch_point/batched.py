@@ -1,0 +1,124 @@
+"""N copies of Catch Point stepped at once: ``gymnasium.make_vec("pamdp/CatchPoint-v0", num_envs=N)``.
+
+The copies run ``particle.catch_point_step``, the scalar env's dynamics, in one compiled loop
+(``particle.catch_point_copies``); each copy draws its resets from its own generator
+(``pamdp.envs.vector``), so copy i follows a scalar env reset with copy i's seed step for step.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+import pamdp.envs.particle as particle
+from pamdp.envs.catch_point.env import CatchPointEnv
+from pamdp.envs.catch_point.render import draw_catch_point
+from pamdp.envs.vector import BatchedVectorEnv
+
+__all__ = ["CatchPointVectorEnv", "parse_actions"]
+
+RESETS_BUFFERED = 64
+"""Episodes' worth of uniforms drawn at a time per copy."""
+
+
+class CatchPointVectorEnv(BatchedVectorEnv):
+    """``num_envs`` independent Catch Point episodes, stepped together.
+
+    Actions are batched like ``batch_space`` of the scalar action space: ``(a, (theta, catch))`` with
+    ``a`` an integer array of shape ``(N,)``, ``theta`` of shape ``(N, 1)`` (``(N,)`` is accepted too)
+    and ``catch`` of shape ``(N, 0)``; :meth:`pamdp.spaces.HybridActionSpace.to_env_batch` produces this
+    format. Observations are ``(N, 4)`` float64; ``info["failed_catches"]`` and ``info["is_success"]``
+    (this step caught the point) are ``(N,)`` arrays, the latter reported (``info["_is_success"]``) by
+    the copies that stepped rather than reset.
+
+    Episodes auto-reset in Gymnasium's default *next-step* mode: the step that ends an episode returns its
+    last observation with ``terminated`` or ``truncated`` set; the next ``step`` ignores that copy's
+    action, resets it, and returns the reset observation with reward 0 and both flags false.
+
+    Copy i draws its resets from its own generator, ``np_randoms[i]``; ``reset(seed=s)`` seeds copy i
+    with ``s + i`` (or ``reset(seed=[...])`` with one seed each).
+
+    Args:
+        num_envs: number of copies N.
+        max_episode_steps: episodes are truncated after this many agent steps (the registration's 25;
+            ``make_vec`` passes it in). ``None`` never truncates.
+        render_mode: ``None`` or ``"rgb_array"``; :meth:`render` then returns one frame per copy.
+    """
+
+    draw = "random"
+    draws_per_step = particle.RESET_DRAWS
+    buffer_size = particle.RESET_DRAWS * RESETS_BUFFERED
+
+    def __init__(self, num_envs: int = 1, max_episode_steps: int | None = 25, render_mode: str | None = None):
+        super().__init__(num_envs, CatchPointEnv(), max_episode_steps, render_mode)
+        self._states = np.zeros((self.num_envs, particle.STATE_SIZE))
+        self._last_actions = np.full(self.num_envs, -1, dtype=np.int64)
+
+    @property
+    def states(self) -> np.ndarray:
+        """A copy of the copies' state rows ``(N, STATE_SIZE)`` (indices in ``pamdp.envs.particle``)."""
+        return self._states.copy()
+
+    def render(self):
+        if self.render_mode != "rgb_array":
+            return None
+        return tuple(draw_catch_point(s, a) for s, a in zip(self._states, self._last_actions))
+
+    # -- the shell's hooks ------------------------------------------------------------------------
+    def _reset_copies(self, mask, options):
+        particle.reset_copies(self._states, mask, self.streams.buffers, self.streams.cursors)
+        self._last_actions[mask] = -1
+        return self._observations(), self._info()
+
+    def _step_copies(self, actions, resetting):
+        a, theta = parse_actions(actions, self.num_envs)
+        streams = self.streams
+        particle.reset_copies(self._states, resetting, streams.buffers, streams.cursors)
+        n = self.num_envs
+        rewards, terminated, caught = np.zeros(n), np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
+        particle.catch_point_copies(self._states, a, theta, ~resetting, rewards, terminated, caught)
+        self._last_actions[:] = np.where(resetting, -1, a)
+        return self._observations(), rewards, terminated, np.zeros(n, dtype=bool), self._info(caught, ~resetting)
+
+    def _observations(self) -> np.ndarray:
+        out = np.empty((self.num_envs, particle.OBS_SIZE))
+        particle.observe(self._states, out)
+        return out
+
+    def _info(self, caught: np.ndarray | None = None, stepped: np.ndarray | None = None) -> dict:
+        """As Gymnasium's vector envs merge the scalar envs' infos: every copy reports its failed catches,
+        the copies that stepped (rather than reset) whether they caught the point."""
+        fails = self._states[:, particle.FAILS].astype(np.int64)
+        info = {"failed_catches": fails, "_failed_catches": np.ones(self.num_envs, dtype=bool)}
+        if caught is not None:
+            info["is_success"], info["_is_success"] = caught, stepped
+        return info
+
+
+def parse_actions(actions, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Check a batch of ``n`` Catch Point actions; return ``a`` (n,) int64 and ``theta`` (n,) float64."""
+    expected = (
+        f"(a, (theta, catch)) with a an int array of shape ({n},) in {{0, 1}}, theta a finite array of "
+        f"shape ({n}, 1) or ({n},) and catch an array of shape ({n}, 0) (or ({n}, 1), ignored)"
+    )
+    if not isinstance(actions, (tuple, list)) or len(actions) != 2:
+        raise ValueError(f"invalid batch of Catch Point actions {actions!r}; expected {expected}")
+    a = np.asarray(actions[0])
+    if a.shape != (n,) or a.dtype.kind not in "iu":
+        raise ValueError(f"invalid discrete actions {actions[0]!r}; expected {expected}")
+    bad = (a < 0) | (a > 1)
+    if bad.any():
+        raise ValueError(f"discrete actions {a[bad]} at indices {np.flatnonzero(bad)}; expected {expected}")
+    params = actions[1]
+    if not isinstance(params, (tuple, list)) or len(params) != 2:
+        raise ValueError(f"invalid parameters {params!r}; expected {expected}")
+    theta, catch = np.asarray(params[0]), np.asarray(params[1])
+    if theta.shape not in ((n,), (n, 1)) or theta.dtype.kind not in "iuf":
+        raise ValueError(f"invalid angles of shape {theta.shape}: {params[0]!r}; expected {expected}")
+    if catch.shape not in ((n, 0), (n, 1)):
+        raise ValueError(f"invalid catch parameters of shape {catch.shape}; expected {expected}")
+    theta = theta.reshape(n).astype(np.float64)
+    if not np.isfinite(theta).all():
+        raise ValueError(
+            f"angles {theta[~np.isfinite(theta)]} at indices {np.flatnonzero(~np.isfinite(theta))}; expected {expected}"
+        )
+    return a.astype(np.int64), theta
