@@ -50,16 +50,12 @@ def gym_hybrid_action_space() -> spaces.Tuple:
 
 
 def check_settings(**settings) -> np.ndarray:
-    """The original constructor's keyword arguments (``dynamics.SETTING_NAMES``; missing ones take
+    """The original constructor's settings (``dynamics.SETTING_NAMES``; missing ones take
     ``dynamics.DEFAULTS``) as the settings row of the compiled functions, or ``ValueError`` naming a bad one."""
-    unknown = set(settings) - set(dyn.SETTING_NAMES)
-    if unknown:
-        raise ValueError(f"unknown settings {sorted(unknown)}; expected some of {list(dyn.SETTING_NAMES)}")
     row = dyn.DEFAULTS.copy()
-    for i, name in enumerate(dyn.SETTING_NAMES):
-        if name not in settings:
-            continue
-        v = settings[name]
+    for name, v in settings.items():
+        if name not in dyn.SETTING_NAMES:
+            raise ValueError(f"unknown setting {name!r}; expected one of {list(dyn.SETTING_NAMES)}")
         if name == "max_step":
             if isinstance(v, bool) or not isinstance(v, numbers.Integral) or v < 1:
                 raise ValueError(f"max_step={v!r}; expected a positive integer")
@@ -67,7 +63,7 @@ def check_settings(**settings) -> np.ndarray:
             raise ValueError(f"{name}={v!r}; expected a finite number")
         elif name != "penalty" and v <= 0:
             raise ValueError(f"{name}={v!r}; expected a positive number")
-        row[i] = float(v)
+        row[dyn.SETTING_NAMES.index(name)] = float(v)
     return row
 
 
