@@ -158,6 +158,12 @@ def test_reset_places_ball_and_keeper_as_the_spec_says():
         assert kx == 14.5 and ky == pytest.approx(by * (20 - 14.5) / (20 - bx), abs=1e-12)
         assert s["keeper"][4] == pytest.approx(math.atan2(by - ky, bx - kx), abs=1e-15)
         assert obs[0] == -1.0 and s["time"] == 0 and np.all(s["ball"][2:] == 0.0)
+        # The first number of the episode is the player's y, uniform(-15, 15) of the generator, bit for bit:
+        # Gymnasium's (a numpy Generator) after a seeded reset, an installed RandomState after a plain one.
+        assert py == np.random.default_rng(seed).uniform(-15.0, 15.0)
+        env.np_random = np.random.RandomState(seed)
+        env.reset()
+        assert env.state["player"][1] == np.random.RandomState(seed).uniform(-15.0, 15.0)
 
 
 @pytest.mark.parametrize(
