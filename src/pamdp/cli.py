@@ -342,7 +342,9 @@ def cmd_reproduce(args) -> int:
 
         print(format_status(exp.name, [run_status(spec, out) for spec, out in jobs], args.workers), end="")
         return 0
-    print(f"{exp.name}: {exp.description}; {len(jobs)} runs of {jobs[0][0].total_steps:,} steps", file=sys.stderr)
+    budgets = sorted({spec.total_steps for spec, _ in jobs})
+    steps = f"{budgets[0]:,}" if len(budgets) == 1 else f"{budgets[0]:,} to {budgets[-1]:,}"
+    print(f"{exp.name}: {exp.description}; {len(jobs)} runs of {steps} steps", file=sys.stderr)
     if args.backend == "ray":
         from pamdp.experiments.ray_backend import run_all_ray
 
@@ -369,6 +371,8 @@ def cmd_plot(args) -> int:
 def _print_report(report: dict) -> None:
     """The results table on stdout, the figures' paths on stderr."""
     print(report["table"].read_text())
+    if "suite" in report:
+        print(report["suite"].read_text())
     figures = [v for k, v in report.items() if k.endswith(("png", "svg"))]
     print(f"figures: {', '.join(map(str, figures))}", file=sys.stderr)
 

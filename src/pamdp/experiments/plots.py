@@ -291,7 +291,9 @@ def write_report(
     ``greedy.svg``: the mean +- std across seeds of those evaluations, at the epochs where they were made. Runs on
     an env that reports episode outcomes (``info["is_success"]``) get ``success_rate.png`` and ``.svg``: the
     training success rate per epoch (epochs logged before a run recorded it are left out), and with
-    ``eval_every`` ``greedy_success_rate.png`` and ``.svg``, that of the greedy evaluations.
+    ``eval_every`` ``greedy_success_rate.png`` and ``.svg``, that of the greedy evaluations. Runs on the benchmark
+    suite's domains also get ``suite.md``, their table beside HyAR's published one, and a figure per domain
+    (:mod:`pamdp.experiments.suite`).
     """
     groups = find_groups(roots)
     out = Path(out)
@@ -321,4 +323,11 @@ def write_report(
                 )
     table = out / "results.md"
     table.write_text(results_table(groups) + "\n")
+    from pamdp.experiments.suite import plot_domains, suite_table
+
+    suite = suite_table(groups)
+    if suite:  # runs on the benchmark suite's domains: their table beside HyAR's, and a figure per domain
+        (out / "suite.md").write_text(suite + "\n")
+        extra["suite"] = out / "suite.md"
+        extra.update({f"{p.stem}_{p.suffix[1:]}": p for p in plot_domains(groups, out)})
     return {"png": png, "svg": svg, "csv": csv_path, "table": table, **extra}
