@@ -23,6 +23,7 @@ SMALL = HybridSACConfig(
     learning_starts=100,
     batch_size=16,
     buffer_size=5_000,
+    updates_per_step=0.5,
 )
 # Three actions with 2, 0 and 1 parameters: padded to m = 2, the all-actions vector [x_0, x_0' | x_2].
 HYBRID = HybridActionSpace(
@@ -273,3 +274,19 @@ def test_masked_actions_are_never_chosen():
         assert torch.all(a == 1)
     a, _ = model._act(obs, False, torch.tensor([[True, True, False]]).expand(2000, -1))
     assert not (a == 2).any()
+
+
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        ({"form": "tree"}, "form = 'tree'; expected one of 'flat', 'hierarchical'"),
+        ({"target_entropy_d": 1.5}, "target_entropy_d = 1.5"),
+        ({"target_entropy_c": 0.7}, "target_entropy_c = 0.7; expected a number below log 2"),
+        ({"init_alpha_c": 0.0}, "init_alpha_c = 0.0"),
+        ({"alpha_lr": -1e-3}, "alpha_lr = -0.001"),
+        ({"tau": 0.0}, "tau = 0.0"),
+    ],
+)
+def test_bad_settings_are_refused_by_name(kwargs, match):
+    with pytest.raises(ValueError, match=match.replace("(", "\\(").replace("[", "\\[")):
+        HybridSACConfig(**kwargs)

@@ -55,7 +55,7 @@ from pamdp.algos.offpolicy import (
     soft_updater,
 )
 from pamdp.algos.replay import ReplayBuffer, transition_fields
-from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, at_least, interval, one_of, setting
+from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
 from pamdp.distributions import MASKED, masked_logits
 from pamdp.policies import ACTIVATIONS, mlp
 from pamdp.spaces import HybridActionSpace
@@ -104,6 +104,7 @@ class HybridSACConfig(OffPolicyConfig, AlgoConfig):
     target_entropy_c: float = setting(
         -1.0,
         "pi_c's target entropy in nats per parameter of the chosen action (SAC: -1 per action dimension; assumed).",
+        Check(lambda v: v < math.log(2.0), "a number below log 2 (the uniform's entropy on [-1, 1])"),
     )
     tau: float = setting(0.005, "Soft target-update rate of the critics (SAC: 0.005).", interval(0, 1, low_open=True))
     batch_size: int = shared_setting("batch_size", 256, "SAC: 256; assumed")
