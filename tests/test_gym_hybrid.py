@@ -113,7 +113,9 @@ def test_squares_are_c_pow_not_products():
     # The original's ``** 2`` is C's pow, which differs from v * v in the last bit for a few inputs; pow2
     # finds it without calling pow for most of them. The hard inputs below are each nearest a halfway case.
     rng = np.random.default_rng(0)
-    v = np.concatenate([rng.uniform(-2.0, 2.0, 100_000), rng.uniform(-1e-3, 1e-3, 10_000), [0.0, -0.0, 2.0**-60, 1e120]])
+    v = np.concatenate(
+        [rng.uniform(-2.0, 2.0, 100_000), rng.uniform(-1e-3, 1e-3, 10_000), [0.0, -0.0, 2.0**-60, 1e120]]
+    )
     pow2 = np.array([dyn.pow2(x) for x in v])
     assert pow2.tolist() == [math.pow(x, 2) for x in v]
     assert (pow2 != v * v).sum() > 50
@@ -230,8 +232,8 @@ def test_settings_change_the_dynamics():
     np.testing.assert_allclose(obs[:2] - obs0[:2], 0.01 * obs0[3:5], rtol=0, atol=1e-15)
     assert obs[2] == 1.0 and obs[9] == 0.1 and reward == obs0[7] - obs[7]
     assert env.step(act(2))[0][2] == 0.75
-    lengths = [env.step(act(1, 0.0))[2] for _ in range(9)]
-    assert lengths == [False] * 8 + [True]  # the step after the 10th ends the episode
+    ended = [env.step(act(1, 0.0))[2] for _ in range(9)]
+    assert ended == [False] * 8 + [True]  # the step after the 10th ends the episode
 
 
 def test_a_homing_policy_reaches_the_goal():
@@ -331,7 +333,9 @@ def test_render_shows_target_and_agent():
 
 
 # --- the batched envs ------------------------------------------------------------------------------------
-@pytest.mark.parametrize("env_id, n, seed", [("pamdp/Moving-v0", 1, 0), ("pamdp/Moving-v0", 9, 4), ("pamdp/Sliding-v0", 12, 40)])
+@pytest.mark.parametrize(
+    "env_id, n, seed", [("pamdp/Moving-v0", 1, 0), ("pamdp/Moving-v0", 9, 4), ("pamdp/Sliding-v0", 12, 40)]
+)
 def test_copy_i_equals_a_scalar_env_seeded_with_seed_plus_i(env_id, n, seed):
     """The batched env against Gymnasium's SyncVectorEnv over scalar envs (env i seeded ``seed + i``, next-step
     autoreset too): copies play random actions, the homing policy or stand still, so episodes end at the
@@ -360,7 +364,11 @@ def test_copy_i_equals_a_scalar_env_seeded_with_seed_plus_i(env_id, n, seed):
             np.testing.assert_array_equal(got[4]["is_success"][ended], want[4]["is_success"][ended])
         np.testing.assert_array_equal(venv.unwrapped.states, [e.unwrapped.state for e in ref.envs])
         timed_out = ended & (got[0][:, 9] > 1)
-        endings += [(got[4]["is_success"] & ended).sum(), (ended & ~got[4]["is_success"] & ~timed_out).sum(), timed_out.sum()]
+        endings += [
+            (got[4]["is_success"] & ended).sum(),
+            (ended & ~got[4]["is_success"] & ~timed_out).sum(),
+            timed_out.sum(),
+        ]
         obs = got[0]
     assert (endings > 0).all() if n > 1 else endings[1] > 0  # goals, leaving the field, the step limit
 
@@ -372,7 +380,10 @@ def test_copy_i_equals_a_scalar_env_seeded_with_seed_plus_i(env_id, n, seed):
         ((np.array([0.0, 1.0]), (np.zeros((2, 1)), np.zeros((2, 1)), np.zeros((2, 0)))), "array([0., 1.])"),
         ((np.array([0, 1]), (np.zeros((2, 2)), np.zeros((2, 1)), np.zeros((2, 0)))), "(2, 2)"),
         ((np.array([0, 1]), (np.zeros((2, 1)), np.array([[np.nan], [0.0]]), np.zeros((2, 0)))), "copy 0"),
-        ((np.array([0, 1]), (np.zeros((2, 1)), np.zeros((2, 1)), np.zeros((2, 1)))), "break parameters of shape (2, 1)"),
+        (
+            (np.array([0, 1]), (np.zeros((2, 1)), np.zeros((2, 1)), np.zeros((2, 1)))),
+            "break parameters of shape (2, 1)",
+        ),
         (np.array([0, 1]), "array([0, 1])"),
     ],
 )

@@ -2,16 +2,17 @@
 
 The two domains share everything but the agent's ACCELERATE and BREAK (spec §3), so every function takes
 ``sliding`` (False: Moving, the agent moves along its heading; True: Sliding, it keeps a velocity direction
-of its own). A copy's state is a float64 row of :data:`STATE_SIZE` numbers (:data:`X` ... :data:`T`, and
-functions of them that a step would otherwise compute twice, :data:`D` ... :data:`SIN_PHI`), updated in place; the constructor's settings are a row of :data:`N_SETTINGS` numbers (:data:`DEFAULTS`).
-:func:`step` advances one copy by one agent step and :func:`reset` starts its episode; the scalar env calls
-them for its one copy, :func:`step_copies` loops them over the copies of the batched env.
+of its own). A copy's state is row i of a float64 array of :data:`STATE_SIZE` columns (:data:`X` ...
+:data:`T`, and functions of them that a step would otherwise compute twice, :data:`D` ... :data:`SIN_PHI`),
+updated in place; the constructor's settings are a row of :data:`N_SETTINGS` numbers (:data:`DEFAULTS`).
+:func:`step` advances copy i by one agent step and :func:`reset` starts its episode; the scalar env calls
+them for its one copy (i = 0), :func:`step_copies` loops them over the copies of the batched env.
 
 Random numbers: only a reset draws, six uniforms in the spec's §5 order, read from ``draws`` (standard
 uniforms of the copy's generator, ``pamdp.envs.vector``) as ``low + (high - low) * u``, which is how
 NumPy's ``uniform`` computes them. Bit for bit with the original: every ``** 2`` of the original is C's
 ``pow`` (:func:`pow2`), the trigonometric functions and square roots are the C library's (what NumPy calls
-on this project's x86-64 builds), the operations keep the original's order, and ``fastmath`` stays off.
+on x86-64 without AVX-512), the operations keep the original's order, and ``fastmath`` stays off.
 
 Everything the compiled functions read is defined in this file: Numba's on-disk cache is keyed on this
 file alone, so a constant imported from elsewhere could go stale in the cache.
