@@ -174,15 +174,14 @@ def draw_plane(state: np.ndarray) -> Canvas:
 
 
 def draw_agent(canvas: Canvas, state: np.ndarray) -> None:
-    """The agent of one copy: a blue disc with its velocity as a line (drawn at twice its value, the
-    distance covered in two seconds at that speed), or a hollow ring on the border of the picture where
-    the agent is out of view."""
+    """The agent of one copy: a blue disc with its velocity as a line, or a hollow ring on the border of
+    the picture where the agent is out of view."""
     margin = 6.0 / PIXELS_PER_UNIT
     ax, ay = (min(max(v, -VIEW + margin), VIEW - margin) for v in (state[AX], state[AY]))
     px, py = to_pixels(ax, ay)
     if (ax, ay) != (state[AX], state[AY]):
         canvas.circle(px, py, 6.0, (40, 80, 220), outline=2.0)
         return
-    vx, vy = to_pixels(ax + 2.0 * state[VX], ay + 2.0 * state[VY])
+    vx, vy = to_pixels(ax + state[VX], ay + state[VY])
     canvas.line(px, py, vx, vy, (40, 80, 220), width=2.0)
     canvas.circle(px, py, 6.0, (40, 80, 220))

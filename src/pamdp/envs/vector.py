@@ -217,12 +217,14 @@ class BatchedVectorEnv(VectorEnv):
 
     def step(self, actions):
         resetting = self._autoreset
-        self.streams.refill(self.draws_per_step)
+        if self.draws_per_step:
+            self.streams.refill(self.draws_per_step)
         obs, rewards, terminated, truncated, infos = self._step_copies(actions, resetting)
-        rewards[resetting] = 0.0
-        terminated[resetting] = truncated[resetting] = False
-        self._elapsed[resetting] = 0
-        self._elapsed[~resetting] += 1
+        self._elapsed += 1
+        if resetting.any():  # most steps reset no copy: skip the masked writes
+            rewards[resetting] = 0.0
+            terminated[resetting] = truncated[resetting] = False
+            self._elapsed[resetting] = 0
         if self.max_episode_steps is not None:
             truncated |= self._elapsed >= self.max_episode_steps
         self._autoreset = terminated | truncated
