@@ -113,20 +113,41 @@ def hard_move_step(state, mx, my, p):
 
 
 @jit
-def catch_point_copies(states, a, theta, stepping, rewards, terminated, caught):
-    """:func:`catch_point_step` for every copy ``i`` with ``stepping[i]``; the outputs are written."""
-    for i in range(states.shape[0]):
-        if stepping[i]:
+def catch_point_copies(states, a, theta, resetting, draws, cursors, obs, rewards, terminated, caught):
+    """One step of every copy: those with ``resetting[i]`` start an episode (:func:`reset`, reading their
+    own ``draws[i]`` at ``cursors[i]``), the others take :func:`catch_point_step` with ``a[i]`` and
+    ``theta[i]``; then every copy's observation goes into ``obs``. The actions are checked before anything
+    changes: returns the first copy whose ``a`` is neither move nor catch or whose ``theta`` is not
+    finite, else -1. One compiled call per batched step: each call costs as much as a few hundred copies."""
+    n = states.shape[0]
+    for i in range(n):
+        if not (a[i] == MOVE or a[i] == CATCH) or not math.isfinite(theta[i]):
+            return i
+    for i in range(n):
+        if resetting[i]:
+            cursors[i] = reset(states[i], draws[i], cursors[i])
+        else:
             rewards[i], terminated[i], caught[i] = catch_point_step(states[i], a[i], theta[i])
+    observe(states, obs)
+    return -1
 
 
 @jit
-def hard_move_copies(states, a, p, motions, stepping, rewards, terminated):
-    """:func:`hard_move_step` for every copy ``i`` with ``stepping[i]``, action ``a[i]`` moving by
-    ``motions[a[i]]`` with parameter ``p[i]``; the outputs are written."""
-    for i in range(states.shape[0]):
-        if stepping[i]:
+def hard_move_copies(states, a, p, motions, resetting, draws, cursors, obs, rewards, terminated):
+    """:func:`catch_point_copies` for Hard Move: copy ``i`` that is not resetting takes
+    :func:`hard_move_step` with ``motions[a[i]]`` (``a`` already checked) and ``p[i]``. Returns the first
+    copy whose ``p`` is not finite (before anything changes), else -1."""
+    n = states.shape[0]
+    for i in range(n):
+        if not math.isfinite(p[i]):
+            return i
+    for i in range(n):
+        if resetting[i]:
+            cursors[i] = reset(states[i], draws[i], cursors[i])
+        else:
             rewards[i], terminated[i] = hard_move_step(states[i], motions[a[i], 0], motions[a[i], 1], p[i])
+    observe(states, obs)
+    return -1
 
 
 @jit
@@ -174,14 +195,15 @@ def draw_plane(state: np.ndarray) -> Canvas:
 
 
 def draw_agent(canvas: Canvas, state: np.ndarray) -> None:
-    """The agent of one copy: a blue disc with its velocity as a line, or a hollow ring on the border of
-    the picture where the agent is out of view."""
+    """The agent of one copy: a blue disc with its velocity as a line (drawn at twice its value, the
+    distance covered in two seconds at that speed), or a hollow ring on the border of the picture where
+    the agent is out of view."""
     margin = 6.0 / PIXELS_PER_UNIT
     ax, ay = (min(max(v, -VIEW + margin), VIEW - margin) for v in (state[AX], state[AY]))
     px, py = to_pixels(ax, ay)
     if (ax, ay) != (state[AX], state[AY]):
         canvas.circle(px, py, 6.0, (40, 80, 220), outline=2.0)
         return
-    vx, vy = to_pixels(ax + state[VX], ay + state[VY])
+    vx, vy = to_pixels(ax + 2.0 * state[VX], ay + 2.0 * state[VY])
     canvas.line(px, py, vx, vy, (40, 80, 220), width=2.0)
     canvas.circle(px, py, 6.0, (40, 80, 220))

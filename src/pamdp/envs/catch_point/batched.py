@@ -14,9 +14,9 @@ from pamdp.envs.catch_point.env import CatchPointEnv
 from pamdp.envs.catch_point.render import draw_catch_point
 from pamdp.envs.vector import BatchedVectorEnv
 
-__all__ = ["CatchPointVectorEnv", "parse_actions"]
+__all__ = ["CatchPointVectorEnv", "action_arrays"]
 
-RESETS_BUFFERED = 64
+RESETS_BUFFERED = 256
 """Episodes' worth of uniforms drawn at a time per copy."""
 
 
@@ -67,22 +67,23 @@ class CatchPointVectorEnv(BatchedVectorEnv):
     def _reset_copies(self, mask, options):
         particle.reset_copies(self._states, mask, self.streams.buffers, self.streams.cursors)
         self._last_actions[mask] = -1
-        return self._observations(), self._info()
+        obs = np.empty((self.num_envs, particle.OBS_SIZE))
+        particle.observe(self._states, obs)
+        return obs, self._info()
 
     def _step_copies(self, actions, resetting):
-        a, theta = parse_actions(actions, self.num_envs)
-        streams = self.streams
-        particle.reset_copies(self._states, resetting, streams.buffers, streams.cursors)
-        n = self.num_envs
-        rewards, terminated, caught = np.zeros(n), np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
-        particle.catch_point_copies(self._states, a, theta, ~resetting, rewards, terminated, caught)
-        self._last_actions[:] = np.where(resetting, -1, a)
-        return self._observations(), rewards, terminated, np.zeros(n, dtype=bool), self._info(caught, ~resetting)
-
-    def _observations(self) -> np.ndarray:
-        out = np.empty((self.num_envs, particle.OBS_SIZE))
-        particle.observe(self._states, out)
-        return out
+        n, streams = self.num_envs, self.streams
+        a, theta = action_arrays(actions, n)
+        obs, rewards = np.empty((n, particle.OBS_SIZE)), np.zeros(n)
+        terminated, caught = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
+        bad = particle.catch_point_copies(
+            self._states, a, theta, resetting, streams.buffers, streams.cursors, obs, rewards, terminated, caught
+        )
+        if bad >= 0:
+            raise ValueError(f"copy {bad}: action {a[bad]} with angle {theta[bad]}; expected {expected_actions(n)}")
+        if self.render_mode is not None:
+            self._last_actions[:] = np.where(resetting, -1, a)
+        return obs, rewards, terminated, np.zeros(n, dtype=bool), self._info(caught, ~resetting)
 
     def _info(self, caught: np.ndarray | None = None, stepped: np.ndarray | None = None) -> dict:
         """As Gymnasium's vector envs merge the scalar envs' infos: every copy reports its failed catches,
@@ -94,31 +95,27 @@ class CatchPointVectorEnv(BatchedVectorEnv):
         return info
 
 
-def parse_actions(actions, n: int) -> tuple[np.ndarray, np.ndarray]:
-    """Check a batch of ``n`` Catch Point actions; return ``a`` (n,) int64 and ``theta`` (n,) float64."""
-    expected = (
+def expected_actions(n: int) -> str:
+    return (
         f"(a, (theta, catch)) with a an int array of shape ({n},) in {{0, 1}}, theta a finite array of "
         f"shape ({n}, 1) or ({n},) and catch an array of shape ({n}, 0) (or ({n}, 1), ignored)"
     )
+
+
+def action_arrays(actions, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """A batch of ``n`` Catch Point actions as ``a`` (n,) int64 and ``theta`` (n,) float64, its structure,
+    shapes and dtypes checked (``ValueError``); the compiled step checks the values."""
     if not isinstance(actions, (tuple, list)) or len(actions) != 2:
-        raise ValueError(f"invalid batch of Catch Point actions {actions!r}; expected {expected}")
+        raise ValueError(f"invalid batch of Catch Point actions {actions!r}; expected {expected_actions(n)}")
     a = np.asarray(actions[0])
     if a.shape != (n,) or a.dtype.kind not in "iu":
-        raise ValueError(f"invalid discrete actions {actions[0]!r}; expected {expected}")
-    bad = (a < 0) | (a > 1)
-    if bad.any():
-        raise ValueError(f"discrete actions {a[bad]} at indices {np.flatnonzero(bad)}; expected {expected}")
+        raise ValueError(f"invalid discrete actions {actions[0]!r}; expected {expected_actions(n)}")
     params = actions[1]
     if not isinstance(params, (tuple, list)) or len(params) != 2:
-        raise ValueError(f"invalid parameters {params!r}; expected {expected}")
-    theta, catch = np.asarray(params[0]), np.asarray(params[1])
+        raise ValueError(f"invalid parameters {params!r}; expected {expected_actions(n)}")
+    theta, catch = np.asarray(params[0]), np.shape(params[1])
     if theta.shape not in ((n,), (n, 1)) or theta.dtype.kind not in "iuf":
-        raise ValueError(f"invalid angles of shape {theta.shape}: {params[0]!r}; expected {expected}")
-    if catch.shape not in ((n, 0), (n, 1)):
-        raise ValueError(f"invalid catch parameters of shape {catch.shape}; expected {expected}")
-    theta = theta.reshape(n).astype(np.float64)
-    if not np.isfinite(theta).all():
-        raise ValueError(
-            f"angles {theta[~np.isfinite(theta)]} at indices {np.flatnonzero(~np.isfinite(theta))}; expected {expected}"
-        )
-    return a.astype(np.int64), theta
+        raise ValueError(f"invalid angles of shape {theta.shape}: {params[0]!r}; expected {expected_actions(n)}")
+    if catch not in ((n, 0), (n, 1)):
+        raise ValueError(f"invalid catch parameters of shape {catch}; expected {expected_actions(n)}")
+    return a.astype(np.int64, copy=False), theta.astype(np.float64, copy=False).reshape(n)

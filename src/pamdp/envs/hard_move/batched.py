@@ -18,8 +18,11 @@ from pamdp.envs.vector import BatchedVectorEnv
 
 __all__ = ["HardMoveVectorEnv", "parse_actions"]
 
-RESETS_BUFFERED = 64
+RESETS_BUFFERED = 256
 """Episodes' worth of uniforms drawn at a time per copy."""
+STACK_AT_MOST = 256
+"""Up to this many boxes (n = 4, 6, 8) stacking all the parameters costs less than taking each copy's own;
+at n = 10 (1024 boxes) taking each copy's own costs less (docs/environments.md gives the speeds)."""
 
 
 class HardMoveVectorEnv(BatchedVectorEnv):
@@ -80,23 +83,23 @@ class HardMoveVectorEnv(BatchedVectorEnv):
     def _reset_copies(self, mask, options):
         particle.reset_copies(self._states, mask, self.streams.buffers, self.streams.cursors)
         self._last_actions[mask] = -1
-        return self._observations(), {}
+        obs = np.empty((self.num_envs, particle.OBS_SIZE))
+        particle.observe(self._states, obs)
+        return obs, {}
 
     def _step_copies(self, actions, resetting):
-        a, p = parse_actions(actions, self.num_envs, len(self.motions))
-        streams = self.streams
-        particle.reset_copies(self._states, resetting, streams.buffers, streams.cursors)
-        n = self.num_envs
-        rewards, terminated = np.zeros(n), np.zeros(n, dtype=bool)
-        particle.hard_move_copies(self._states, a, p, self.motions, ~resetting, rewards, terminated)
-        self._last_actions[:] = np.where(resetting, -1, a)
-        self._last_params[:] = p
-        return self._observations(), rewards, terminated, np.zeros(n, dtype=bool), _info(terminated.copy(), ~resetting)
-
-    def _observations(self) -> np.ndarray:
-        out = np.empty((self.num_envs, particle.OBS_SIZE))
-        particle.observe(self._states, out)
-        return out
+        n, streams = self.num_envs, self.streams
+        a, p = parse_actions(actions, n, len(self.motions))
+        obs, rewards, terminated = np.empty((n, particle.OBS_SIZE)), np.zeros(n), np.zeros(n, dtype=bool)
+        bad = particle.hard_move_copies(
+            self._states, a, p, self.motions, resetting, streams.buffers, streams.cursors, obs, rewards, terminated
+        )
+        if bad >= 0:
+            raise ValueError(f"copy {bad}: parameter {p[bad]} of action {a[bad]}; expected a finite number")
+        if self.render_mode is not None:
+            self._last_actions[:] = np.where(resetting, -1, a)
+            self._last_params[:] = p
+        return obs, rewards, terminated, np.zeros(n, dtype=bool), _info(terminated.copy(), ~resetting)
 
 
 def _info(success: np.ndarray, stepped: np.ndarray) -> dict:
@@ -106,46 +109,53 @@ def _info(success: np.ndarray, stepped: np.ndarray) -> dict:
 
 def parse_actions(actions, n: int, n_actions: int) -> tuple[np.ndarray, np.ndarray]:
     """Check a batch of ``n`` Hard Move actions with ``n_actions`` discrete actions; return ``a`` (n,)
-    int64 and each copy's own parameter ``p[i] = p_{a[i]}[i]`` (n,) float64.
+    int64 and each copy's own parameter ``p[i] = p_{a[i]}[i]`` (n,) float64 (the compiled step checks
+    that it is finite).
 
-    The parameters are gathered without a Python loop over the ``n_actions`` boxes or the copies: from
-    a stacked array by fancy indexing, from a sequence of boxes by ``map`` over the chosen ones (C-level
-    iteration; only those are checked).
+    The parameters are gathered without a Python loop over the ``n_actions`` boxes or the copies: a
+    sequence of at most :data:`STACK_AT_MOST` boxes is stacked (in C) and read by fancy indexing, as a
+    stacked array is; from a longer one, ``map`` takes each copy's own box and value (C-level iteration;
+    only those boxes are checked).
     """
     expected = (
         f"(a, (p_0, ..., p_{n_actions - 1})) with a an int array of shape ({n},) in 0..{n_actions - 1} and "
         f"each p an array of shape ({n}, 1) or ({n},), or all of them stacked in one array of shape "
-        f"({n_actions}, {n}, 1) or ({n_actions}, {n}); the chosen ones finite"
+        f"({n_actions}, {n}, 1) or ({n_actions}, {n})"
     )
     if not isinstance(actions, (tuple, list)) or len(actions) != 2:
         raise ValueError(f"invalid batch of Hard Move actions {actions!r}; expected {expected}")
     a = np.asarray(actions[0])
     if a.shape != (n,) or a.dtype.kind not in "iu":
         raise ValueError(f"invalid discrete actions {actions[0]!r}; expected {expected}")
-    bad = (a < 0) | (a >= n_actions)
-    if bad.any():
+    if a.min() < 0 or a.max() >= n_actions:
+        bad = (a < 0) | (a >= n_actions)
         raise ValueError(f"discrete actions {a[bad]} at indices {np.flatnonzero(bad)}; expected {expected}")
-    a = a.astype(np.int64)
+    a = a.astype(np.int64, copy=False)
     params = actions[1]
-    if isinstance(params, np.ndarray):
-        if params.shape not in ((n_actions, n, 1), (n_actions, n)) or params.dtype.kind not in "iuf":
-            raise ValueError(f"invalid stacked parameters of shape {params.shape}; expected {expected}")
-        p = params.reshape(n_actions, n)[a, np.arange(n)].astype(np.float64)
-    else:
+    if not isinstance(params, np.ndarray):
         if not isinstance(params, (tuple, list)) or len(params) != n_actions:
             given = f"{len(params)} boxes" if isinstance(params, (tuple, list)) else f"a {type(params).__name__}"
             raise ValueError(f"invalid parameters ({given}); expected {expected}")
-        chosen = list(map(params.__getitem__, a.tolist()))  # copy i's box
+        if n_actions > STACK_AT_MOST:
+            return a, _gather(params, a, n, expected)
         try:
-            shapes = set(map(attrgetter("shape"), chosen))
-            kinds = {dtype.kind for dtype in set(map(attrgetter("dtype"), chosen))}
-        except AttributeError:
-            raise ValueError(f"the chosen parameters are not all arrays; expected {expected}") from None
-        if not shapes <= {(n,), (n, 1)} or not kinds <= set("iuf"):
-            found = f"shapes {sorted(shapes)} and dtype kinds {sorted(kinds)}"
-            raise ValueError(f"the chosen parameters have {found}; expected {expected}")
-        p = np.fromiter(map(np.ndarray.item, chosen, range(n)), np.float64, n)  # p_{a[i]}[i]
-    finite = np.isfinite(p)
-    if not finite.all():
-        raise ValueError(f"parameters {p[~finite]} at indices {np.flatnonzero(~finite)}; expected {expected}")
-    return a, p
+            params = np.asarray(params)
+        except ValueError:
+            raise ValueError(f"the parameter boxes differ in shape; expected {expected}") from None
+    if params.shape not in ((n_actions, n, 1), (n_actions, n)) or params.dtype.kind not in "iuf":
+        raise ValueError(f"parameters stacked to shape {params.shape}, dtype {params.dtype}; expected {expected}")
+    return a, params.reshape(n_actions, n)[a, np.arange(n)].astype(np.float64, copy=False)
+
+
+def _gather(params, a, n: int, expected: str) -> np.ndarray:
+    """``params[a[i]][i]`` for every copy ``i``, by C-level iteration over the chosen boxes (checked)."""
+    chosen = list(map(params.__getitem__, a.tolist()))  # copy i's box
+    try:
+        shapes = set(map(attrgetter("shape"), chosen))
+        kinds = {dtype.kind for dtype in set(map(attrgetter("dtype"), chosen))}
+    except AttributeError:
+        raise ValueError(f"the chosen parameters are not all arrays; expected {expected}") from None
+    if not shapes <= {(n,), (n, 1)} or not kinds <= set("iuf"):
+        found = f"shapes {sorted(shapes)} and dtype kinds {sorted(kinds)}"
+        raise ValueError(f"the chosen parameters have {found}; expected {expected}")
+    return np.fromiter(map(np.ndarray.item, chosen, range(n)), np.float64, n)  # p_{a[i]}[i]
