@@ -137,14 +137,31 @@ def test_render_writes_a_gif(tmp_path):
     assert gif.read_bytes()[:6] in (b"GIF87a", b"GIF89a")
 
 
-def test_soccer_evaluation_reports_goal_rate(tmp_path, capsys):
+def test_soccer_evaluation_reports_its_success_rate_as_a_goal_rate(tmp_path, capsys):
     out = tmp_path / "hfo"
     argv = ["train", "patrpo", "--env", "pamdp/HalfFieldOffense-v0", "--total-steps", "500", "--out", str(out)]
     assert main([*argv, "--eval-episodes", "0", *TINY]) == 0
     assert main(["evaluate", str(out), "--episodes", "8", "--json"]) == 0
     result = json.loads(capsys.readouterr().out)
-    assert result["episodes"] == 8 and 0.0 <= result["goal_rate"] <= 1.0
-    assert result["mean_steps_to_goal"] is None or result["mean_steps_to_goal"] > 0
+    assert result["episodes"] == 8 and 0.0 <= result["success_rate"] <= 1.0
+    assert result["mean_steps_to_success"] is None or result["mean_steps_to_success"] > 0
+    assert main(["evaluate", str(out), "--episodes", "8"]) == 0
+    assert f"; goal rate {result['success_rate']:.3f}" in capsys.readouterr().out  # the same 8 episodes
+
+
+def test_evaluation_lines_name_success_by_the_env_and_read_old_keys():
+    from pamdp.cli import _format_evaluation
+
+    base = {"episodes": 4, "mean_return": 1.0, "std_return": 0.0, "mean_length": 9.0}
+    new = {**base, "success_rate": 0.75, "mean_steps_to_success": 8.0}
+    assert _format_evaluation(new, env_id="pamdp/CatchPoint-v0").endswith("; success rate 0.750, 8.0 steps to success")
+    assert _format_evaluation(new, env_id="pamdp/Goal-v0").endswith("; goal rate 0.750, 8.0 steps to goal")
+    # an evaluation.json written before the general name, and one whose env never succeeded
+    old = {**base, "goal_rate": 0.5, "mean_steps_to_goal": None}
+    assert _format_evaluation(old, env_id="pamdp/HalfFieldOffense-v0").endswith(
+        "(mean length 9.0 steps); goal rate 0.500"
+    )
+    assert "rate" not in _format_evaluation(base, env_id="pamdp/Platform-v0")
 
 
 def test_config_file_preset_and_seed_with_flags(tmp_path):

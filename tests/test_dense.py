@@ -6,6 +6,7 @@ import dataclasses
 
 import pytest
 import torch
+from test_hybrid_plumbing import MaskedLine
 from torch import nn
 
 from pamdp import PADDPG, PASVG0
@@ -90,12 +91,14 @@ SMALL = PADDPGConfig(hidden_sizes=(32, 24), learning_starts=64, batch_size=16, e
 
 
 def _autograd_update(model):
-    """PADDPG's update on autograd: the form its hand-written update must equal."""
+    """PADDPG's update on autograd: the form its hand-written update must equal (with action masks, the critic
+    sees a forbidden action's score at -1)."""
     cfg = model.config
     batch = model.replay.sample(cfg.batch_size, model.np_rng)
     obs, next_obs = batch["obs"], batch["next_obs"]
     with torch.no_grad():
-        q_next = model.critic_target(next_obs, model.actor_target(next_obs).clamp(-1.0, 1.0))
+        out_next = model._masked(model.actor_target(next_obs).clamp(-1.0, 1.0), batch.get("next_mask"))
+        q_next = model.critic_target(next_obs, out_next)
         y = batch["reward"] + cfg.gamma * (~batch["terminated"]).float() * q_next
         y = torch.where(torch.isnan(batch["mc"]), y, cfg.beta * batch["mc"].nan_to_num() + (1 - cfg.beta) * y)
     q = model.critic(obs, batch["out"])
@@ -104,7 +107,7 @@ def _autograd_update(model):
     (q - y).square().mean().backward()
     nn.utils.clip_grad_norm_(model.critic.parameters(), cfg.grad_clip)
     model.critic_optimizer.step()
-    backprop_actor(model.actor, model.critic, obs, cfg.bound)
+    backprop_actor(lambda o: model._masked(model.actor(o), batch.get("mask")), model.critic, obs, cfg.bound)
     nn.utils.clip_grad_norm_(model.actor.parameters(), cfg.grad_clip)
     model.actor_optimizer.step()
     with torch.no_grad():
@@ -113,10 +116,10 @@ def _autograd_update(model):
                 t.lerp_(s, cfg.tau)
 
 
-@pytest.mark.parametrize("bound", ["invert", "squash", "zero"])
-def test_paddpg_update_matches_the_autograd_update(bound):
-    cfg = dataclasses.replace(SMALL, bound=bound, grad_clip=0.5, activation="leaky_relu")
-    mine = PADDPG("pamdp/Platform-v0", cfg)
+@pytest.mark.parametrize("bound, masked", [("invert", False), ("squash", False), ("zero", False), ("invert", True)])
+def test_paddpg_update_matches_the_autograd_update(bound, masked):
+    cfg = dataclasses.replace(SMALL, bound=bound, grad_clip=0.5, activation="leaky_relu", action_mask=masked)
+    mine = PADDPG(MaskedLine() if masked else "pamdp/Platform-v0", cfg)
     mine.learn(200, progress_bar=False)  # fills the replay and takes ~140 updates, so Adam's state exists
     ref = copy.deepcopy(mine)
     for _ in range(30):  # both draw the same batch from their (equal) random streams
@@ -136,11 +139,12 @@ SVG_SMALL = PASVG0Config(hidden_sizes=(32, 24), learning_starts=64, batch_size=1
         {},  # the paper's: straight-through, learned log-std, no entropy bonus
         {"straight_through": False, "entropy_coef": 0.05, "activation": "tanh"},
         {"learn_std": False, "temperature": 0.5, "init_log_std": 2.0},  # log-std at the clamp's bound
+        {"action_mask": True, "entropy_coef": 0.05},  # on an env that forbids an action in some states
     ],
 )
 def test_pasvg_update_matches_the_autograd_update(settings):
     cfg = dataclasses.replace(SVG_SMALL, **settings)
-    mine = PASVG0("pamdp/Platform-v0", cfg)
+    mine = PASVG0(MaskedLine() if cfg.action_mask else "pamdp/Platform-v0", cfg)
     mine.learn(200, progress_bar=False)
     ref = copy.deepcopy(mine)
     ref._bind_networks()  # its soft update over its own copies

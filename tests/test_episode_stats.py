@@ -118,7 +118,7 @@ def test_off_policy_epoch_reports_the_success_rate_the_env_saw():
     fields |= {"next_obs": ((2,), np.float32), "terminated": ((), np.bool_)}
     loop = OffPolicyLoop(PADDPGConfig(epoch_steps=600, learning_starts=10**9), hybrid, ReplayBuffer(10_000, fields))
 
-    def act(obs, step, episode_start):
+    def act(obs, step, episode_start, mask):
         return torch.zeros(len(obs), dtype=torch.int64), torch.zeros(len(obs), 1), {}
 
     stats = loop.run_epoch(env, act, dict, 0, np.random.default_rng(0))

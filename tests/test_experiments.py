@@ -288,24 +288,27 @@ def test_greedy_evaluations_get_their_own_figure(tmp_path):
     assert "without" not in report["greedy_svg"].read_text() and "with_eval" in report["greedy_svg"].read_text()
 
 
-def test_training_goal_rates_get_their_own_figure(tmp_path):
-    from pamdp.experiments.plots import GOAL_METRIC, aggregate, write_report
+def test_training_success_rates_get_their_own_figure_under_either_name(tmp_path):
+    from pamdp.experiments.plots import SUCCESS_METRIC, aggregate, write_report
 
-    header = "time/total_timesteps,charts/episodic_return,charts/goal_rate\n"
-    for seed, rates in {0: ["", 0.5, 0.7], 1: ["", 0.3, 0.9]}.items():  # the first epoch predates the column
-        run = tmp_path / "exp" / "soccer" / f"seed{seed}"
-        run.mkdir(parents=True)
-        rows = [f"{1000 * (i + 1)},{0.1 * i},{v}" for i, v in enumerate(rates)]
-        (run / "progress.csv").write_text(header + "\n".join(rows) + "\n")
-    agg = aggregate(sorted((tmp_path / "exp" / "soccer").iterdir()), GOAL_METRIC)
-    assert agg["mean"][1:] == pytest.approx([0.4, 0.8]) and agg["std"][2] == pytest.approx(0.1)
+    # soccer's runs on disk logged the rate as charts/goal_rate; runs since as charts/success_rate
+    for name, column in (("soccer", "charts/goal_rate"), ("goal", "charts/success_rate")):
+        header = f"time/total_timesteps,charts/episodic_return,{column}\n"
+        for seed, rates in {0: ["", 0.5, 0.7], 1: ["", 0.3, 0.9]}.items():  # the first epoch predates the column
+            run = tmp_path / "exp" / name / f"seed{seed}"
+            run.mkdir(parents=True)
+            rows = [f"{1000 * (i + 1)},{0.1 * i},{v}" for i, v in enumerate(rates)]
+            (run / "progress.csv").write_text(header + "\n".join(rows) + "\n")
+        agg = aggregate(sorted((tmp_path / "exp" / name).iterdir()), SUCCESS_METRIC)
+        assert agg["mean"][1:] == pytest.approx([0.4, 0.8]) and agg["std"][2] == pytest.approx(0.1)
     report = write_report([tmp_path / "exp"], tmp_path / "fig")
-    assert report["goal_png"].exists() and "goal rate" in report["goal_svg"].read_text()
-    assert "greedy_png" not in report
+    svg = report["success_svg"].read_text()
+    assert report["success_png"].exists() and "success rate" in svg and "soccer" in svg and "goal" in svg
+    assert "greedy_png" not in report and "greedy_success_png" not in report
     plain = tmp_path / "platform" / "PATRPO" / "seed0"
     plain.mkdir(parents=True)
     (plain / "progress.csv").write_text("time/total_timesteps,charts/episodic_return\n1000,0.1\n2000,0.2\n")
-    assert "goal_png" not in write_report([tmp_path / "platform"], tmp_path / "fig2")
+    assert "success_png" not in write_report([tmp_path / "platform"], tmp_path / "fig2")
 
 
 def test_an_arm_still_training_keeps_its_finished_seeds_curves(tmp_path):
@@ -374,3 +377,111 @@ def test_status_paces_an_off_policy_run_by_its_epochs_after_warm_up(tmp_path):
     (out / "progress.csv").write_text("\n".join(rows[:4]) + "\n")  # warm-up only: no pace to go by yet
     assert run_status(spec, out).seconds_per_step is None
     assert remaining_seconds([run_status(spec, out)])[1] == {"small delta": 1}
+
+
+def test_runs_give_their_own_env_budget_and_evaluation_interval(tmp_path):
+    path = tmp_path / "suite.toml"
+    path.write_text("""
+seeds = [0, 1]
+eval_every = 3
+[[runs]]
+label = "a on Goal"
+algo = "pdqn"
+env = "pamdp/Goal-v0"
+total_steps = 3e5
+[[runs]]
+label = "b on Hard Move n=6"
+algo = "patrpo"
+env = "pamdp/HardMove-v0"
+env_kwargs = { n = 6 }
+total_steps = 1_000_000
+eval_every = 2
+""")
+    exp = load_experiment(path)
+    specs = exp.specs(scale=0.01)
+    assert [(s.env, s.total_steps, s.eval_every, s.seed) for s in specs] == [
+        ("pamdp/Goal-v0", 3_000, 3, 0),
+        ("pamdp/Goal-v0", 3_000, 3, 1),
+        ("pamdp/HardMove-v0", 10_000, 2, 0),
+        ("pamdp/HardMove-v0", 10_000, 2, 1),
+    ]
+    assert dict(specs[2].env_kwargs) == {"n": 6}
+    # An experiment-wide budget is every run's that gives none; a run's own wins.
+    text = path.read_text().replace("seeds", "total_steps = 50\nenv = 'pamdp/Platform-v0'\nseeds", 1)
+    path.write_text(text.replace("total_steps = 3e5\n", "").replace('env = "pamdp/Goal-v0"\n', ""))
+    assert [(s.env, s.total_steps) for s in load_experiment(path).specs(seeds=[0])] == [
+        ("pamdp/Platform-v0", 50),
+        ("pamdp/HardMove-v0", 1_000_000),
+    ]
+
+
+@pytest.mark.parametrize(
+    "change, message",
+    [
+        (("total_steps = 3e5\n", ""), r"run 0 \('a'\) has no total_steps, nor has the file"),
+        (('env = "x"\n', ""), r"run 0 \('a'\) has no env, nor has the file"),
+        (("total_steps = 3e5", "total_steps = 0.5"), r"runs\[0\].total_steps = 0.5; expected a whole number of steps"),
+        (("total_steps = 3e5", "total_steps = 3e5\neval_every = -1"), r"runs\[0\].eval_every = -1; expected an int"),
+    ],
+)
+def test_bad_run_budgets_are_refused_naming_the_run(tmp_path, change, message):
+    path = tmp_path / "bad.toml"
+    text = 'seeds = [0]\n[[runs]]\nlabel = "a"\nalgo = "pdqn"\nenv = "x"\ntotal_steps = 3e5\n'
+    path.write_text(text.replace(*change))
+    with pytest.raises(ValueError, match=message):
+        load_experiment(path)
+
+
+def test_the_benchmark_suite_is_hyars_table_at_its_budgets():
+    exp = load_experiment("benchmark-suite")
+    budgets = {"Platform": 200_000, "Goal": 300_000, "Hard Goal": 300_000, "Catch Point": 1_000_000}
+    budgets.update({f"Hard Move n={n}": 1_000_000 for n in (4, 6, 8, 10)})  # ../shared/specs/benchmarks.md
+    specs = exp.specs()
+    assert len(exp.seeds) >= 3 and exp.eval_episodes == 1000
+    for method in ("MP-DQN", "HyAR-TD3", "PATRPO"):
+        mine = {s.label.split(" on ")[1]: s for s in specs if s.label.startswith(method + " on ")}
+        assert {d: s.total_steps for d, s in mine.items()} == budgets
+        assert all(s.eval_every >= 1 for s in mine.values())
+    hard_move = {dict(s.env_kwargs)["n"] for s in specs if s.env == "pamdp/HardMove-v0"}
+    assert hard_move == {4, 6, 8, 10}
+    assert all(s.config()[2].multi_pass for s in specs if s.algo == "pdqn")
+
+
+def _suite_run(root, label, env, seed, env_kwargs=None, evaluation=None, greedy=None):
+    run = root / label.replace(" ", "_") / f"seed{seed}"
+    run.mkdir(parents=True)
+    (run / "run.json").write_text(json.dumps({"label": label, "algo": "x", "env": env, "env_kwargs": env_kwargs or {}}))
+    column = "eval/mean_return" if env == "pamdp/Platform-v0" else "eval/success_rate"
+    rows = "".join(f"{10_000 * (i + 1)},0.0,{v}\n" for i, v in enumerate(greedy or [""]))
+    (run / "progress.csv").write_text(f"time/total_timesteps,charts/episodic_return,{column}\n{rows}")
+    if evaluation is not None:
+        (run / "evaluation.json").write_text(json.dumps({"mean_return": 0.0, **evaluation}))
+
+
+def test_the_suite_table_puts_each_domains_runs_beside_hyars_numbers(tmp_path):
+    from pamdp.experiments.plots import write_report
+
+    root = tmp_path / "benchmark-suite"
+    for seed, rate in enumerate((0.5, 0.7, 0.9)):
+        _suite_run(root, "MP-DQN on Goal", "pamdp/Goal-v0", seed, evaluation={"success_rate": rate})
+    _suite_run(root, "MP-DQN on Platform", "pamdp/Platform-v0", 0, evaluation={"mean_return": 0.96})
+    _suite_run(root, "MP-DQN on Platform", "pamdp/Platform-v0", 1, evaluation={"goal_rate": 1.0, "mean_return": 0.9})
+    # a run still training: its last greedy evaluation; another domain's n tells Hard Move's rows apart
+    _suite_run(root, "PATRPO on Hard Move n=8", "pamdp/HardMove-v0", 0, {"n": 8}, greedy=[0.1, "", 0.4])
+    _suite_run(root, "PATRPO on Goal", "pamdp/Goal-v0", 0)  # nothing evaluated yet
+    report = write_report([root], tmp_path / "fig")
+    lines = report["suite"].read_text().splitlines()
+    assert lines[0] == "| domain | pamdp MP-DQN | pamdp PATRPO | HyAR's HyAR-TD3 | HyAR's PDQN | HyAR's HPPO |"
+    rows = {line.split(" | ")[0][2:]: line.split(" | ")[1:] for line in lines[2:10]}
+    assert list(rows) == ["Platform", "Goal", "Hard Goal", "Catch Point"] + [f"Hard Move n={n}" for n in (4, 6, 8, 10)]
+    goal_std = np.std([0.5, 0.7, 0.9])
+    assert rows["Goal"][:2] == [f"0.70 +- {goal_std:.2f} (3 seeds)", "-"]
+    assert rows["Goal"][2:] == ["0.78 +- 0.03", "0.70 +- 0.07", "0.0 |"]
+    assert rows["Platform"][0] == "0.93 +- 0.03 (2 seeds)"  # the return, not the old success key
+    assert rows["Hard Move n=8"][:2] == ["-", "0.40 +- 0.00 (1 seed, 1 partial*)"]
+    assert rows["Hard Move n=10"][:2] == ["-", "-"] and rows["Hard Move n=10"][2] == "0.75 +- 0.05"
+    assert report["domain-goal_png"].exists() and "domain-hard-move-n8_svg" in report
+    other = tmp_path / "other"
+    _suite_run(other, "MP-DQN on CartPole", "CartPole-v1", 0, evaluation={"success_rate": 1.0})
+    _suite_run(other, "MP-DQN on Hard Move n=5", "pamdp/HardMove-v0", 0, {"n": 5}, evaluation={"success_rate": 1.0})
+    assert "suite" not in write_report([other], tmp_path / "fig2")

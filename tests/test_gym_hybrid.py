@@ -110,51 +110,71 @@ def test_reset_draws_the_originals_two_uniforms_and_nothing_ahead(make_rng):
 
 
 def test_squares_are_c_pow_not_products():
-    # The original's ``** 2`` is C's pow, which differs from v * v in the last bit for a few inputs.
-    v = np.random.default_rng(0).uniform(-2.0, 2.0, 20_000)
+    # The original's ``** 2`` is C's pow, which differs from v * v in the last bit for a few inputs; pow2
+    # finds it without calling pow for most of them. The hard inputs below are each nearest a halfway case.
+    rng = np.random.default_rng(0)
+    v = np.concatenate(
+        [rng.uniform(-2.0, 2.0, 100_000), rng.uniform(-1e-3, 1e-3, 10_000), [0.0, -0.0, 2.0**-60, 1e120]]
+    )
     pow2 = np.array([dyn.pow2(x) for x in v])
     assert pow2.tolist() == [math.pow(x, 2) for x in v]
-    assert (pow2 != v * v).sum() > 0
+    assert (pow2 != v * v).sum() > 50
+    assert [dyn.c_pow2(x) for x in v[:2000]] == [math.pow(x, 2) for x in v[:2000]]
+
+
+def test_wrap_angle_is_pythons_floor_mod():
+    rng = np.random.default_rng(1)
+    tiny = [0.0, -0.0, -1e-300, -1e-17, 2 * np.pi, np.nextafter(2 * np.pi, 0), 4 * np.pi, -2 * np.pi, 1e5, -1e5]
+    a = np.concatenate([rng.uniform(-np.pi / 2, 2.5 * np.pi, 50_000), rng.uniform(-50.0, 50.0, 5_000), tiny])
+    got = [dyn.wrap_angle(x) for x in a]
+    want = [float(x) % (2 * np.pi) for x in a]
+    assert got == want and [math.copysign(1, g) for g in got] == [math.copysign(1, w) for w in want]
 
 
 # --- the rules, from the spec's formulas --------------------------------------------------------------
 def start(x=0.0, y=0.0, theta=0.0, tx=0.5, ty=0.5):
-    state = np.zeros(dyn.STATE_SIZE)
-    state[[dyn.X, dyn.Y, dyn.THETA, dyn.TX, dyn.TY]] = x, y, theta, tx, ty
+    """One copy's states array (one row), at rest."""
+    state = dyn.INITIAL_STATE[None].copy()
+    state[0, [dyn.X, dyn.Y, dyn.THETA, dyn.TX, dyn.TY]] = x, y, theta, tx, ty
+    dyn.refresh(state, 0)
     return state
 
 
+def step(state, a, p, sliding):
+    return dyn.step(state, 0, a, p, dyn.DEFAULTS, sliding)
+
+
 def observe(state):
-    out = np.empty(dyn.OBS_SIZE)
-    dyn.observe(state, dyn.DEFAULTS, out)
-    return out
+    out = np.empty((1, dyn.OBS_SIZE))
+    dyn.observe(state, 0, dyn.DEFAULTS, out)
+    return out[0]
 
 
 def test_moving_goes_along_its_heading_and_sliding_keeps_its_velocity():
     moving, sliding = start(), start()
     for state, is_sliding in ((moving, False), (sliding, True)):
-        dyn.step(state, 0, 1.0, dyn.DEFAULTS, is_sliding)  # speed 0.5, one move of 0.005 * 0.5 along x
-        dyn.step(state, 1, 1.0, dyn.DEFAULTS, is_sliding)  # heading pi/2, then a move
-    assert moving[[dyn.X, dyn.Y, dyn.SPEED]].tolist() == pytest.approx([0.0025, 0.0025, 0.5], abs=1e-15)
-    assert sliding[[dyn.X, dyn.Y, dyn.SPEED]].tolist() == pytest.approx([0.005, 0.0, 0.5], abs=1e-15)
-    assert sliding[dyn.THETA] == moving[dyn.THETA] == np.pi / 2
+        step(state, 0, 1.0, is_sliding)  # speed 0.5, one move of 0.005 * 0.5 along x
+        step(state, 1, 1.0, is_sliding)  # heading pi/2, then a move
+    assert moving[0, [dyn.X, dyn.Y, dyn.SPEED]].tolist() == pytest.approx([0.0025, 0.0025, 0.5], abs=1e-15)
+    assert sliding[0, [dyn.X, dyn.Y, dyn.SPEED]].tolist() == pytest.approx([0.005, 0.0, 0.5], abs=1e-15)
+    assert sliding[0, dyn.THETA] == moving[0, dyn.THETA] == np.pi / 2
     # Thrust 0.5 along y added to velocity 0.5 along x: speed sqrt(0.5) at 45 degrees, as vectors add.
-    dyn.step(sliding, 0, 1.0, dyn.DEFAULTS, True)
-    assert sliding[dyn.SPEED] == pytest.approx(math.hypot(0.5, 0.5), abs=1e-15)
-    assert sliding[dyn.PHI] == pytest.approx(np.pi / 4, abs=1e-15)
-    assert sliding[dyn.X] == pytest.approx(0.005 + 0.0025, abs=1e-15)
+    step(sliding, 0, 1.0, True)
+    assert sliding[0, dyn.SPEED] == pytest.approx(math.hypot(0.5, 0.5), abs=1e-15)
+    assert sliding[0, dyn.PHI] == pytest.approx(np.pi / 4, abs=1e-15)
+    assert sliding[0, dyn.X] == pytest.approx(0.005 + 0.0025, abs=1e-15)
 
 
 def test_break_slows_by_a_tenth_or_stops_and_a_stopped_slider_faces_its_heading():
     state = start(theta=1.0)
-    dyn.step(state, 0, 0.5, dyn.DEFAULTS, True)  # speed 0.25 along the heading
-    dyn.step(state, 1, 0.5, dyn.DEFAULTS, True)  # heading 1 + pi/4, still sliding at angle 1
+    step(state, 0, 0.5, True)  # speed 0.25 along the heading
+    step(state, 1, 0.5, True)  # heading 1 + pi/4, still sliding at angle 1
     speeds = []
     for _ in range(3):
-        dyn.step(state, 2, 0.0, dyn.DEFAULTS, True)
-        speeds.append(state[dyn.SPEED])
+        step(state, 2, 0.0, True)
+        speeds.append(state[0, dyn.SPEED])
     assert speeds == pytest.approx([0.15, 0.05, 0.0], abs=1e-15) and speeds[-1] == 0.0
-    assert state[dyn.PHI] == state[dyn.THETA] == 1.0 + np.pi / 4
+    assert state[0, dyn.PHI] == state[0, dyn.THETA] == 1.0 + np.pi / 4
 
 
 @pytest.mark.parametrize(
@@ -168,28 +188,28 @@ def test_break_slows_by_a_tenth_or_stops_and_a_stopped_slider_faces_its_heading(
 )
 def test_parameters_are_clipped_and_the_heading_wrapped(a, p, theta, speed):
     state = start(theta=0.25 if a == 1 else 0.0)
-    dyn.step(state, a, p, dyn.DEFAULTS, False)
+    step(state, a, p, False)
     want = (theta + np.clip(p, -1, 1) * np.pi / 2) % (2 * np.pi) if a == 1 else theta
-    assert state[dyn.THETA] == want and 0 <= state[dyn.THETA] < 2 * np.pi and state[dyn.SPEED] == speed
+    assert state[0, dyn.THETA] == want and 0 <= state[0, dyn.THETA] < 2 * np.pi and state[0, dyn.SPEED] == speed
 
 
 def test_the_goal_needs_a_full_stop_strictly_inside_the_target():
     # At distance exactly 0.1 the indicator says "inside" but stopping there is no goal.
     edge = start(x=0.1, tx=0.0, ty=0.0)
-    assert dyn.distance(edge) == 0.1 and observe(edge)[8] == 1.0
-    assert dyn.step(edge, 2, 0.0, dyn.DEFAULTS, False) == (-0.001, False, False)
+    assert dyn.distance(edge, 0) == 0.1 and observe(edge)[8] == 1.0
+    assert step(edge, 2, 0.0, False) == (-0.001, False, False)
     inside = start(x=0.05, tx=0.0, ty=0.0)
-    dyn.step(inside, 0, 0.2, dyn.DEFAULTS, False)  # moving: no goal
-    assert not dyn.step(inside, 1, 0.0, dyn.DEFAULTS, False)[1]
-    d_prev = dyn.distance(inside)
-    reward, terminated, goal = dyn.step(inside, 2, 0.0, dyn.DEFAULTS, False)  # speed 0.1 - 0.1 = 0: stopped
-    assert terminated and goal and reward == ((d_prev - dyn.distance(inside)) - 0.001) + 1
+    step(inside, 0, 0.2, False)  # moving: no goal
+    assert not step(inside, 1, 0.0, False)[1]
+    d_prev = dyn.distance(inside, 0)
+    reward, terminated, goal = step(inside, 2, 0.0, False)  # speed 0.1 - 0.1 = 0: stopped
+    assert terminated and goal and reward == ((d_prev - dyn.distance(inside, 0)) - 0.001) + 1
 
 
 def test_leaving_the_field_is_strict():
     state = start(x=1.0, tx=0.0)
-    assert dyn.step(state, 1, 0.0, dyn.DEFAULTS, False) == (-0.001, False, False)  # on the edge: still in
-    assert dyn.step(state, 0, 0.01, dyn.DEFAULTS, False) == (-1.0, True, False) and state[dyn.X] > 1.0
+    assert step(state, 1, 0.0, False) == (-0.001, False, False)  # on the edge: still in
+    assert step(state, 0, 0.01, False) == (-1.0, True, False) and state[0, dyn.X] > 1.0
 
 
 def test_an_episode_has_201_steps_the_last_one_rewarded_minus_one():
@@ -212,8 +232,8 @@ def test_settings_change_the_dynamics():
     np.testing.assert_allclose(obs[:2] - obs0[:2], 0.01 * obs0[3:5], rtol=0, atol=1e-15)
     assert obs[2] == 1.0 and obs[9] == 0.1 and reward == obs0[7] - obs[7]
     assert env.step(act(2))[0][2] == 0.75
-    lengths = [env.step(act(1, 0.0))[2] for _ in range(9)]
-    assert lengths == [False] * 8 + [True]  # the step after the 10th ends the episode
+    ended = [env.step(act(1, 0.0))[2] for _ in range(9)]
+    assert ended == [False] * 8 + [True]  # the step after the 10th ends the episode
 
 
 def test_a_homing_policy_reaches_the_goal():
@@ -313,7 +333,9 @@ def test_render_shows_target_and_agent():
 
 
 # --- the batched envs ------------------------------------------------------------------------------------
-@pytest.mark.parametrize("env_id, n, seed", [("pamdp/Moving-v0", 1, 0), ("pamdp/Moving-v0", 9, 4), ("pamdp/Sliding-v0", 12, 40)])
+@pytest.mark.parametrize(
+    "env_id, n, seed", [("pamdp/Moving-v0", 1, 0), ("pamdp/Moving-v0", 9, 4), ("pamdp/Sliding-v0", 12, 40)]
+)
 def test_copy_i_equals_a_scalar_env_seeded_with_seed_plus_i(env_id, n, seed):
     """The batched env against Gymnasium's SyncVectorEnv over scalar envs (env i seeded ``seed + i``, next-step
     autoreset too): copies play random actions, the homing policy or stand still, so episodes end at the
@@ -342,7 +364,11 @@ def test_copy_i_equals_a_scalar_env_seeded_with_seed_plus_i(env_id, n, seed):
             np.testing.assert_array_equal(got[4]["is_success"][ended], want[4]["is_success"][ended])
         np.testing.assert_array_equal(venv.unwrapped.states, [e.unwrapped.state for e in ref.envs])
         timed_out = ended & (got[0][:, 9] > 1)
-        endings += [(got[4]["is_success"] & ended).sum(), (ended & ~got[4]["is_success"] & ~timed_out).sum(), timed_out.sum()]
+        endings += [
+            (got[4]["is_success"] & ended).sum(),
+            (ended & ~got[4]["is_success"] & ~timed_out).sum(),
+            timed_out.sum(),
+        ]
         obs = got[0]
     assert (endings > 0).all() if n > 1 else endings[1] > 0  # goals, leaving the field, the step limit
 
@@ -350,11 +376,14 @@ def test_copy_i_equals_a_scalar_env_seeded_with_seed_plus_i(env_id, n, seed):
 @pytest.mark.parametrize(
     "action, shown",
     [
-        ((np.array([0, 3]), (np.zeros((2, 1)), np.zeros((2, 1)), np.zeros((2, 0)))), "[3]"),
+        ((np.array([0, 3]), (np.zeros((2, 1)), np.zeros((2, 1)), np.zeros((2, 0)))), "copy 1: discrete action 3"),
         ((np.array([0.0, 1.0]), (np.zeros((2, 1)), np.zeros((2, 1)), np.zeros((2, 0)))), "array([0., 1.])"),
         ((np.array([0, 1]), (np.zeros((2, 2)), np.zeros((2, 1)), np.zeros((2, 0)))), "(2, 2)"),
-        ((np.array([0, 1]), (np.zeros((2, 1)), np.array([[np.nan], [0.0]]), np.zeros((2, 0)))), "nan"),
-        ((np.array([0, 1]), (np.zeros((2, 1)), np.zeros((2, 1)), np.zeros((2, 1)))), "break parameters of shape (2, 1)"),
+        ((np.array([0, 1]), (np.zeros((2, 1)), np.array([[np.nan], [0.0]]), np.zeros((2, 0)))), "copy 0"),
+        (
+            (np.array([0, 1]), (np.zeros((2, 1)), np.zeros((2, 1)), np.zeros((2, 1)))),
+            "break parameters of shape (2, 1)",
+        ),
         (np.array([0, 1]), "array([0, 1])"),
     ],
 )

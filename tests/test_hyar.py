@@ -122,7 +122,7 @@ def model(**kw):
 def test_warm_up_acts_uniformly_and_its_latents_are_reencoded():
     m = model(warmup_steps=3000, epoch_steps=2000, buffer_size=6000, num_envs=64, vae_updates=0, updates_per_step=0.05)
     obs = torch.from_numpy(np.random.default_rng(0).uniform(0, 1, size=(3000, 9)).astype(np.float32))
-    a, x, extras = m._explore(obs, 0, np.zeros(3000, dtype=bool))
+    a, x, extras = m._explore(obs, 0, np.zeros(3000, dtype=bool), None)
     np.testing.assert_allclose(np.bincount(a.numpy(), minlength=3) / 3000, [1 / 3] * 3, atol=0.04)
     assert x.min() < -0.95 and x.max() > 0.95 and abs(float(x.mean())) < 0.05
     m.learn(2000, progress_bar=False)
@@ -165,14 +165,14 @@ def test_epsilon_draws_embeddings_uniformly_and_anneals():
     obs = torch.from_numpy(np.random.default_rng(0).uniform(0, 1, size=(3000, 9)).astype(np.float32))
     with torch.no_grad():
         greedy = m.actor.to_latent(m.actor(obs))
-        a, x, extras = m._explore(obs, 1, np.zeros(3000, dtype=bool))  # past the warm-up, epsilon ~1
+        a, x, extras = m._explore(obs, 1, np.zeros(3000, dtype=bool), None)  # past the warm-up, epsilon ~1
     latent = torch.from_numpy(extras["latent"])
     np.testing.assert_allclose(np.bincount(a.numpy(), minlength=3) / 3000, [1 / 3] * 3, atol=0.04)
     torch.testing.assert_close(latent[:, :3], m.rep.embedding[a].detach())  # exactly the drawn action's row
     torch.testing.assert_close(latent[:, 3:], greedy[:, 3:])  # the parameters' latent is the actor's
     with torch.no_grad():
         torch.testing.assert_close(x, m.rep.decode(obs, latent)[1])
-        a_late, _, extras = m._explore(obs, 10**6, np.zeros(3000, dtype=bool))  # epsilon 0.2
+        a_late, _, extras = m._explore(obs, 10**6, np.zeros(3000, dtype=bool), None)  # epsilon 0.2
     replaced = (torch.from_numpy(extras["latent"])[:, :3] != greedy[:, :3]).any(-1).float().mean()
     assert float(replaced) == pytest.approx(0.2, abs=0.03)
 

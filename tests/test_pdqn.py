@@ -149,9 +149,9 @@ def test_epsilon_annealing_endpoints_and_exploration():
     starts = np.zeros(3000, dtype=bool)
     with torch.no_grad():
         greedy, _ = model._act(obs, deterministic=True)
-        a, x, extras = model._explore(obs, 0, starts)  # epsilon 1: uniform actions
+        a, x, extras = model._explore(obs, 0, starts, None)  # epsilon 1: uniform actions
         np.testing.assert_allclose(np.bincount(a.numpy(), minlength=3) / 3000, [1 / 3] * 3, atol=0.04)
-        a, _, _ = model._explore(obs, 10**6, starts)  # epsilon 0.05: greedy but for about 5% x 2/3
+        a, _, _ = model._explore(obs, 10**6, starts, None)  # epsilon 0.05: greedy but for about 5% x 2/3
         assert np.mean(a.numpy() != greedy.numpy()) == pytest.approx(0.05 * 2 / 3, abs=0.015)
 
 
@@ -161,7 +161,7 @@ def test_explore_params_redraws_only_the_random_actions_parameters():
     obs = torch.from_numpy(np.random.default_rng(0).uniform(0, 1, size=(2000, 9)).astype(np.float32))
     with torch.no_grad():
         clean = model.actor(obs).clamp(-1, 1)
-        a, x, extras = model._explore(obs, 0, np.zeros(2000, dtype=bool))
+        a, x, extras = model._explore(obs, 0, np.zeros(2000, dtype=bool), None)
     params = torch.from_numpy(extras["params"])
     chosen = torch.from_numpy(param_blocks(model.hybrid))[a]
     torch.testing.assert_close(params[~chosen], clean[~chosen])  # the other actions keep the actor's

@@ -155,7 +155,7 @@ def test_epoch_stats_average_each_figure_over_the_updates_that_computed_it():
     loop = OffPolicyLoop(config, hybrid, ReplayBuffer(1000, fields))
     calls = []
 
-    def act(obs, step, episode_start):
+    def act(obs, step, episode_start, mask):
         n = len(obs)
         return torch.zeros(n, dtype=torch.long), torch.zeros(n, hybrid.max_param_size), {}
 

@@ -319,7 +319,7 @@ def cmd_train(args) -> int:
             )
         return 130
     if result:
-        print(_format_evaluation(result))
+        print(_format_evaluation(result, env_id=args.env))
     return 0
 
 
@@ -342,7 +342,9 @@ def cmd_reproduce(args) -> int:
 
         print(format_status(exp.name, [run_status(spec, out) for spec, out in jobs], args.workers), end="")
         return 0
-    print(f"{exp.name}: {exp.description}; {len(jobs)} runs of {jobs[0][0].total_steps:,} steps", file=sys.stderr)
+    budgets = sorted({spec.total_steps for spec, _ in jobs})
+    steps = f"{budgets[0]:,}" if len(budgets) == 1 else f"{budgets[0]:,} to {budgets[-1]:,}"
+    print(f"{exp.name}: {exp.description}; {len(jobs)} runs of {steps} steps", file=sys.stderr)
     if args.backend == "ray":
         from pamdp.experiments.ray_backend import run_all_ray
 
@@ -369,20 +371,30 @@ def cmd_plot(args) -> int:
 def _print_report(report: dict) -> None:
     """The results table on stdout, the figures' paths on stderr."""
     print(report["table"].read_text())
+    if "suite" in report:
+        print(report["suite"].read_text())
     figures = [v for k, v in report.items() if k.endswith(("png", "svg"))]
     print(f"figures: {', '.join(map(str, figures))}", file=sys.stderr)
 
 
 # -- evaluate, render ----------------------------------------------------------------------------
-def _format_evaluation(result: dict, policy: str = "greedy") -> str:
-    """One line: ``policy`` (greedy, or stochastic) return, length, and on HFO the goal rate."""
+# What a success is where the env's own word says it better than "success" (``info["is_success"]``)
+SUCCESS_WORDS = {"pamdp/HalfFieldOffense-v0": "goal", "pamdp/Goal-v0": "goal", "pamdp/HardGoal-v0": "goal"}
+
+
+def _format_evaluation(result: dict, policy: str = "greedy", env_id: str | None = None) -> str:
+    """One line: ``policy`` (greedy, or stochastic) return, length, and, where the env reports success, the
+    success rate (the goal rate on the soccer envs) and the mean steps of the successful episodes."""
+    from pamdp.algos.logger import success_of
+
     text = (
         f"{policy} return over {result['episodes']} episodes: {result['mean_return']:.4f} +- {result['std_return']:.4f}"
     )
     text += f" (mean length {result['mean_length']:.1f} steps)"
-    if "goal_rate" in result:
-        steps = result["mean_steps_to_goal"]
-        text += f"; goal rate {result['goal_rate']:.3f}" + (f", {steps:.1f} steps to goal" if steps is not None else "")
+    rate, steps = success_of(result)
+    if rate is not None:
+        word = SUCCESS_WORDS.get(env_id, "success")
+        text += f"; {word} rate {rate:.3f}" + (f", {steps:.1f} steps to {word}" if steps is not None else "")
     return text
 
 
@@ -394,7 +406,7 @@ def cmd_evaluate(args) -> int:
     seed = args.seed if args.seed is not None else 10_000 + model.config.seed
     policy = "stochastic" if args.stochastic else "greedy"
     result = evaluate(model, episodes=args.episodes, seed=seed, deterministic=not args.stochastic)
-    print(json.dumps({**result, "policy": policy}) if args.json else _format_evaluation(result, policy))
+    print(json.dumps({**result, "policy": policy}) if args.json else _format_evaluation(result, policy, model.env_id))
     return 0
 
 

@@ -28,8 +28,9 @@ def evaluate(
 
     Each of the ``num_envs`` copies plays a fixed share of the episodes, so that short episodes are not
     over-represented. Returns ``mean_return``, ``std_return``, ``mean_length`` and ``episodes``; when the
-    env reports ``info["is_success"]`` at an episode's end (Half Field Offense: a goal), also ``goal_rate``
-    and ``mean_steps_to_goal`` (``None`` when no episode succeeded), over the episodes that reported it.
+    env reports ``info["is_success"]`` at an episode's end (a goal on Half Field Offense and Goal, a target
+    reached or caught on the others), also ``success_rate`` and ``mean_steps_to_success`` (``None`` when no
+    episode succeeded), over the episodes that reported it.
     """
     if episodes < 1:
         raise ValueError(f"episodes = {episodes!r}; expected an integer >= 1")
@@ -72,5 +73,5 @@ def evaluate(
     }
     summary = success_summary(lengths, succeeded)
     if summary is not None:
-        result["goal_rate"], result["mean_steps_to_goal"] = summary
+        result["success_rate"], result["mean_steps_to_success"] = summary
     return result

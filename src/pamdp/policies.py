@@ -14,7 +14,7 @@ import torch
 import torch.nn.functional as F
 from torch import nn
 
-from pamdp.distributions import HybridDistribution
+from pamdp.distributions import HybridDistribution, masked_logits
 from pamdp.spaces import HybridActionSpace
 
 __all__ = ["ACTIVATIONS", "mlp", "LinearizedMLP", "HybridPolicy", "ValueNetwork"]
@@ -139,10 +139,11 @@ class HybridPolicy(nn.Module):
         eye = torch.eye(self.n_actions, dtype=obs.dtype, device=obs.device)
         return obs.unsqueeze(1).expand(batch, self.n_actions, self.obs_dim), eye.expand(batch, -1, -1)
 
-    def forward(self, obs: torch.Tensor) -> HybridDistribution:
-        """The distribution at ``obs`` ``(B, obs_dim)``, with ``pi_c`` evaluated for every action in one pass."""
+    def forward(self, obs: torch.Tensor, action_mask: torch.Tensor | None = None) -> HybridDistribution:
+        """The distribution at ``obs`` ``(B, obs_dim)``, with ``pi_c`` evaluated for every action in one pass;
+        ``action_mask`` (bool ``(B, K)``, True = allowed) restricts ``pi_d`` to the allowed actions."""
         means = self.param_means(*self._every_action(obs))
-        return HybridDistribution(self.pi_d(obs), means, self.log_std, self.mask)
+        return HybridDistribution(masked_logits(self.pi_d(obs), action_mask), means, self.log_std, self.mask)
 
     def linearize(
         self, obs: torch.Tensor
@@ -151,6 +152,8 @@ class HybridPolicy(nn.Module):
 
         The product takes parameter tangents by name (``dict(self.named_parameters())``'s keys) and returns the
         tangents of ``(logits (B, K), means (B, K, m), log_std (K, m))``, the distribution's own parameters.
+        The logits are unmasked: a KL's Hessian at a masked distribution gives masked actions no weight, so a
+        Fisher-vector product needs no mask beyond the old distribution's.
         """
         lin_d = LinearizedMLP(self.pi_d, obs)
         lin_c = LinearizedMLP(self.pi_c, torch.cat(self._every_action(obs), dim=-1))

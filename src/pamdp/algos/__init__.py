@@ -64,6 +64,9 @@ ALGORITHMS: dict[str, AlgoEntry] = {
     "hyar": AlgoEntry(
         "pamdp.algos.hyar:HyAR", "HyAR-TD3 (Li et al.): TD3 in a learned latent space of hybrid actions", 200_000
     ),
+    "hsac": AlgoEntry(
+        "pamdp.algos.hsac:HybridSAC", "Hybrid SAC (Delalleau et al.): soft actor-critic, flat or hierarchical", 300_000
+    ),
 }
 """Command-line name -> :class:`AlgoEntry`."""
 

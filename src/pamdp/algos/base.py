@@ -99,6 +99,12 @@ class Algorithm:
         self.observation_space = obs_space
         self.action_space = act_space
         self.hybrid = HybridActionSpace.from_gym(act_space)
+        if self.hybrid.max_param_size == 0:
+            raise ValueError(
+                f"action space {act_space!r}: no action has parameters (every box has size 0), so it is a plain "
+                "discrete action space; expected at least one action with continuous parameters (use a "
+                "discrete-action algorithm such as DQN on the Discrete part)"
+            )
         self.obs_dim = int(obs_space.shape[0])
         self.device = resolve_device(config.device)
         self.num_timesteps = 0
@@ -121,8 +127,11 @@ class Algorithm:
         """Collect one epoch of samples and learn from them; returns statistics including ``"steps"``."""
         raise NotImplementedError
 
-    def _act(self, obs: torch.Tensor, deterministic: bool) -> tuple[torch.Tensor, torch.Tensor]:
-        """Discrete actions ``(B,)`` and padded ``[-1, 1]`` parameters ``(B, m)`` for a batch of observations."""
+    def _act(
+        self, obs: torch.Tensor, deterministic: bool, mask: torch.Tensor | None = None
+    ) -> tuple[torch.Tensor, torch.Tensor]:
+        """Discrete actions ``(B,)`` and padded ``[-1, 1]`` parameters ``(B, m)`` for a batch of observations,
+        among the actions ``mask`` allows (bool ``(B, K)`` on the device; ``None``: all)."""
         raise NotImplementedError
 
     def _modules(self) -> dict[str, torch.nn.Module]:
@@ -165,8 +174,12 @@ class Algorithm:
         return torch.as_tensor(np.asarray(obs, dtype=np.float32), device=self.device)
 
     # -- public API --------------------------------------------------------------------------
-    def predict(self, obs, deterministic: bool = True):
-        """The action for one observation (the env's action tuple) or a batch (a vector env's action)."""
+    def predict(self, obs, deterministic: bool = True, action_mask=None):
+        """The action for one observation (the env's action tuple) or a batch (a vector env's action).
+
+        ``action_mask``: bool ``(K,)`` for one observation, ``(N, K)`` for a batch, True where a discrete action
+        is allowed (an env's ``info["action_mask"]``); the action is chosen among those. ``None``: all allowed.
+        """
         expected = f"expected an array of shape ({self.obs_dim},) or (N, {self.obs_dim})"
         shown = "" if isinstance(obs, np.ndarray) else f" {obs!r:.60}"  # an array's shape says it in one line
         try:
@@ -183,8 +196,18 @@ class Algorithm:
             raise ValueError(
                 f"observation with a non-finite value {obs[tuple(where)]} at index {where}; expected numbers"
             )
+        mask = None
+        if action_mask is not None:
+            k = self.hybrid.n_actions
+            mask = np.asarray(action_mask)
+            if mask.dtype != np.bool_ or mask.shape != obs.shape[:-1] + (k,):
+                raise ValueError(
+                    f"action_mask of dtype {mask.dtype} and shape {mask.shape}; expected bool of shape "
+                    f"{obs.shape[:-1] + (k,)} (True where a discrete action is allowed)"
+                )
+            mask = torch.as_tensor(mask.reshape(-1, k), device=self.device)
         with torch.no_grad():
-            a, x = self._act(self._obs_tensor(obs.reshape(-1, self.obs_dim)), deterministic)
+            a, x = self._act(self._obs_tensor(obs.reshape(-1, self.obs_dim)), deterministic, mask)
         a, x = a.cpu().numpy(), x.cpu().numpy()
         return self.hybrid.to_env(a[0], x[0]) if single else self.hybrid.to_env_batch(a, x)
 

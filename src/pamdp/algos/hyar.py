@@ -57,9 +57,11 @@ from pamdp.algos.offpolicy import (
     linear_epsilon,
     shared_setting,
     soft_update,
+    uniform_actions,
 )
 from pamdp.algos.replay import ReplayBuffer, transition_fields
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, at_least, interval, one_of, setting
+from pamdp.distributions import masked_logits
 from pamdp.policies import ACTIVATIONS, mlp
 from pamdp.spaces import HybridActionSpace
 
@@ -230,15 +232,31 @@ class ActionRepresentation(nn.Module):
         """Action ``a``'s parameters for latent ``z``, in ``[-1, 1]``, zero in the unused slots."""
         return torch.tanh(self.param_head(self._trunk(obs, a, z))) * self.mask[a]
 
-    def nearest_action(self, e: torch.Tensor) -> torch.Tensor:
-        """The discrete action whose embedding is nearest to ``e`` (Euclidean distance)."""
-        return torch.cdist(e, self.embedding).argmin(-1)
+    def nearest_action(self, e: torch.Tensor, mask: torch.Tensor | None = None) -> torch.Tensor:
+        """The discrete action whose embedding is nearest to ``e`` (Euclidean distance), among those ``mask``
+        allows."""
+        distance = torch.cdist(e, self.embedding)
+        return distance.argmin(-1) if mask is None else masked_logits(-distance, mask).argmax(-1)
 
-    def decode(self, obs: torch.Tensor, latent: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
-        """The hybrid action ``(a, x)`` of latent actions ``(e, z)``, concatenated in ``latent``."""
+    def decode(
+        self, obs: torch.Tensor, latent: torch.Tensor, mask: torch.Tensor | None = None
+    ) -> tuple[torch.Tensor, torch.Tensor]:
+        """The hybrid action ``(a, x)`` of latent actions ``(e, z)``, concatenated in ``latent`` (``a`` among the
+        actions ``mask`` allows)."""
         e, z = latent.split([self.embedding.shape[1], self.latent_dim], dim=-1)
-        a = self.nearest_action(e)
+        a = self.nearest_action(e, mask)
         return a, self.decode_params(obs, a, z)
+
+    def snap(self, latent: torch.Tensor, mask: torch.Tensor | None) -> torch.Tensor:
+        """Latent actions whose nearest embedding is a forbidden action, with ``e`` moved onto the embedding of
+        the allowed action they decode to: the critic then sees which action each one executes."""
+        if mask is None:
+            return latent
+        d = self.embedding.shape[1]
+        e = latent[:, :d]
+        a = self.nearest_action(e, mask)
+        moved = torch.where((a != self.nearest_action(e))[:, None], self.embedding[a], e)
+        return torch.cat([moved, latent[:, d:]], dim=-1)
 
     def latent(self, obs: torch.Tensor, a: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
         """The current (deterministic) latent action of ``(a, x)``: ``(e_a, mu(x, s, e_a))``."""
@@ -318,6 +336,7 @@ class HyAR(Algorithm):
         fields = transition_fields(
             self.obs_dim,
             h.max_param_size,
+            masks=h.n_actions if cfg.action_mask else 0,
             latent=((self.latent_size,), np.float32),  # the latent action that was decoded and executed
         )
         self.replay = ReplayBuffer(cfg.buffer_size, fields, self.device)
@@ -351,20 +370,20 @@ class HyAR(Algorithm):
             self.pretrained = False
 
     # -- acting ----------------------------------------------------------------------------------
-    def _act(self, obs, deterministic):
+    def _act(self, obs, deterministic, mask=None):
         u = self.actor(obs).clamp(-1.0, 1.0)
         if not deterministic:
             u = self._noisy(u)
-        return self.rep.decode(obs, self.actor.to_latent(u))
+        return self.rep.decode(obs, self.actor.to_latent(u), mask)
 
     def _noisy(self, u: torch.Tensor) -> torch.Tensor:
         noise = self.np_rng.normal(0.0, self.config.exploration_noise, size=u.shape).astype(np.float32)
         return (u + self._from_numpy(noise)).clamp(-1.0, 1.0)
 
-    def _explore(self, obs: torch.Tensor, step: int, episode_start: np.ndarray):
+    def _explore(self, obs: torch.Tensor, step: int, episode_start: np.ndarray, mask: torch.Tensor | None):
         if step < self.config.warmup_steps:  # uniformly random hybrid actions; latents are filled in after warm-up
             n, h = len(obs), self.hybrid
-            a = self._from_numpy(self.np_rng.integers(h.n_actions, size=n))
+            a = uniform_actions(n, h.n_actions, mask, self.np_rng, self.device)
             x = self.np_rng.uniform(-1.0, 1.0, size=(n, h.max_param_size)).astype(np.float32)
             x = self._from_numpy(x) * self.rep.mask[a]
             return a, x, {"latent": np.zeros((n, self.latent_size), dtype=np.float32)}
@@ -372,10 +391,11 @@ class HyAR(Algorithm):
         eps = self.epsilon(step)
         if eps > 0:  # a uniformly drawn action's embedding in place of the actor's, the parameters' latent kept
             drawn = self._from_numpy(self.np_rng.random(len(obs)) < eps)
-            k = self._from_numpy(self.np_rng.integers(self.hybrid.n_actions, size=len(obs)))
+            k = uniform_actions(len(obs), self.hybrid.n_actions, mask, self.np_rng, self.device)
             e = torch.where(drawn[:, None], self.rep.embedding[k], latent[:, : self.config.embed_dim])
             latent = torch.cat([e, latent[:, self.config.embed_dim :]], dim=-1)
-        a, x = self.rep.decode(obs, latent)
+        latent = self.rep.snap(latent, mask)
+        a, x = self.rep.decode(obs, latent, mask)
         return a, x, {"latent": latent.cpu().numpy()}
 
     def epsilon(self, step: int) -> float:
@@ -446,7 +466,7 @@ class HyAR(Algorithm):
         current = self.rep.latent(b["obs"], b["a"], b["x"])
         if mode == "all":
             return current, 1.0
-        a, x = self.rep.decode(b["obs"], latent)
+        a, x = self.rep.decode(b["obs"], latent, b.get("mask"))
         stale = (a != b["a"]) | ((x - b["x"] * self.rep.mask[b["a"]]).abs().amax(-1) > self.config.relabel_tolerance)
         return torch.where(stale[:, None], current, latent), float(stale.float().mean())
 
@@ -474,7 +494,8 @@ class HyAR(Algorithm):
             u_next = self.actor_target(next_obs).clamp(-1.0, 1.0)
             noise = torch.randn(u_next.shape, generator=self.torch_gen, device=self.device) * cfg.target_noise
             u_next = (u_next + noise.clamp(-cfg.target_noise_clip, cfg.target_noise_clip)).clamp(-1.0, 1.0)
-            q1_next, q2_next = self.critic_target(next_obs, self.actor_target.to_latent(u_next))
+            latent_next = self.rep.snap(self.actor_target.to_latent(u_next), b.get("next_mask"))
+            q1_next, q2_next = self.critic_target(next_obs, latent_next)
             y = b["reward"] + cfg.gamma * (~b["terminated"]).float() * torch.minimum(q1_next, q2_next)
         q1, q2 = self.critic(obs, latent)
         critic_loss = F.mse_loss(q1, y) + F.mse_loss(q2, y)

@@ -9,7 +9,26 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["EpisodeTracker", "Logger", "successes", "success_summary"]
+__all__ = ["EpisodeTracker", "Logger", "successes", "success_summary", "RENAMED", "SUCCESS_KEYS", "success_of"]
+
+RENAMED = {
+    "charts/success_rate": "charts/goal_rate",
+    "charts/steps_to_success": "charts/steps_to_goal",
+    "eval/success_rate": "eval/goal_rate",
+}
+"""Logged names -> the names runs recorded before success had its general name (soccer's runs on disk)."""
+
+SUCCESS_KEYS = (("success_rate", "mean_steps_to_success"), ("goal_rate", "mean_steps_to_goal"))
+"""An evaluation's success keys, then the ones ``evaluation.json`` files written before held."""
+
+
+def success_of(result: dict) -> tuple[float | None, float | None]:
+    """``(success rate, mean steps to success)`` of an evaluation, by its keys or their old names (``None``
+    where it has none)."""
+    for rate, steps in SUCCESS_KEYS:
+        if rate in result:
+            return result[rate], result.get(steps)
+    return None, None
 
 
 def successes(info: dict | None, ended: np.ndarray) -> list[bool | None]:
@@ -38,8 +57,8 @@ class EpisodeTracker:
     Where the env says whether an episode succeeded (``info["is_success"]`` at its end, the Gymnasium and SB3
     convention; a goal on Half Field Offense), the success rate and the mean length of the successful episodes
     are kept too, over the episodes whose end reported it: the training counterparts of
-    :func:`pamdp.evaluation.evaluate`'s ``goal_rate`` and ``mean_steps_to_goal``, logged as ``charts/goal_rate``
-    and ``charts/steps_to_goal`` (the names of the recorded runs, all on soccer).
+    :func:`pamdp.evaluation.evaluate`'s ``success_rate`` and ``mean_steps_to_success``, logged as
+    ``charts/success_rate`` and ``charts/steps_to_success`` (runs recorded before: :data:`RENAMED`).
     """
 
     def __init__(self, num_envs: int):
@@ -76,9 +95,9 @@ class EpisodeTracker:
         }
         summary = success_summary(self.done_lengths, self.done_goals)
         if summary is not None:
-            stats["charts/goal_rate"] = summary[0]
+            stats["charts/success_rate"] = summary[0]
             if summary[1] is not None:
-                stats["charts/steps_to_goal"] = summary[1]
+                stats["charts/steps_to_success"] = summary[1]
         self.done_returns, self.done_lengths, self.done_goals = [], [], []
         return stats
 

@@ -33,6 +33,8 @@ from pamdp.algos.logger import EpisodeTracker
 from pamdp.algos.replay import ReplayBuffer
 from pamdp.algos.settings import NON_NEGATIVE, POSITIVE, at_least, interval, setting
 from pamdp.algos.subnormals import subnormals_flushed
+from pamdp.algos.vector_env import info_action_masks
+from pamdp.distributions import masked_logits
 
 __all__ = [
     "OffPolicyConfig",
@@ -46,6 +48,7 @@ __all__ = [
     "optimizer_step",
     "gradient_step",
     "linear_epsilon",
+    "uniform_actions",
     "mixed_target",
     "discounted_returns",
     "BOUNDS",
@@ -101,8 +104,11 @@ def shared_setting(name: str, default, source: str):
     return setting(default, f"{help.rstrip('.')} ({source}).")
 
 
-# act(obs (N, d) tensor, global step, episode_start (N,) bool) -> (a (N,), x (N, m) in [-1, 1], extra fields)
-ActFn = Callable[[torch.Tensor, int, np.ndarray], tuple[torch.Tensor, torch.Tensor, dict[str, np.ndarray]]]
+# act(obs (N, d) tensor, global step, episode_start (N,) bool, mask (N, K) bool tensor or None)
+#     -> (a (N,), x (N, m) in [-1, 1], extra fields); mask: the allowed actions, with the action_mask setting only
+ActFn = Callable[
+    [torch.Tensor, int, np.ndarray, torch.Tensor | None], tuple[torch.Tensor, torch.Tensor, dict[str, np.ndarray]]
+]
 # update() -> the figures it computed; an epoch's stats average each one over the updates that returned it, so a
 # figure computed every few updates (a delayed actor step, a representation round) is the mean of those steps.
 UpdateFn = Callable[[], dict[str, float]]
@@ -222,6 +228,23 @@ def linear_epsilon(step: int, start: float, end: float, steps: int) -> float:
     return start + min(step / steps, 1.0) * (end - start)
 
 
+def uniform_actions(
+    n: int, n_actions: int, mask: torch.Tensor | None, rng: np.random.Generator | torch.Generator, device
+) -> torch.Tensor:
+    """``n`` discrete actions drawn uniformly among those ``mask`` allows (bool ``(n, K)``; ``None``: all K), on
+    ``device``, from ``rng`` (NumPy's or torch's). Without a mask the draw is ``rng``'s integers in ``[0, K)``,
+    as before masks existed; with one, the argmax of uniform scores over the allowed actions."""
+    if isinstance(rng, torch.Generator):
+        if mask is None:
+            return torch.randint(n_actions, (n,), generator=rng, device=device)
+        scores = torch.rand((n, n_actions), generator=rng, device=device)
+    else:
+        if mask is None:
+            return torch.from_numpy(rng.integers(n_actions, size=n)).to(device)
+        scores = torch.from_numpy(rng.random((n, n_actions))).to(device)
+    return masked_logits(scores, mask).argmax(-1)
+
+
 def mixed_target(y: torch.Tensor, mc: torch.Tensor, beta: float) -> torch.Tensor:
     """Hausknecht & Stone's mixed target ``beta * MC + (1 - beta) * y`` where the Monte-Carlo return is known.
 
@@ -296,7 +319,12 @@ class OffPolicyLoop:
             algorithm's extras, and ``mc`` when ``mc_returns``.
         mc_returns: compute Monte-Carlo returns (discounted by ``config.gamma``) when episodes end.
         tail_value: with ``mc_returns``, the value of a truncated episode's final observations
-            ``(B, d) -> (B,)``, which bootstraps its Monte-Carlo return; ``None`` treats the cut as an end.
+            ``(B, d)`` with their action masks (``(B, K)`` bool, or ``None``) ``-> (B,)``, which bootstraps its
+            Monte-Carlo return; ``None`` treats the cut as an end.
+
+    With the ``action_mask`` setting the loop reads the env's ``info["action_mask"]`` at every step, passes the
+    current state's to ``act`` and stores both states' in the buffer's ``mask`` and ``next_mask`` fields (build
+    it with ``transition_fields(..., masks=K)``).
     """
 
     def __init__(
@@ -305,7 +333,7 @@ class OffPolicyLoop:
         hybrid,
         buffer: ReplayBuffer,
         mc_returns: bool = False,
-        tail_value: Callable[[np.ndarray], np.ndarray] | None = None,
+        tail_value: Callable[[np.ndarray, np.ndarray | None], np.ndarray] | None = None,
     ):
         self.config = config
         self.hybrid = hybrid
@@ -314,6 +342,7 @@ class OffPolicyLoop:
         self.tail_value = tail_value
         self.update_credit = 0.0
         self.obs: np.ndarray | None = None  # the env's current observations; None until the first reset
+        self.masks: np.ndarray | None = None  # their allowed actions (N, K), with the action_mask setting
 
     def _start(self, env, np_rng: np.random.Generator) -> None:
         self.env = env
@@ -322,7 +351,14 @@ class OffPolicyLoop:
         self.prev_done = np.zeros(self.num_envs, dtype=bool)
         self.episode_start = np.ones(self.num_envs, dtype=bool)
         self._pending: list[tuple[list[int], list[float]]] = [([], []) for _ in range(self.num_envs)]
-        self.obs, _ = env.reset(seed=int(np_rng.integers(2**31 - 1)))
+        self.obs, info = env.reset(seed=int(np_rng.integers(2**31 - 1)))
+        self.masks = self._masks(info)
+
+    def _masks(self, info: dict) -> np.ndarray | None:
+        """The allowed actions of each copy's new observation, with the action_mask setting (else ``None``)."""
+        if not self.config.action_mask:
+            return None
+        return info_action_masks(info, self.num_envs, self.hybrid.n_actions)
 
     def run_epoch(
         self, env, act: ActFn, update: UpdateFn, start_step: int, np_rng: np.random.Generator
@@ -339,12 +375,13 @@ class OffPolicyLoop:
         n_updates = n_valid = 0
         while n_valid < n_samples:
             obs = np.asarray(self.obs, dtype=np.float32)
+            device = self.buffer.device
+            mask = None if self.masks is None else torch.from_numpy(self.masks).to(device)
             with torch.no_grad():  # the observations to the algorithm's device, the actions back
-                a, x, extras = act(
-                    torch.from_numpy(obs).to(self.buffer.device), start_step + n_valid, self.episode_start
-                )
+                a, x, extras = act(torch.from_numpy(obs).to(device), start_step + n_valid, self.episode_start, mask)
             a, x = a.cpu().numpy(), x.cpu().numpy()
             next_obs, reward, terminated, truncated, info = self.env.step(self.hybrid.to_env_batch(a, x))
+            next_masks = self._masks(info)
             valid = ~self.prev_done
             done = (terminated | truncated) & valid
             self.tracker.step(np.asarray(reward, dtype=np.float64), done, valid, info)
@@ -360,9 +397,11 @@ class OffPolicyLoop:
                 }
                 if self.mc_returns:
                     row["mc"] = np.full(int(valid.sum()), np.nan, dtype=np.float32)
+                if next_masks is not None:
+                    row["mask"], row["next_mask"] = self.masks[valid], next_masks[valid]
                 counters = self.buffer.add(**row)
                 if self.mc_returns:
-                    self._finish_returns(counters, valid, reward, terminated, done, next_obs)
+                    self._finish_returns(counters, valid, reward, terminated, done, next_obs, next_masks)
                 counts += np.bincount(a[valid], minlength=self.hybrid.n_actions)
                 n = int(valid.sum())
                 n_valid += n
@@ -377,7 +416,7 @@ class OffPolicyLoop:
                             n_updates += 1
             self.episode_start = ~valid
             self.prev_done = done
-            self.obs = next_obs
+            self.obs, self.masks = next_obs, next_masks
         stats = {k: v / reported[k] for k, v in sums.items()}
         stats["train/updates"] = float(n_updates)
         stats["train/buffer_size"] = float(len(self.buffer))
@@ -386,13 +425,15 @@ class OffPolicyLoop:
         stats["steps"] = n_valid
         return stats
 
-    def _finish_returns(self, counters, valid, reward, terminated, done, next_obs) -> None:
+    def _finish_returns(self, counters, valid, reward, terminated, done, next_obs, next_masks) -> None:
         """Queue this step's transitions per env copy; write their Monte-Carlo returns when episodes end."""
         ended = np.flatnonzero(done)
         tails = np.zeros(self.num_envs)
         cut = [i for i in ended if not terminated[i]]
         if cut and self.tail_value is not None:
-            tails[cut] = self.tail_value(np.asarray(next_obs, dtype=np.float32)[cut])
+            tails[cut] = self.tail_value(
+                np.asarray(next_obs, dtype=np.float32)[cut], None if next_masks is None else next_masks[cut]
+            )
         for c, i in zip(counters, np.flatnonzero(valid)):
             self._pending[i][0].append(int(c))
             self._pending[i][1].append(float(reward[i]))

@@ -14,10 +14,19 @@ import numpy as np
 import torch
 
 from pamdp.algos.logger import EpisodeTracker
+from pamdp.algos.vector_env import info_action_masks
 from pamdp.policies import HybridPolicy
 from pamdp.spaces import HybridActionSpace
 
-__all__ = ["Rollout", "gae", "advantage_batch", "update_tensors", "network_values", "LinearFeatureBaseline"]
+__all__ = [
+    "Rollout",
+    "gae",
+    "advantage_batch",
+    "update_tensors",
+    "mask_tensor",
+    "network_values",
+    "LinearFeatureBaseline",
+]
 
 
 def gae(
@@ -55,9 +64,12 @@ class Rollout:
 
     KEYS = ("obs", "a", "x", "reward", "terminated", "done", "valid", "next_obs", "t")
 
-    def __init__(self):
-        # (observation, autoreset pending, step within episode) of every env copy between epochs
-        self.state: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+    def __init__(self, action_mask: bool = False):
+        """``action_mask``: sample among the actions each state's ``info["action_mask"]`` allows, and record
+        those masks (the batch's ``"mask"``, bool ``(T, N, K)``) for the update's probabilities."""
+        self.action_mask = action_mask
+        # (observation, autoreset pending, step within episode, allowed actions or None) of every copy between epochs
+        self.state: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None] | None = None
         self.tracker: EpisodeTracker | None = None
 
     def collect(
@@ -70,22 +82,28 @@ class Rollout:
         torch_gen: torch.Generator,
     ) -> dict[str, np.ndarray]:
         """Step ``env`` with ``(a, x) ~ policy`` until ``n_samples`` valid samples; ``(T, N, ...)`` arrays of
-        :attr:`KEYS` (``t``: the step within the episode; ``terminated`` and ``done`` are false when not valid).
+        :attr:`KEYS` (``t``: the step within the episode; ``terminated`` and ``done`` are false when not valid),
+        and ``mask`` with ``action_mask``.
 
         The policy runs on ``torch_gen``'s device (the algorithm's) and the env on the CPU: a step moves the
         observations there and the actions back, nothing else.
         """
         n, device = env.num_envs, torch_gen.device
+        masks_of = lambda info: (  # noqa: E731
+            info_action_masks(info, n, hybrid.n_actions) if self.action_mask else None
+        )
         if self.state is None:
-            obs, _ = env.reset(seed=int(np_rng.integers(2**31 - 1)))
-            self.state = (obs, np.zeros(n, dtype=bool), np.zeros(n, dtype=np.int64))
+            obs, info = env.reset(seed=int(np_rng.integers(2**31 - 1)))
+            self.state = (obs, np.zeros(n, dtype=bool), np.zeros(n, dtype=np.int64), masks_of(info))
             self.tracker = EpisodeTracker(n)
-        obs, prev_done, t_ep = self.state
-        rows: dict[str, list] = {k: [] for k in self.KEYS}
+        obs, prev_done, t_ep, masks = self.state
+        rows: dict[str, list] = {k: [] for k in self.KEYS + (("mask",) if self.action_mask else ())}
         n_valid = 0
         while n_valid < n_samples:
             with torch.no_grad():
-                a, x = policy(torch.as_tensor(np.asarray(obs, dtype=np.float32), device=device)).sample(torch_gen)
+                mask = None if masks is None else torch.from_numpy(masks).to(device)
+                dist = policy(torch.as_tensor(np.asarray(obs, dtype=np.float32), device=device), mask)
+                a, x = dist.sample(torch_gen)
             a, x = a.cpu().numpy(), x.cpu().numpy()
             next_obs, reward, terminated, truncated, info = env.step(hybrid.to_env_batch(a, x))
             valid = ~prev_done
@@ -93,11 +111,13 @@ class Rollout:
             row = (obs, a, x, reward, terminated & valid, done, valid, next_obs, t_ep)
             for k, v in zip(self.KEYS, row):
                 rows[k].append(np.array(v))
+            if masks is not None:
+                rows["mask"].append(masks)
             self.tracker.step(np.asarray(reward, dtype=np.float64), done, valid, info)
             n_valid += int(valid.sum())
             t_ep = np.where(valid, t_ep + 1, 0)
-            prev_done, obs = done, next_obs
-        self.state = (obs, prev_done, t_ep)
+            prev_done, obs, masks = done, next_obs, masks_of(info)
+        self.state = (obs, prev_done, t_ep, masks)
         return {k: np.stack(v) for k, v in rows.items()}
 
     def epoch_stats(self, a: np.ndarray, n_actions: int, explained_var: float) -> dict[str, float]:
@@ -121,9 +141,9 @@ def advantage_batch(
     """GAE over a :meth:`Rollout.collect` batch, flattened to its valid samples.
 
     ``values_fn(obs, t)`` is the baseline's value ``(B,)`` of observations at step ``t`` of their episodes.
-    Returns the valid samples' ``obs, t, a, x``, ``adv`` (standardised within the batch when ``normalize``),
-    ``returns`` (``adv + values``, the baseline's regression target) and ``values``, with the fraction of
-    the returns' variance the values explain.
+    Returns the valid samples' ``obs, t, a, x`` (and ``mask`` where the batch has one), ``adv`` (standardised
+    within the batch when ``normalize``), ``returns`` (``adv + values``, the baseline's regression target) and
+    ``values``, with the fraction of the returns' variance the values explain.
     """
     T, N = batch["reward"].shape
     flat = lambda arr: arr.reshape(T * N, *arr.shape[2:])  # noqa: E731
@@ -133,7 +153,7 @@ def advantage_batch(
     returns = adv + values
 
     valid = flat(batch["valid"])
-    data = {k: flat(batch[k])[valid] for k in ("obs", "t", "a", "x")}
+    data = {k: flat(batch[k])[valid] for k in ("obs", "t", "a", "x", "mask") if k in batch}
     data.update(adv=flat(adv)[valid], returns=flat(returns)[valid], values=flat(values)[valid])
     var_ret = np.var(data["returns"])
     explained_var = float(1 - np.var(data["returns"] - data["values"]) / var_ret) if var_ret > 0 else float("nan")
@@ -153,6 +173,12 @@ def update_tensors(
         torch.as_tensor(data["x"], device=device),
         torch.as_tensor(data["adv"], dtype=torch.float32, device=device),
     )
+
+
+def mask_tensor(data: dict[str, np.ndarray], device: torch.device | str = "cpu") -> torch.Tensor | None:
+    """The allowed actions ``(B, K)`` of an :func:`advantage_batch`'s samples on ``device``; ``None`` without
+    masks."""
+    return torch.as_tensor(data["mask"], device=device) if "mask" in data else None
 
 
 def network_values(value: torch.nn.Module, obs: np.ndarray) -> np.ndarray:

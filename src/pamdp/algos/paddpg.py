@@ -51,6 +51,7 @@ from pamdp.algos.offpolicy import (
 )
 from pamdp.algos.replay import ReplayBuffer, transition_fields
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, at_least, interval, one_of, setting
+from pamdp.distributions import masked_logits
 from pamdp.policies import ACTIVATIONS, mlp
 from pamdp.spaces import HybridActionSpace
 
@@ -135,9 +136,10 @@ class Actor(nn.Module):
     def forward(self, obs: torch.Tensor) -> torch.Tensor:
         return self.net(obs)
 
-    def action(self, out: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
-        """The executed action for output vectors ``out``: argmax of the scores and its parameters, padded."""
-        a = out[:, : self.n_actions].argmax(-1)
+    def action(self, out: torch.Tensor, mask: torch.Tensor | None = None) -> tuple[torch.Tensor, torch.Tensor]:
+        """The executed action for output vectors ``out``: argmax of the scores (of the actions ``mask`` allows)
+        and its parameters, padded."""
+        a = masked_logits(out[:, : self.n_actions], mask).argmax(-1)
         x = out.gather(1, self.param_index[a]) * self.param_mask[a]
         return a, x.clamp(-1.0, 1.0)
 
@@ -175,6 +177,7 @@ class PADDPG(Algorithm):
             self.obs_dim,
             h.max_param_size,
             mc_returns=cfg.beta > 0,  # the loop fills them only when asked to compute Monte-Carlo returns
+            masks=h.n_actions if cfg.action_mask else 0,
             out=((self.out_size,), np.float32),  # the output vector the critic sees (after exploration)
         )
         self.replay = ReplayBuffer(cfg.buffer_size, fields, self.device)
@@ -204,11 +207,19 @@ class PADDPG(Algorithm):
     def _load_extra_state(self, state):
         self.loop.load_state_dict(state["loop"])
 
-    def _act(self, obs, deterministic):
+    def _act(self, obs, deterministic, mask=None):
         out = self.actor(obs).clamp(-1.0, 1.0)
         if not deterministic:  # one epsilon-greedy draw at the final exploration rate
             out = self._epsilon_greedy(out, self.config.epsilon_end)
-        return self.actor.action(out)
+        return self.actor.action(out, mask)
+
+    def _masked(self, out: torch.Tensor, mask: torch.Tensor | None) -> torch.Tensor:
+        """Output vectors as the critic sees them: the scores of the actions ``mask`` forbids at the lower bound
+        -1, so that a stored or target vector says which action it executes."""
+        if mask is None:
+            return out
+        k = self.hybrid.n_actions
+        return torch.cat([torch.where(mask, out[:, :k], -1.0), out[:, k:]], dim=-1)
 
     def epsilon(self, step: int) -> float:
         """The exploration rate after ``step`` samples: linear from epsilon_start to epsilon_end."""
@@ -220,22 +231,22 @@ class PADDPG(Algorithm):
         uniform = self.np_rng.uniform(-1.0, 1.0, size=out.shape).astype(np.float32)
         return torch.where(self._from_numpy(random)[:, None], self._from_numpy(uniform), out)
 
-    def _explore(self, obs: torch.Tensor, step: int, episode_start: np.ndarray):
+    def _explore(self, obs: torch.Tensor, step: int, episode_start: np.ndarray, mask: torch.Tensor | None):
         cfg = self.config
         out = self.actor(obs)
         if cfg.ou_sigma > 0:
             ou = self._ou((len(obs), self.out_size - self.hybrid.n_actions), episode_start, self.np_rng)
             noise = np.concatenate([np.zeros((len(obs), self.hybrid.n_actions)), ou], axis=1)
             out = out + self._from_numpy(noise.astype(np.float32))
-        out = self._epsilon_greedy(out.clamp(-1.0, 1.0), self.epsilon(step))
-        a, x = self.actor.action(out)
+        out = self._masked(self._epsilon_greedy(out.clamp(-1.0, 1.0), self.epsilon(step)), mask)
+        a, x = self.actor.action(out, mask)
         return a, x, {"out": out.cpu().numpy()}
 
-    def _target_value(self, obs: np.ndarray) -> np.ndarray:
+    def _target_value(self, obs: np.ndarray, mask: np.ndarray | None) -> np.ndarray:
         """``Q'(s, mu'(s))``, the bootstrap of a truncated episode's Monte-Carlo return."""
         with torch.no_grad():
-            o = self._from_numpy(obs)
-            return self.critic_target(o, self.actor_target(o).clamp(-1.0, 1.0)).cpu().numpy()
+            o, mask = self._from_numpy(obs), None if mask is None else self._from_numpy(mask)
+            return self.critic_target(o, self._masked(self.actor_target(o).clamp(-1.0, 1.0), mask)).cpu().numpy()
 
     def _run_epoch(self) -> dict[str, float]:
         stats = self.loop.run_epoch(self.vec_env, self._explore, self._update, self.num_timesteps, self.np_rng)
@@ -251,7 +262,7 @@ class PADDPG(Algorithm):
         batch, nets = len(obs), self._dense
         actor, critic = nets["actor"], nets["critic"]
         with torch.no_grad():
-            out_next = nets["actor_target"](next_obs).clamp(-1.0, 1.0)
+            out_next = self._masked(nets["actor_target"](next_obs).clamp(-1.0, 1.0), b.get("next_mask"))
             q_next = nets["critic_target"](torch.cat([next_obs, out_next], dim=-1)).squeeze(-1)
             y = b["reward"] + cfg.gamma * (~b["terminated"]).float() * q_next
             if cfg.beta > 0:
@@ -263,9 +274,12 @@ class PADDPG(Algorithm):
             gradient_step(self.critic_optimizer, cfg.grad_clip)(critic.backward(cache, error * (2.0 / batch))[0])
             # actor: ascend on Q(s, mu(s)) with the critic just updated, dQ/dmu edited at the bounds
             out, actor_cache = actor.forward_cached(obs)
-            q_mu, q_cache = critic.forward_cached(torch.cat([obs, out], dim=-1))
+            q_mu, q_cache = critic.forward_cached(torch.cat([obs, self._masked(out, b.get("mask"))], dim=-1))
             _, dq_dx = critic.backward(q_cache, torch.ones_like(q_mu), weights=False, inputs=True)
             dq_dp = bounded(dq_dx[:, self.obs_dim :], out, cfg.bound)
+            if "mask" in b:  # a forbidden action's score is held at -1: no gradient reaches it
+                k = self.hybrid.n_actions
+                dq_dp = torch.cat([dq_dp[:, :k] * b["mask"], dq_dp[:, k:]], dim=-1)
             gradient_step(self.actor_optimizer, cfg.grad_clip)(actor.backward(actor_cache, -dq_dp / batch)[0])
             self._soft_update(cfg.tau)
         return {

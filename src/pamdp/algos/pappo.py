@@ -33,7 +33,7 @@ import numpy as np
 import torch
 
 from pamdp.algos.base import Algorithm
-from pamdp.algos.onpolicy import Rollout, advantage_batch, network_values, update_tensors
+from pamdp.algos.onpolicy import Rollout, advantage_batch, mask_tensor, network_values, update_tensors
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
 from pamdp.algos.subnormals import subnormals_flushed
 from pamdp.distributions import HybridDistribution, kl_divergence
@@ -171,7 +171,7 @@ class PAPPO(Algorithm):
         self.policy = HybridPolicy(self.obs_dim, self.hybrid, cfg.hidden_sizes, cfg.activation, cfg.init_log_std)
         self.value = ValueNetwork(self.obs_dim, cfg.vf_hidden_sizes)
         self.optimizer = torch.optim.Adam([*self.policy.parameters(), *self.value.parameters()], lr=cfg.lr)
-        self.rollout = Rollout()  # a loaded model starts new episodes
+        self.rollout = Rollout(cfg.action_mask)  # a loaded model starts new episodes
 
     def _modules(self):
         return {"policy": self.policy, "value": self.value}
@@ -179,8 +179,8 @@ class PAPPO(Algorithm):
     def _optimizers(self):
         return {"adam": self.optimizer}
 
-    def _act(self, obs, deterministic):
-        dist = self.policy(obs)
+    def _act(self, obs, deterministic, mask=None):
+        dist = self.policy(obs, mask)
         return dist.mode() if deterministic else dist.sample(self.torch_gen)
 
     def _values(self, obs: np.ndarray, t: np.ndarray) -> np.ndarray:
@@ -194,15 +194,16 @@ class PAPPO(Algorithm):
         data, explained_var = advantage_batch(batch, self._values, cfg.gamma, cfg.gae_lambda, cfg.normalize_advantages)
         with subnormals_flushed(cfg.flush_denormal):
             returns = torch.as_tensor(data["returns"], dtype=torch.float32, device=self.device)
-            stats = self._update(*update_tensors(data, self.device), returns)
+            stats = self._update(*update_tensors(data, self.device), returns, mask_tensor(data, self.device))
         stats.update(self.rollout.epoch_stats(data["a"], self.hybrid.n_actions, explained_var))
         return stats
 
-    def _update(self, obs, a, x, adv, returns) -> dict[str, float]:
-        """``n_epochs`` passes of minibatch Adam steps on the joint loss, stopped early by ``target_kl``."""
+    def _update(self, obs, a, x, adv, returns, mask=None) -> dict[str, float]:
+        """``n_epochs`` passes of minibatch Adam steps on the joint loss, stopped early by ``target_kl``; ``mask``:
+        the samples' allowed actions, which the policy's probabilities range over (``None``: all)."""
         cfg = self.config
         with torch.no_grad():
-            old = self.policy(obs).detach()
+            old = self.policy(obs, mask).detach()
             old_logp = old.log_prob(a, x)
         params = [p for group in self.optimizer.param_groups for p in group["params"]]
         n = len(adv)
@@ -212,7 +213,7 @@ class PAPPO(Algorithm):
         for _ in range(cfg.n_epochs):
             perm = torch.randperm(n, generator=self.torch_gen, device=self.device)
             for idx in torch.tensor_split(perm, n_minibatches):
-                dist = self.policy(obs[idx])
+                dist = self.policy(obs[idx], None if mask is None else mask[idx])
                 if cfg.target_kl > 0:
                     with torch.no_grad():
                         stopped_at_kl = float(kl_divergence(old[idx], dist.detach()).mean()) > cfg.target_kl
@@ -233,7 +234,7 @@ class PAPPO(Algorithm):
                 break
         stats = {k: v / updates for k, v in sums.items()}  # the first minibatch always runs: pi == pi_old there
         with torch.no_grad():
-            stats["train/kl"] = float(kl_divergence(old, self.policy(obs)).mean())
+            stats["train/kl"] = float(kl_divergence(old, self.policy(obs, mask)).mean())
         stats["train/updates"] = float(updates)
         stats["train/early_stop"] = float(stopped_at_kl)
         stats["train/param_std"] = float(self.policy.log_std.detach().exp()[self.policy.mask].mean())

@@ -45,9 +45,11 @@ from pamdp.algos.offpolicy import (
     gradient_step,
     shared_setting,
     soft_updater,
+    uniform_actions,
 )
 from pamdp.algos.replay import ReplayBuffer, transition_fields
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
+from pamdp.distributions import masked_logits
 from pamdp.policies import ACTIVATIONS, mlp
 from pamdp.spaces import HybridActionSpace
 
@@ -219,11 +221,18 @@ class GumbelHybridPolicy(nn.Module):
         return self.log_std.clamp(LOG_STD_MIN, LOG_STD_MAX).exp()
 
     def sample(
-        self, obs: torch.Tensor, eta_a: torch.Tensor, eta_x: torch.Tensor, temperature: float, hard: bool
+        self,
+        obs: torch.Tensor,
+        eta_a: torch.Tensor,
+        eta_x: torch.Tensor,
+        temperature: float,
+        hard: bool,
+        mask: torch.Tensor | None = None,
     ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
-        """``(logits, index, a, x)`` for the noise ``(eta_a, eta_x)``: ``pi_d``'s logits, the action, the critic's
-        action input ``a`` and the parameters ``x``, so an update runs ``pi_d`` once."""
-        logits = self.pi_d(obs)
+        """``(logits, index, a, x)`` for the noise ``(eta_a, eta_x)``: ``pi_d``'s logits (restricted to the actions
+        ``mask`` allows), the action, the critic's action input ``a`` and the parameters ``x``, so an update runs
+        ``pi_d`` once."""
+        logits = masked_logits(self.pi_d(obs), mask)
         index, a = gumbel_softmax_sample(logits, eta_a, temperature, hard)
         return logits, index, a, self.params(obs, index, a, eta_x)
 
@@ -244,27 +253,37 @@ class GumbelHybridPolicy(nn.Module):
         return obs_k, onehots, self.params(obs_k, index, onehots, eta_x.unsqueeze(-2))
 
     def forward(
-        self, obs: torch.Tensor, eta_a: torch.Tensor, eta_x: torch.Tensor, temperature: float, hard: bool
+        self,
+        obs: torch.Tensor,
+        eta_a: torch.Tensor,
+        eta_x: torch.Tensor,
+        temperature: float,
+        hard: bool,
+        mask: torch.Tensor | None = None,
     ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
         """``(index, a, x)`` for the noise ``(eta_a, eta_x)``; ``a`` is the critic's action input."""
-        return self.sample(obs, eta_a, eta_x, temperature, hard)[1:]
+        return self.sample(obs, eta_a, eta_x, temperature, hard, mask)[1:]
 
-    def mode(self, obs: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
-        """The greedy action: the most probable discrete action and its mean parameters."""
-        index = self.pi_d(obs).argmax(-1)
+    def mode(self, obs: torch.Tensor, mask: torch.Tensor | None = None) -> tuple[torch.Tensor, torch.Tensor]:
+        """The greedy action: the most probable (allowed) discrete action and its mean parameters."""
+        index = masked_logits(self.pi_d(obs), mask).argmax(-1)
         onehot = F.one_hot(index, self.n_actions).to(obs.dtype)
         return index, torch.tanh(self.pi_c(torch.cat([obs, onehot], dim=-1))) * self.mask[index]
 
 
 def expected_q(
-    policy: GumbelHybridPolicy, critic: Callable, obs: torch.Tensor, eta_x: torch.Tensor
+    policy: GumbelHybridPolicy,
+    critic: Callable,
+    obs: torch.Tensor,
+    eta_x: torch.Tensor,
+    mask: torch.Tensor | None = None,
 ) -> tuple[torch.Tensor, torch.Tensor]:
     """``(logits, E_{k ~ pi_d}[Q(s, k, g(s, k, eta_x))])``: the value the Gumbel-Softmax sample estimates, exactly.
 
     Differentiable in both policies: in ``pi_d`` through the probabilities, in ``pi_c`` through every
-    action's parameters, each weighted by its probability.
+    action's parameters, each weighted by its probability. With ``mask``, ``pi_d`` ranges over the allowed actions.
     """
-    logits = policy.pi_d(obs)
+    logits = masked_logits(policy.pi_d(obs), mask)
     q_all = critic(*policy.params_all(obs, eta_x))
     return logits, (logits.softmax(-1) * q_all).sum(-1)
 
@@ -334,6 +353,7 @@ class PASVG0(Algorithm):
         fields = transition_fields(
             self.obs_dim,
             m,
+            masks=K if cfg.action_mask else 0,
             a_in=((K,), np.float32),  # the critic's action input: one-hot, or the soft sample
             eta_a=((K,), np.float32),
             eta_x=((m,), np.float32),
@@ -391,20 +411,20 @@ class PASVG0(Algorithm):
         eta_x = torch.randn((batch, self.hybrid.max_param_size), generator=self.torch_gen, device=self.device)
         return eta_a, eta_x
 
-    def _act(self, obs, deterministic):
+    def _act(self, obs, deterministic, mask=None):
         if deterministic:
-            return self.policy.mode(obs)
-        index, _, x = self.policy(obs, *self._noise(len(obs)), self.config.temperature, True)
+            return self.policy.mode(obs, mask)
+        index, _, x = self.policy(obs, *self._noise(len(obs)), self.config.temperature, True, mask)
         return index, x
 
-    def _explore(self, obs: torch.Tensor, step: int, episode_start: np.ndarray):
+    def _explore(self, obs: torch.Tensor, step: int, episode_start: np.ndarray, mask: torch.Tensor | None):
         cfg = self.config
         eta_a, eta_x = self._noise(len(obs))
-        index, a_in, x = self.policy(obs, eta_a, eta_x, cfg.temperature, cfg.straight_through)
+        index, a_in, x = self.policy(obs, eta_a, eta_x, cfg.temperature, cfg.straight_through, mask)
         if cfg.explore_epsilon > 0:  # drawn only when on, so that the paper's preset keeps its random stream
             n, K = len(obs), self.hybrid.n_actions
             flip = torch.rand(n, generator=self.torch_gen, device=self.device) < cfg.explore_epsilon
-            uniform = torch.randint(K, (n,), generator=self.torch_gen, device=self.device)
+            uniform = uniform_actions(n, K, mask, self.torch_gen, self.device)
             onehot = F.one_hot(uniform, K).to(a_in.dtype)
             index = torch.where(flip, uniform, index)
             a_in = torch.where(flip[:, None], onehot, a_in)
@@ -425,12 +445,12 @@ class PASVG0(Algorithm):
         with ``discrete_gradient="expected"``, ``E_{k ~ pi_d'}[Q'(s', k, x'_k)]``); no bootstrap after a
         termination."""
         cfg = self.config
-        next_obs = b["next_obs"]
+        next_obs, mask = b["next_obs"], b.get("next_mask")
         eta_a, eta_x = self._noise(len(next_obs))
         if cfg.discrete_gradient == "expected":
-            _, q_next = expected_q(self.policy_target, self._target_q, next_obs, eta_x)
+            _, q_next = expected_q(self.policy_target, self._target_q, next_obs, eta_x, mask)
         else:
-            _, a_next, x_next = self.policy_target(next_obs, eta_a, eta_x, cfg.temperature, cfg.straight_through)
+            _, a_next, x_next = self.policy_target(next_obs, eta_a, eta_x, cfg.temperature, cfg.straight_through, mask)
             q_next = self._target_q(next_obs, a_next, x_next)
         return b["reward"] + cfg.gamma * (~b["terminated"]).float() * q_next
 
@@ -460,10 +480,13 @@ class PASVG0(Algorithm):
         cfg = self.config
         obs = b["obs"]
         # The recorded noise, pushed through the current policy: a = f(s, eta_a), x = g(s, a, eta_x).
+        mask = b.get("mask")
         if cfg.discrete_gradient == "expected":
-            logits, q_pi = expected_q(self.policy, self.critic, obs, b["eta_x"])
+            logits, q_pi = expected_q(self.policy, self.critic, obs, b["eta_x"], mask)
         else:
-            logits, _, a, x = self.policy.sample(obs, b["eta_a"], b["eta_x"], cfg.temperature, cfg.straight_through)
+            logits, _, a, x = self.policy.sample(
+                obs, b["eta_a"], b["eta_x"], cfg.temperature, cfg.straight_through, mask
+            )
             q_pi = self.critic(obs, a, x)
         entropy = -(logits.softmax(-1) * logits.log_softmax(-1)).sum(-1).mean()
         alpha = cfg.entropy_coef if self.entropy_weight is None else float(self.entropy_weight().detach())
@@ -512,7 +535,8 @@ class PASVG0(Algorithm):
 
         # policy: descend on -mean Q(s, a, x) - alpha * mean H(pi_d), with the recorded noise
         logits, d_cache = nets["pi_d"].forward_cached(obs)
-        log_p = logits.log_softmax(-1)
+        # a forbidden action's probability is 0 exactly, so the gradient below is 0 at its logit
+        log_p = masked_logits(logits, b.get("mask")).log_softmax(-1)
         z = log_p + b["eta_a"]
         soft_a = torch.softmax(z / temperature, dim=-1)
         index = z.argmax(-1)

@@ -29,7 +29,14 @@ import numpy as np
 import torch
 
 from pamdp.algos.base import Algorithm
-from pamdp.algos.onpolicy import LinearFeatureBaseline, Rollout, advantage_batch, network_values, update_tensors
+from pamdp.algos.onpolicy import (
+    LinearFeatureBaseline,
+    Rollout,
+    advantage_batch,
+    mask_tensor,
+    network_values,
+    update_tensors,
+)
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, at_least, interval, one_of, setting
 from pamdp.algos.subnormals import subnormals_flushed
 from pamdp.algos.trpo import (
@@ -161,7 +168,7 @@ class PATRPO(Algorithm):
             self.vf_optimizer = torch.optim.Adam(self.value.parameters(), lr=cfg.vf_lr)
         else:
             self.linear_baseline = LinearFeatureBaseline(self.obs_dim)
-        self.rollout = Rollout()  # a loaded model starts new episodes
+        self.rollout = Rollout(cfg.action_mask)  # a loaded model starts new episodes
 
     def _modules(self):
         return {"policy": self.policy, **({"value": self.value} if self.config.baseline == "mlp" else {})}
@@ -178,8 +185,8 @@ class PATRPO(Algorithm):
         if self.config.baseline == "linear":
             self.linear_baseline.coef = state["linear_baseline"].numpy()
 
-    def _act(self, obs, deterministic):
-        dist = self.policy(obs)
+    def _act(self, obs, deterministic, mask=None):
+        dist = self.policy(obs, mask)
         return dist.mode() if deterministic else dist.sample(self.torch_gen)
 
     # -- one epoch -------------------------------------------------------------------------------
@@ -190,17 +197,18 @@ class PATRPO(Algorithm):
         )
         data, explained_var = advantage_batch(batch, self._values, cfg.gamma, cfg.gae_lambda, cfg.normalize_advantages)
         with subnormals_flushed(cfg.flush_denormal):
-            stats = self._update_policy(*update_tensors(data, self.device))
+            stats = self._update_policy(*update_tensors(data, self.device), mask_tensor(data, self.device))
             stats["losses/value_loss"] = self._fit_baseline(data["obs"], data["t"], data["returns"])
         stats.update(self.rollout.epoch_stats(data["a"], self.hybrid.n_actions, explained_var))
         return stats
 
-    def _update_policy(self, obs, a, x, adv) -> dict[str, float]:
-        """One natural-gradient step with line search on the surrogate (the paper's PATRPO update)."""
+    def _update_policy(self, obs, a, x, adv, mask=None) -> dict[str, float]:
+        """One natural-gradient step with line search on the surrogate (the paper's PATRPO update); ``mask``: the
+        samples' allowed actions, which the policy's probabilities range over (``None``: all)."""
         cfg = self.config
         params = [p for p in self.policy.parameters() if p.requires_grad]
         with torch.no_grad():
-            old = self.policy(obs).detach()
+            old = self.policy(obs, mask).detach()
             old_logp = old.log_prob(a, x)
 
         def surrogate(new) -> torch.Tensor:
@@ -210,12 +218,12 @@ class PATRPO(Algorithm):
         tried = []  # the line search's last policy distribution: the accepted one's, for the KL after the step
 
         def evaluate() -> tuple[torch.Tensor, torch.Tensor]:  # one forward pass for both of a step's figures
-            tried[:] = [self.policy(obs)]
+            tried[:] = [self.policy(obs, mask)]
             return surrogate(tried[0]), kl_divergence(old, tried[0], cfg.kl_estimator, a, x).mean()
 
-        objective = surrogate(self.policy(obs))
+        objective = surrogate(self.policy(obs, mask))
         g = flat_grad(objective, params)
-        fvp = self._fisher_vector_product(obs, a, x, old)
+        fvp = self._fisher_vector_product(obs, a, x, old, mask)
         direction = conjugate_gradient(fvp, g, cfg.cg_iters)
         shs = float(direction @ fvp(direction))
         stats = {"train/entropy": float(old.entropy().mean()), "train/grad_norm": float(g.norm())}
@@ -248,19 +256,20 @@ class PATRPO(Algorithm):
         )
         return stats
 
-    def _fisher_vector_product(self, obs, a, x, old) -> Callable[[torch.Tensor], torch.Tensor]:
+    def _fisher_vector_product(self, obs, a, x, old, mask=None) -> Callable[[torch.Tensor], torch.Tensor]:
         """The damped Fisher-vector product of the KL estimator, on ``fvp_subsample`` of the batch."""
         cfg = self.config
         n_fvp = max(1, int(round(cfg.fvp_subsample * len(obs))))
         if n_fvp < len(obs):
             sub = torch.randperm(len(obs), generator=self.torch_gen, device=self.device)[:n_fvp]
             obs, a, x, old = obs[sub], a[sub], x[sub], old[sub]
+            mask = None if mask is None else mask[sub]
         method = cfg.fvp
         if method == "auto":
             method = "double_backprop" if cfg.kl_estimator == "joint_sample" else "gauss_newton"
         if method == "double_backprop":
             params = [p for p in self.policy.parameters() if p.requires_grad]
-            kl = kl_divergence(old, self.policy(obs), cfg.kl_estimator, a, x).mean()
+            kl = kl_divergence(old, self.policy(obs, mask), cfg.kl_estimator, a, x).mean()
             return FisherVectorProduct(kl, params, cfg.cg_damping)
         return hybrid_gauss_newton_fvp(self.policy, old, obs, a, cfg.kl_estimator, cfg.cg_damping)
 

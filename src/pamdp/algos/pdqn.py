@@ -50,9 +50,11 @@ from pamdp.algos.offpolicy import (
     mixed_target,
     shared_setting,
     soft_update,
+    uniform_actions,
 )
 from pamdp.algos.replay import ReplayBuffer, transition_fields
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, at_least, interval, one_of, setting
+from pamdp.distributions import masked_logits
 from pamdp.policies import ACTIVATIONS, mlp
 from pamdp.spaces import HybridActionSpace
 
@@ -221,6 +223,7 @@ class PDQN(Algorithm):
             self.obs_dim,
             h.max_param_size,
             mc_returns=cfg.beta > 0,
+            masks=h.n_actions if cfg.action_mask else 0,
             params=((h.total_param_size,), np.float32),  # every action's, after exploration: what Q learns on
         )
         self.replay = ReplayBuffer(cfg.buffer_size, fields, self.device)
@@ -240,11 +243,11 @@ class PDQN(Algorithm):
         self.loop.load_state_dict(state["loop"])
 
     # -- acting ----------------------------------------------------------------------------------
-    def _act(self, obs, deterministic):
+    def _act(self, obs, deterministic, mask=None):
         params = self.actor(obs).clamp(-1.0, 1.0)
-        a = self.q_net(obs, params).argmax(-1)
+        a = masked_logits(self.q_net(obs, params), mask).argmax(-1)
         if not deterministic:  # one epsilon-greedy draw at the final exploration rate
-            a, params = self._epsilon_greedy(a, params, self.config.epsilon_end)
+            a, params = self._epsilon_greedy(a, params, self.config.epsilon_end, mask)
         return a, self.actor.select(params, a)
 
     def epsilon(self, step: int) -> float:
@@ -252,30 +255,36 @@ class PDQN(Algorithm):
         cfg = self.config
         return linear_epsilon(step, cfg.epsilon_start, cfg.epsilon_end, cfg.epsilon_steps)
 
-    def _epsilon_greedy(self, a: torch.Tensor, params: torch.Tensor, eps: float):
-        """With probability ``eps`` a uniform discrete action (with ``explore_params``, uniform parameters for it)."""
+    def _epsilon_greedy(self, a: torch.Tensor, params: torch.Tensor, eps: float, mask: torch.Tensor | None):
+        """With probability ``eps`` a uniform discrete action among the allowed (with ``explore_params``, uniform
+        parameters for it)."""
         random = self._from_numpy(self.np_rng.random(len(a)) < eps)
-        a = torch.where(random, self._from_numpy(self.np_rng.integers(self.hybrid.n_actions, size=len(a))), a)
+        a = torch.where(random, uniform_actions(len(a), self.hybrid.n_actions, mask, self.np_rng, self.device), a)
         if self.config.explore_params:
             uniform = self._from_numpy(self.np_rng.uniform(-1.0, 1.0, size=params.shape).astype(np.float32))
             params = torch.where(random[:, None] & self.blocks[a], uniform, params)
         return a, params
 
-    def _explore(self, obs: torch.Tensor, step: int, episode_start: np.ndarray):
+    def _explore(self, obs: torch.Tensor, step: int, episode_start: np.ndarray, mask: torch.Tensor | None):
         cfg = self.config
         params = self.actor(obs)
-        a = self.q_net(obs, params.clamp(-1.0, 1.0)).argmax(-1)  # the greedy choice, before any noise
+        a = masked_logits(self.q_net(obs, params.clamp(-1.0, 1.0)), mask).argmax(-1)  # greedy, before any noise
         if cfg.ou_sigma > 0:
             noise = self._ou(tuple(params.shape), episode_start, self.np_rng)
             params = params + self._from_numpy(noise.astype(np.float32))
-        a, params = self._epsilon_greedy(a, params.clamp(-1.0, 1.0), self.epsilon(step))
+        a, params = self._epsilon_greedy(a, params.clamp(-1.0, 1.0), self.epsilon(step), mask)
         return a, self.actor.select(params, a), {"params": params.cpu().numpy()}
 
-    def _target_value(self, obs: np.ndarray) -> np.ndarray:
-        """``max_k Q'_k(s, x'(s))``, the bootstrap of a truncated episode's Monte-Carlo return."""
+    def _target_value(self, obs: np.ndarray, mask: np.ndarray | None) -> np.ndarray:
+        """``max_k Q'_k(s, x'(s))`` over the allowed ``k``, the bootstrap of a truncated episode's Monte-Carlo
+        return."""
         with torch.no_grad():
             o = self._from_numpy(obs)
-            return self.q_target(o, self.actor_target(o).clamp(-1.0, 1.0)).max(-1).values.cpu().numpy()
+            return self._next_value(o, None if mask is None else self._from_numpy(mask)).cpu().numpy()
+
+    def _next_value(self, obs: torch.Tensor, mask: torch.Tensor | None) -> torch.Tensor:
+        """``max_k Q'_k(s, x'(s))`` of the target networks, over the actions ``mask`` allows."""
+        return masked_logits(self.q_target(obs, self.actor_target(obs).clamp(-1.0, 1.0)), mask).max(-1).values
 
     # -- learning --------------------------------------------------------------------------------
     def _run_epoch(self) -> dict[str, float]:
@@ -289,7 +298,7 @@ class PDQN(Algorithm):
         b = self.replay.sample(cfg.batch_size, self.np_rng)
         obs, next_obs = b["obs"], b["next_obs"]
         with torch.no_grad():
-            q_next = self.q_target(next_obs, self.actor_target(next_obs).clamp(-1.0, 1.0)).max(-1).values
+            q_next = self._next_value(next_obs, b.get("next_mask"))
             y = b["reward"] + cfg.gamma * (~b["terminated"]).float() * q_next
             if cfg.beta > 0:
                 y = mixed_target(y, b["mc"], cfg.beta)

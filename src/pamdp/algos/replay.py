@@ -30,12 +30,14 @@ __all__ = ["ReplayBuffer", "transition_fields"]
 FieldSpec = Mapping[str, tuple[tuple[int, ...], type | np.dtype]]
 
 
-def transition_fields(obs_dim: int, max_param_size: int, mc_returns: bool = False, **extra) -> dict:
+def transition_fields(obs_dim: int, max_param_size: int, mc_returns: bool = False, masks: int = 0, **extra) -> dict:
     """The fields every off-policy algorithm stores, ``obs, a, x, reward, next_obs, terminated``, then ``extra``.
 
     ``x`` holds the chosen action's parameters, padded to ``max_param_size``. With ``mc_returns`` a field
     ``"mc"`` holds the Monte-Carlo return-to-go, NaN until the episode ends (PADDPG's and P-DQN's mixed
-    targets, filled by :class:`pamdp.algos.offpolicy.OffPolicyLoop`).
+    targets, filled by :class:`pamdp.algos.offpolicy.OffPolicyLoop`). With ``masks = K`` (the number of discrete
+    actions) the fields ``"mask"`` and ``"next_mask"`` hold which actions the env allowed at ``obs`` and at
+    ``next_obs`` (bool ``(K,)``, from ``info["action_mask"]``), for the ``action_mask`` setting.
     """
     fields = {
         "obs": ((obs_dim,), np.float32),
@@ -48,6 +50,8 @@ def transition_fields(obs_dim: int, max_param_size: int, mc_returns: bool = Fals
     }
     if mc_returns:
         fields["mc"] = ((), np.float32)
+    if masks:
+        fields["mask"] = fields["next_mask"] = ((masks,), np.bool_)
     return fields
 
 

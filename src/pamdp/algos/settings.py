@@ -104,6 +104,12 @@ class AlgoConfig:
         "cuda:N; the envs step on the CPU either way (what a GPU buys: benchmarks/gpu_speed.md).",
         DEVICE,
     )
+    action_mask: bool = setting(
+        False,
+        'Use the env\'s info["action_mask"] (True where a discrete action has an effect now), where it reports '
+        "one, in acting and in targets: masked actions are never chosen, greedily or at random, and the targets "
+        "and the policy's probabilities range over the allowed ones only. Off: every action, as the papers do.",
+    )
 
     def __post_init__(self):
         """Each setting against its type and its ``check`` (in declaration order); subclasses add checks across

@@ -1,8 +1,10 @@
 """The paper's experiments as files, and what runs and plots them (``pamdp reproduce``, ``pamdp plot``).
 
-Each experiment is a TOML file in ``configs/`` (one per figure of the paper): the env, the budget, the
-seeds, optional ``env_kwargs`` for the env's constructor, and a list of runs (a label, an algorithm, a preset,
-setting overrides, and optionally their own ``env`` and ``env_kwargs``).
+Each experiment is a TOML file in ``configs/`` (one per figure of the paper, and ``benchmark-suite``): the env,
+the budget, the seeds, optional ``env_kwargs`` for the env's constructor, and a list of runs (a label, an
+algorithm, a preset, setting overrides, and optionally their own ``env``, ``env_kwargs``, ``total_steps`` and
+``eval_every``: a suite of domains gives each its own budget). The experiment's ``env`` and ``total_steps``
+may be left out where every run gives its own.
 """
 
 from __future__ import annotations
@@ -27,8 +29,8 @@ def available_experiments() -> list[str]:
 class Experiment:
     name: str
     description: str
-    env: str
-    total_steps: int
+    env: str | None  # None: each run names its own
+    total_steps: int | None  # None: each run gives its own
     seeds: tuple[int, ...]
     eval_episodes: int
     runs: tuple[dict, ...]
@@ -36,11 +38,10 @@ class Experiment:
     eval_every: int = 0
 
     def specs(self, seeds=None, scale: float = 1.0, labels=None) -> list[RunSpec]:
-        """One :class:`RunSpec` per (run, seed); ``scale`` multiplies the step budget; ``labels`` (run labels
-        or their directory names) keeps only those runs, in the experiment's order."""
+        """One :class:`RunSpec` per (run, seed); ``scale`` multiplies each run's step budget; ``labels`` (run
+        labels or their directory names) keeps only those runs, in the experiment's order."""
         if scale <= 0:
             raise ValueError(f"scale = {scale!r}; expected a positive factor")
-        steps = max(1, int(round(self.total_steps * scale)))
         runs = self.runs
         if labels is not None:
             names = {name for run in self.runs for name in (run["label"], _slug(run["label"]))}
@@ -53,6 +54,7 @@ class Experiment:
             runs = [run for run in self.runs if run["label"] in labels or _slug(run["label"]) in labels]
         out = []
         for run in runs:
+            steps = max(1, int(round(run.get("total_steps", self.total_steps) * scale)))
             for seed in self.seeds if seeds is None else seeds:
                 settings = tuple(sorted(run.get("settings", {}).items()))
                 env_kwargs = tuple(sorted({**self.env_kwargs, **run.get("env_kwargs", {})}.items()))
@@ -67,7 +69,7 @@ class Experiment:
                         self.eval_episodes,
                         run["label"],
                         env_kwargs,
-                        self.eval_every,
+                        run.get("eval_every", self.eval_every),
                     )
                 )
         return out
@@ -102,8 +104,8 @@ def load_experiment(name_or_path: str | os.PathLike) -> Experiment:
     return Experiment(
         path.stem,
         data.get("description", ""),
-        data["env"],
-        int(data["total_steps"]),
+        data.get("env"),
+        int(data["total_steps"]) if "total_steps" in data else None,
         tuple(data["seeds"]),
         int(data.get("eval_episodes", 1000)),
         tuple(data["runs"]),
@@ -114,7 +116,7 @@ def load_experiment(name_or_path: str | os.PathLike) -> Experiment:
 
 MAX_STEPS = 10**12  # as ``pamdp train --total-steps``: a budget beyond this is a typing slip
 _KEYS = {"description", "env", "total_steps", "seeds", "eval_episodes", "eval_every", "env_kwargs", "runs"}
-_RUN_KEYS = {"label", "algo", "preset", "settings", "env", "env_kwargs"}
+_RUN_KEYS = {"label", "algo", "preset", "settings", "env", "env_kwargs", "total_steps", "eval_every"}
 
 
 def _whole(value, low: int, high: int | None = None) -> bool:
@@ -124,6 +126,10 @@ def _whole(value, low: int, high: int | None = None) -> bool:
     return value == int(value) and low <= value and (high is None or value <= high)
 
 
+def _count(value) -> bool:
+    return isinstance(value, int) and _whole(value, 0)
+
+
 def _check_experiment(path: Path, data: dict) -> None:
     """Refuse what an experiment file gets wrong, naming the key, its value and what was expected: a misspelt key
     would otherwise be ignored, and a seed given twice would write one run directory twice."""
@@ -131,20 +137,21 @@ def _check_experiment(path: Path, data: dict) -> None:
     def refuse(what: str, value, expected: str):
         raise ValueError(f"experiment file {path}: {what} = {value!r}; expected {expected}")
 
-    missing = {"env", "total_steps", "seeds", "runs"} - set(data)
+    missing = {"seeds", "runs"} - set(data)
     if missing:
         raise ValueError(f"experiment file {path} lacks {sorted(missing)}")
     for key in sorted(set(data) - _KEYS):
         refuse(key, data[key], "only the keys " + ", ".join(sorted(_KEYS)))
-    if not _whole(data["total_steps"], 1, MAX_STEPS):
-        refuse("total_steps", data["total_steps"], f"a whole number of steps from 1 to {MAX_STEPS:.0e}")
+    budget = f"a whole number of steps from 1 to {MAX_STEPS:.0e}"
+    if "total_steps" in data and not _whole(data["total_steps"], 1, MAX_STEPS):
+        refuse("total_steps", data["total_steps"], budget)
     seeds = data["seeds"]
     if not isinstance(seeds, list) or not seeds or not all(_whole(s, 0) and isinstance(s, int) for s in seeds):
         refuse("seeds", seeds, "a list of integer seeds >= 0")
     if len(set(seeds)) < len(seeds):
         refuse("seeds", seeds, "each seed once")
     for key in ("eval_episodes", "eval_every"):
-        if key in data and not (isinstance(data[key], int) and _whole(data[key], 0)):
+        if key in data and not _count(data[key]):
             refuse(key, data[key], "an integer >= 0")
     runs = data["runs"]
     if not isinstance(runs, list) or not runs or not all(isinstance(run, dict) for run in runs):
@@ -160,6 +167,13 @@ def _check_experiment(path: Path, data: dict) -> None:
         for key in ("settings", "env_kwargs"):
             if key in run and not isinstance(run[key], dict):
                 refuse(f"runs[{i}].{key}", run[key], "a table")
+        for key in ("env", "total_steps"):  # each run needs its own where the experiment gives none
+            if key not in run and key not in data:
+                raise ValueError(f"experiment file {path}: run {i} ({run['label']!r}) has no {key}, nor has the file")
+        if "total_steps" in run and not _whole(run["total_steps"], 1, MAX_STEPS):
+            refuse(f"runs[{i}].total_steps", run["total_steps"], budget)
+        if "eval_every" in run and not _count(run["eval_every"]):
+            refuse(f"runs[{i}].eval_every", run["eval_every"], "an integer >= 0")
         slug = _slug(str(run["label"]))
         if slug in dirs:
             refuse(f"runs[{i}].label", run["label"], f"a label whose directory differs from {dirs[slug]!r}'s ({slug})")

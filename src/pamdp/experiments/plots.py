@@ -16,6 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
+from pamdp.algos.logger import RENAMED, success_of
+
 __all__ = [
     "find_groups",
     "aggregate",
@@ -30,16 +32,19 @@ __all__ = [
 
 METRIC = "charts/episodic_return"
 GREEDY_METRIC = "eval/mean_return"  # logged every few epochs by runs with eval_every (``--eval-every``)
-GOAL_METRIC = "charts/goal_rate"  # logged by runs on envs that report each episode's outcome (soccer)
+SUCCESS_METRIC = "charts/success_rate"  # logged by runs on envs that report each episode's outcome
+GREEDY_SUCCESS_METRIC = "eval/success_rate"  # with eval_every, on those envs
 LABELS = {
     METRIC: "average return",
     GREEDY_METRIC: "greedy return (100 episodes)",
-    GOAL_METRIC: "goal rate (training episodes)",
+    SUCCESS_METRIC: "success rate (training episodes)",
+    GREEDY_SUCCESS_METRIC: "greedy success rate (100 episodes)",
 }
 # Figures beside the curves, for the runs that logged their metric: (name, metric, report keys)
 EXTRA_FIGURES = (
     ("greedy", GREEDY_METRIC, ("greedy_png", "greedy_svg")),
-    ("goal_rate", GOAL_METRIC, ("goal_png", "goal_svg")),
+    ("success_rate", SUCCESS_METRIC, ("success_png", "success_svg")),
+    ("greedy_success_rate", GREEDY_SUCCESS_METRIC, ("greedy_success_png", "greedy_success_svg")),
 )
 
 
@@ -99,6 +104,8 @@ def _read_progress(run: Path, metric: str) -> tuple[np.ndarray, np.ndarray]:
             f"{path} has no column 'time/total_timesteps' (columns: {', '.join(columns) or 'none'}); "
             "expected a progress.csv written by pamdp train"
         )
+    if metric not in columns and RENAMED.get(metric) in columns:  # a run logged before the name was general
+        metric = RENAMED[metric]
     try:
         steps = np.array([float(r["time/total_timesteps"]) for r in rows])
         values = np.array([float(r[metric]) if r.get(metric) not in (None, "") else np.nan for r in rows])
@@ -236,7 +243,8 @@ def plot_curves(
 def results_table(groups: dict[str, list[Path]]) -> str:
     """A markdown table of the final greedy evaluations (mean +- std across seeds)."""
     lines = [
-        "| setting | seeds | greedy return (mean +- std over seeds) | goal rate | steps to goal | last-epoch return |",
+        "| setting | seeds | greedy return (mean +- std over seeds) | success rate | steps to success "
+        "| last-epoch return |",
         "|---|---|---|---|---|---|",
     ]
     for label, runs in groups.items():
@@ -251,8 +259,8 @@ def results_table(groups: dict[str, list[Path]]) -> str:
             ret = np.array([e["mean_return"] for e in evals])
             per_seed = ", ".join(f"{r:.3f}" for r in ret)
             greedy = f"{ret.mean():.3f} +- {ret.std():.3f} ({len(evals)} evaluated: {per_seed})"
-            goals = [e["goal_rate"] for e in evals if "goal_rate" in e]
-            steps = [e["mean_steps_to_goal"] for e in evals if e.get("mean_steps_to_goal") is not None]
+            goals = [rate for rate, _ in map(success_of, evals) if rate is not None]
+            steps = [n for _, n in map(success_of, evals) if n is not None]
             goal = f"{np.mean(goals):.3f}" if goals else "-"
             to_goal = f"{np.mean(steps):.1f}" if steps else "-"
         else:
@@ -281,8 +289,11 @@ def write_report(
 
     Runs that logged greedy evaluations during training (``eval_every``) also get ``greedy.png`` and
     ``greedy.svg``: the mean +- std across seeds of those evaluations, at the epochs where they were made. Runs on
-    an env that reports episode outcomes (soccer) get ``goal_rate.png`` and ``goal_rate.svg``: the training goal
-    rate per epoch (epochs logged before a run recorded it are left out).
+    an env that reports episode outcomes (``info["is_success"]``) get ``success_rate.png`` and ``.svg``: the
+    training success rate per epoch (epochs logged before a run recorded it are left out), and with
+    ``eval_every`` ``greedy_success_rate.png`` and ``.svg``, that of the greedy evaluations. Runs on the benchmark
+    suite's domains also get ``suite.md``, their table beside HyAR's published one, and a figure per domain
+    (:mod:`pamdp.experiments.suite`).
     """
     groups = find_groups(roots)
     out = Path(out)
@@ -312,4 +323,11 @@ def write_report(
                 )
     table = out / "results.md"
     table.write_text(results_table(groups) + "\n")
+    from pamdp.experiments.suite import plot_domains, suite_table
+
+    suite = suite_table(groups)
+    if suite:  # runs on the benchmark suite's domains: their table beside HyAR's, and a figure per domain
+        (out / "suite.md").write_text(suite + "\n")
+        extra["suite"] = out / "suite.md"
+        extra.update({f"{p.stem}_{p.suffix[1:]}": p for p in plot_domains(groups, out)})
     return {"png": png, "svg": svg, "csv": csv_path, "table": table, **extra}

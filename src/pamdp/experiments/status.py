@@ -17,6 +17,7 @@ import statistics
 import time
 from pathlib import Path
 
+from pamdp.algos.logger import success_of
 from pamdp.experiments.runner import RunSpec, is_finished
 
 __all__ = ["RunStatus", "run_status", "format_status", "remaining_seconds"]
@@ -38,7 +39,7 @@ class RunStatus:
     train_seconds: float  # summed epoch times from progress.csv
     last_return: float | None  # mean training return of the last epoch
     greedy_return: float | None  # the final greedy evaluation, once done
-    goal_rate: float | None
+    success_rate: float | None  # of the final greedy evaluation, where the env reports success
     idle_seconds: float | None  # since progress.csv was last written; small while a run is training
     seconds_per_step: float | None = None  # the run's pace, from :func:`recent_pace`; None before it has one
 
@@ -100,7 +101,7 @@ def run_status(spec: RunSpec, out: str | Path, now: float | None = None) -> RunS
         state = DONE
         if (out / "evaluation.json").exists():
             result = json.loads((out / "evaluation.json").read_text())
-            greedy, goal = _float(result.get("mean_return")), _float(result.get("goal_rate"))
+            greedy, goal = _float(result.get("mean_return")), _float(success_of(result)[0])
     elif (out / CHECKPOINT).exists() or (out / FINAL_MODEL).exists() or steps > 0:
         state = PARTIAL
     else:
@@ -154,9 +155,9 @@ def remaining_seconds(statuses: list[RunStatus]) -> tuple[float, dict[str, int]]
 
 def format_status(name: str, statuses: list[RunStatus], workers: int = 1) -> str:
     """A markdown table of the runs and a summary line with the training time still to go."""
-    goal = any(s.goal_rate is not None for s in statuses)
+    goal = any(s.success_rate is not None for s in statuses)
     head = "| run | seed | state | samples | trained | last epoch's return | greedy return |" + (
-        " goal rate |" if goal else ""
+        " success rate |" if goal else ""
     )
     lines = [head, "|---" * (head.count("|") - 1) + "|"]
     for s in statuses:
@@ -174,7 +175,7 @@ def format_status(name: str, statuses: list[RunStatus], workers: int = 1) -> str
             f"{s.greedy_return:.3f}" if s.greedy_return is not None else "-",
         ]
         if goal:
-            cells.append(f"{s.goal_rate:.3f}" if s.goal_rate is not None else "-")
+            cells.append(f"{s.success_rate:.3f}" if s.success_rate is not None else "-")
         lines.append("| " + " | ".join(cells) + " |")
     counts = {k: sum(s.state == k for s in statuses) for k in (DONE, PARTIAL, NOT_STARTED)}
     left, unknown = remaining_seconds(statuses)

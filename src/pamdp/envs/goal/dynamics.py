@@ -194,7 +194,8 @@ def reset(s, draws, cursor):
     """Start an episode in the row ``s``; takes :data:`RESET_DRAWS` number. Returns the next cursor."""
     if cursor + RESET_DRAWS > draws.size:
         raise ValueError("reset needs RESET_DRAWS numbers in draws after cursor")
-    s[:] = 0.0
+    for k in range(STATE_SIZE):
+        s[k] = 0.0
     s[PY] = uniform(-HALF_WIDTH, HALF_WIDTH, draws, cursor)
     s[PHI] = angle_between(0.0, s[PY], HALF_LENGTH, 0.0)
     offset = KICKABLE - 1e-12  # the ball starts just kickable (quirk 9)
@@ -269,11 +270,11 @@ def substep(s, kick, tx, ty, draws, cursor):
     """One tick of the simulation (§7). Returns ``(reward, done, cursor)``."""
     cursor = player_act(s, kick, tx, ty, draws, cursor)
     cursor = keeper_act(s, draws, cursor)
-    for e, config in ((PLAYER, PLAYER_CONFIG), (KEEPER, KEEPER_CONFIG), (BALL, BALL_CONFIG)):  # §7.3
+    for e, decay in ((PLAYER, PLAYER_CONFIG[5]), (KEEPER, KEEPER_CONFIG[5]), (BALL, BALL_CONFIG[5])):  # §7.3
         s[e] = s[e] + s[e + 2]
         s[e + 1] = s[e + 1] + s[e + 3]
-        s[e + 2] = s[e + 2] * config[5]
-        s[e + 3] = s[e + 3] * config[5]
+        s[e + 2] = s[e + 2] * decay
+        s[e + 3] = s[e + 3] * decay
     collide(s, PLAYER, PLAYER_CONFIG[0], KEEPER, KEEPER_CONFIG[0])
     collide(s, PLAYER, PLAYER_CONFIG[0], BALL, BALL_CONFIG[0])
     collide(s, KEEPER, KEEPER_CONFIG[0], BALL, BALL_CONFIG[0])
@@ -352,19 +353,16 @@ def step_copies(states, kick, tx, ty, pending, draws, cursors, substeps, rewards
 @jit
 def observe(states, out):
     """§3's 17 scaled features of each copy (row of ``states``) into the rows of ``out``."""
-    raw = np.empty(OBS_SIZE)
     for i in range(states.shape[0]):
         s = states[i]
-        raw[:14] = s[:14]
         dx, dy = s[BX] - s[KX], s[BY] - s[KY]
         n = math.sqrt(fma(dy, dy, dx * dx))  # np.linalg.norm as the recordings' NumPy computes it
-        raw[14], raw[15] = dx / n, dy / n
         if s[KX] == s[BX]:
             pos = -HALF_GOAL if s[KY] < s[BY] else HALF_GOAL
         else:
             g = (s[KY] - s[BY]) / (s[KX] - s[BX])
             c = s[BY] - g * s[BX]
             pos = min(max((g * 40.0) / 2 + c, -HALF_GOAL), GOAL_WIDTH)  # clipped at 14.02 (quirk 6)
-        raw[16] = pos
         for j in range(OBS_SIZE):
-            out[i, j] = (2.0 * (raw[j] - OBS_LOW[j])) / OBS_DEN[j] - 1.0
+            raw = s[j] if j < 14 else dx / n if j == 14 else dy / n if j == 15 else pos
+            out[i, j] = (2.0 * (raw - OBS_LOW[j])) / OBS_DEN[j] - 1.0

@@ -39,7 +39,7 @@ from pamdp.envs.vector import RandomStreams
 
 __all__ = ["GoalEnv", "HardGoalEnv", "hard_goal_shot", "BUFFER_SIZE"]
 
-BUFFER_SIZE = 2048
+BUFFER_SIZE = 4096
 """Uniform numbers kept drawn ahead per copy (a sub-step takes at most ``dynamics.SUBSTEP_DRAWS``)."""
 KICK_LOW, KICK_HIGH = np.array([0.0, -15.0]), np.array([40.0, 15.0])
 """Kick-to's box, also the float64 bounds its parameters are clipped to (§4.1)."""
@@ -173,8 +173,14 @@ class GoalEnv(gymnasium.Env):
     def _expected(self, n: int | None = None) -> str:
         k = self.action_space[0].n
         if n is None:
-            return f"(a, (p_0, ..., p_{k - 1})) with a in 0..{k - 1}, p_0 a finite array of shape (2,) and each other p a finite number or shape-(1,) array"
-        return f"(a, (p_0, ..., p_{k - 1})) with a an int array of shape ({n},) in 0..{k - 1}, p_0 a finite array of shape ({n}, 2) and each other p of shape ({n}, 1) or ({n},)"
+            return (
+                f"(a, (p_0, ..., p_{k - 1})) with a in 0..{k - 1}, p_0 a finite array of shape (2,) and each "
+                "other p a finite number or shape-(1,) array"
+            )
+        return (
+            f"(a, (p_0, ..., p_{k - 1})) with a an int array of shape ({n},) in 0..{k - 1}, p_0 a finite array "
+            f"of shape ({n}, 2) and each other p of shape ({n}, 1) or ({n},)"
+        )
 
     def _check_action(self, action) -> tuple[int, list]:
         """Check one action's form; return ``a`` and the parameters as arrays of their box's shape."""

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import math
 import os
 from collections.abc import Callable
@@ -47,12 +48,31 @@ def draw_goal(
     keeper_x: float, keeper_y: float, keeper_psi: float,
     ball_x: float, ball_y: float,
 ) -> np.ndarray:  # fmt: skip
-    """A ``(RENDER_HEIGHT, RENDER_WIDTH, 3)`` uint8 top view: the field's lines, the goal and its net on the right, the keeper
-    (red), the player (blue), each with a tick in the direction it faces, and the ball (white)."""
+    """A ``(RENDER_HEIGHT, RENDER_WIDTH, 3)`` uint8 top view: the field's lines, the goal and its net on
+    the right, the keeper (red), the player (blue), each with a tick in the direction it faces, and the
+    ball (white)."""
+    canvas = Canvas(RENDER_WIDTH, RENDER_HEIGHT)
+    canvas.image[:] = _field()
+    for x, y, angle, size, color in (
+        (keeper_x, keeper_y, keeper_psi, KEEPER_CONFIG[0], KEEPER_COLOR),
+        (player_x, player_y, player_phi, PLAYER_CONFIG[0], PLAYER_COLOR),
+    ):
+        canvas.circle(*_px(x, y), size * RENDER_SCALE, color)
+        tip = _px(x + size * math.cos(angle), y + size * math.sin(angle))
+        canvas.line(*_px(x, y), *tip, (255, 230, 80), width=3.0)
+    cx, cy = _px(ball_x, ball_y)
+    canvas.circle(cx, cy, BALL_CONFIG[0] * RENDER_SCALE, BALL_COLOR)
+    canvas.circle(cx, cy, BALL_CONFIG[0] * RENDER_SCALE, (20, 20, 20), outline=1.5)
+    return canvas.image
+
+
+@functools.cache
+def _field() -> np.ndarray:
+    """The frame without players and ball (drawn once: the lines are most of the drawing's cost)."""
     canvas = Canvas(RENDER_WIDTH, RENDER_HEIGHT, background=GRASS)
 
-    def segment(xa, ya, xb, yb, color=LINE, width=2.0):
-        canvas.line(*_px(xa, ya), *_px(xb, yb), color, width=width)
+    def segment(xa, ya, xb, yb, color=LINE):
+        canvas.line(*_px(xa, ya), *_px(xb, yb), color, width=2.0)
 
     canvas.rect(*_px(HALF_LENGTH, HALF_GOAL), *_px(NET_BACK, -HALF_GOAL), NET)
     for xa, ya, xb, yb in (
@@ -69,16 +89,7 @@ def draw_goal(
         segment(HALF_LENGTH, y, NET_BACK, y, (90, 90, 90))
         canvas.circle(*_px(HALF_LENGTH, y), 3, (40, 40, 40))
     segment(NET_BACK, -HALF_GOAL, NET_BACK, HALF_GOAL, (90, 90, 90))
-
-    for x, y, angle, size, color in (
-        (keeper_x, keeper_y, keeper_psi, KEEPER_CONFIG[0], KEEPER_COLOR),
-        (player_x, player_y, player_phi, PLAYER_CONFIG[0], PLAYER_COLOR),
-    ):
-        canvas.circle(*_px(x, y), size * RENDER_SCALE, color)
-        segment(x, y, x + size * math.cos(angle), y + size * math.sin(angle), (255, 230, 80), width=3.0)
-    cx, cy = _px(ball_x, ball_y)
-    canvas.circle(cx, cy, BALL_CONFIG[0] * RENDER_SCALE, BALL_COLOR)
-    canvas.circle(cx, cy, BALL_CONFIG[0] * RENDER_SCALE, (20, 20, 20), outline=1.5)
+    canvas.image.flags.writeable = False
     return canvas.image
 
 

@@ -11,4 +11,11 @@ from pamdp.envs.gym_hybrid.batched import MovingVectorEnv, SlidingVectorEnv
 from pamdp.envs.gym_hybrid.env import MovingEnv, SlidingEnv, gym_hybrid_action_space
 from pamdp.envs.gym_hybrid.render import draw_gym_hybrid
 
-__all__ = ["MovingEnv", "SlidingEnv", "MovingVectorEnv", "SlidingVectorEnv", "gym_hybrid_action_space", "draw_gym_hybrid"]
+__all__ = [
+    "MovingEnv",
+    "SlidingEnv",
+    "MovingVectorEnv",
+    "SlidingVectorEnv",
+    "gym_hybrid_action_space",
+    "draw_gym_hybrid",
+]

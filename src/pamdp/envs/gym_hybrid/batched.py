@@ -56,7 +56,7 @@ class GymHybridVectorEnv(BatchedVectorEnv):
         super().__init__(num_envs, single, max_episode_steps, render_mode)
         self.settings = single.settings
         self.sliding = single.sliding
-        self._states = np.zeros((self.num_envs, dyn.STATE_SIZE))
+        self._states = np.tile(dyn.INITIAL_STATE, (self.num_envs, 1))
         self._started = False
 
     @property
@@ -104,17 +104,14 @@ class SlidingVectorEnv(GymHybridVectorEnv):
 
 
 def parse_actions(actions, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Check a batch of ``n`` gym-hybrid actions; return ``a`` (n,) int64 and the accelerate and turn
-    parameters (n,) float64, not yet clipped."""
+    """Check a batch of ``n`` gym-hybrid actions; return ``a`` (n,) and the accelerate and turn parameters (n,),
+    float32 or float64 as given (the compiled step widens them to float64), not yet clipped."""
     expected = f"{ACTION_FORM} arrays of shape ({n}, 1) or ({n},), p_break of shape ({n}, 0); a of shape ({n},)"
     if not isinstance(actions, (tuple, list)) or len(actions) != 2:
         raise ValueError(f"invalid batch of gym-hybrid actions {actions!r}; expected {expected}")
     a = np.asarray(actions[0])
     if a.shape != (n,) or a.dtype.kind not in "iu":
         raise ValueError(f"invalid discrete actions {actions[0]!r}; expected {expected}")
-    bad = (a < 0) | (a > 2)
-    if bad.any():
-        raise ValueError(f"discrete actions {a[bad]} at indices {np.flatnonzero(bad)}; expected {expected}")
     params = actions[1]
     if not isinstance(params, (tuple, list)) or len(params) != 3:
         raise ValueError(f"invalid parameters {params!r}; expected {expected}")
@@ -123,10 +120,13 @@ def parse_actions(actions, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         p = np.asarray(params[i])
         if p.shape not in ((n,), (n, 1)) or p.dtype.kind not in "iuf":
             raise ValueError(f"invalid parameter {i} of shape {p.shape}: {p!r}; expected {expected}")
-        p = p.reshape(n).astype(np.float64)
-        if not np.isfinite(p).all():
-            raise ValueError(f"parameter {i} contains {p[~np.isfinite(p)]}; expected {expected}")
-        columns.append(p)
+        columns.append(p.reshape(n) if p.dtype in (np.float32, np.float64) else p.reshape(n).astype(np.float64))
     if np.shape(params[2]) != (n, 0):
         raise ValueError(f"invalid break parameters of shape {np.shape(params[2])}; expected {expected}")
-    return a.astype(np.int64), columns[0], columns[1]
+    bad = dyn.first_bad_action(a, *columns)  # one compiled pass instead of a NumPy pass per check
+    if bad >= 0:
+        raise ValueError(
+            f"copy {bad}: discrete action {int(a[bad])}, parameters {float(columns[0][bad])}, "
+            f"{float(columns[1][bad])}; expected {expected}"
+        )
+    return a, columns[0], columns[1]

@@ -120,27 +120,27 @@ class GymHybridEnv(gymnasium.Env):
         )  # fmt: skip
         self.action_space = gym_hybrid_action_space()
         self.observation_space = spaces.Box(-np.inf, np.inf, shape=(dyn.OBS_SIZE,), dtype=np.float64)
-        self._state = np.zeros(dyn.STATE_SIZE)
+        self._states = dyn.INITIAL_STATE[None].copy()  # one row: the batched env's layout at N = 1
         # Exactly one reset's numbers at a time, so np_random holds no number drawn ahead between resets.
         self._streams = RandomStreams(1, "random", dyn.DRAWS_PER_RESET)
         self._started = False
 
     @property
     def state(self) -> np.ndarray:
-        """A copy of the state row (indices ``dynamics.X`` ... ``dynamics.T``)."""
-        return self._state.copy()
+        """A copy of the state row (indices ``dynamics.X`` ... ``dynamics.SIN_PHI``)."""
+        return self._states[0].copy()
 
     def _observation(self) -> np.ndarray:
-        out = np.empty(dyn.OBS_SIZE)
-        dyn.observe(self._state, self.settings, out)
-        return out
+        out = np.empty((1, dyn.OBS_SIZE))
+        dyn.observe(self._states, 0, self.settings, out)
+        return out[0]
 
     def reset(self, *, seed: int | None = None, options: dict | None = None):
         super().reset(seed=seed)
         streams = self._streams
         streams.follow(0, self.np_random)
         streams.refill(dyn.DRAWS_PER_RESET)
-        streams.cursors[0] = dyn.reset(self._state, streams.buffers[0], streams.cursors[0])
+        streams.cursors[0] = dyn.reset(self._states, 0, streams.buffers, streams.cursors[0])
         self._started = True
         return self._observation(), {}
 
@@ -148,12 +148,12 @@ class GymHybridEnv(gymnasium.Env):
         if not self._started:
             raise gymnasium.error.ResetNeeded("call reset() before step()")
         a, p = parse_action(action)
-        reward, terminated, goal = dyn.step(self._state, a, p, self.settings, self.sliding)
+        reward, terminated, goal = dyn.step(self._states, 0, a, p, self.settings, self.sliding)
         return self._observation(), reward, terminated, False, {"is_success": goal} if terminated else {}
 
     def render(self):
         if self.render_mode == "rgb_array":
-            return draw_gym_hybrid(self._state, self.sliding)
+            return draw_gym_hybrid(self._states[0], self.sliding)
         return None
 
 

@@ -11,7 +11,7 @@ import gymnasium
 import numpy as np
 
 import pamdp.envs.hfo.dynamics as dyn
-from pamdp.envs.hfo.env import HalfFieldOffenseEnv
+from pamdp.envs.hfo.env import HalfFieldOffenseEnv, kick_mask
 from pamdp.envs.hfo.interface import draw_half_field, parse_actions, reset_options
 from pamdp.envs.vector import BatchedVectorEnv, copy_seeds
 
@@ -25,8 +25,9 @@ class HalfFieldOffenseVectorEnv(BatchedVectorEnv):
     shell's ``max_episode_steps`` (None: HFO's own clocks end the episodes). Actions are the
     ``batch_space`` of the scalar action space: ``(a[N], (dash[N, 2], turn[N, 1], kick[N, 2]))``. A copy
     that ended on the previous step is reset instead of stepped (its action is ignored) and returns its
-    first observation with reward 0. ``infos`` holds ``status`` (strings) and ``step`` per copy, and
-    ``is_success`` (a goal) for the copies whose episode ended (``_is_success``). ``reset(options=...)``
+    first observation with reward 0. ``infos`` holds ``status`` (strings), ``step`` and ``action_mask`` (bool
+    ``(N, 3)``, as the scalar env's) per copy, and ``is_success`` (a goal) for the copies whose episode ended
+    (``_is_success``). ``reset(options=...)``
     takes the scalar env's options, each once for every copy or per copy (a leading axis of size N),
     and the shell's ``reset_mask``.
 
@@ -102,4 +103,11 @@ class HalfFieldOffenseVectorEnv(BatchedVectorEnv):
         every = np.ones(self.num_envs, dtype=bool)
         names = _STATUS_NAMES[status] if status is not None else np.full(self.num_envs, "IN_GAME")
         steps = self.states[:, dyn.STEPS].astype(np.int64)
-        return {"status": names, "_status": every, "step": steps, "_step": every}
+        return {
+            "status": names,
+            "_status": every,
+            "step": steps,
+            "_step": every,
+            "action_mask": kick_mask(self.states),
+            "_action_mask": every,
+        }

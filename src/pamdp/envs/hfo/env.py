@@ -10,6 +10,14 @@ import pamdp.envs.hfo.dynamics as dyn
 from pamdp.envs.hfo.interface import check_settings, draw_half_field, hfo_action_space, parse_action, reset_options
 
 
+def kick_mask(states: np.ndarray) -> np.ndarray:
+    """The actions with an effect in one state vector ``(STATE_SIZE,)`` or a batch ``(N, STATE_SIZE)``: DASH and
+    TURN always, KICK where the agent's kickable test passes (``dynamics.simulate`` drops it otherwise)."""
+    mask = np.ones(states.shape[:-1] + (3,), dtype=bool)
+    mask[..., dyn.KICK] = states[..., dyn.KICKABLE_NOW] != 0.0
+    return mask
+
+
 class HalfFieldOffenseEnv(gymnasium.Env):
     """HFO 1v0: score on an empty goal from a random start, with HFO's low-level actions and features.
 
@@ -39,8 +47,10 @@ class HalfFieldOffenseEnv(gymnasium.Env):
         terminal_deltas: pay the distance and kick terms on the terminal transition too. dqn-hfo zeroes
             them (only +5 for a goal survives), which is the default.
 
-    ``info`` holds ``status`` ("IN_GAME", "GOAL", "OUT_OF_BOUNDS" or "OUT_OF_TIME") and ``step``, the
-    number of actions taken this episode; when an episode ends also ``is_success`` (True on a goal). The
+    ``info`` holds ``status`` ("IN_GAME", "GOAL", "OUT_OF_BOUNDS" or "OUT_OF_TIME"), ``step``, the
+    number of actions taken this episode, and ``action_mask``, bool ``(3,)``: which of DASH, TURN and KICK
+    have an effect in the returned state (KICK only when the agent's kickable test passes, as HFO's agent
+    sends it); when an episode ends also ``is_success`` (True on a goal). The
     observation returned with a terminal status is the true terminal state. ``reset(options=...)``
     accepts ``ball`` (x, y), ``player`` (x, y) and ``body`` (degrees), in the server's metres (goal
     centre at (52.5, 0)); missing ones are drawn as usual. Every random number (placements, actuator
@@ -85,7 +95,7 @@ class HalfFieldOffenseEnv(gymnasium.Env):
         obs = np.empty(self.profile.n_features, dtype=np.float32)
         dyn.reset_one(self.state, self.stream, self.settings, placement, self._features, obs)
         self._started = True
-        return obs, {"status": "IN_GAME", "step": 0}
+        return obs, {"status": "IN_GAME", "step": 0, "action_mask": kick_mask(self.state)}
 
     def step(self, action):
         if not self._started:
@@ -95,7 +105,11 @@ class HalfFieldOffenseEnv(gymnasium.Env):
         obs = np.empty(self.profile.n_features, dtype=np.float32)
         reward, status = dyn.step_one(self.state, self.stream, a, x0, x1, self.settings, self._features, obs)
         terminated, truncated = dyn.ending(status, self.settings)
-        info = {"status": dyn.STATUS_NAMES[status], "step": int(self.state[dyn.STEPS])}
+        info = {
+            "status": dyn.STATUS_NAMES[status],
+            "step": int(self.state[dyn.STEPS]),
+            "action_mask": kick_mask(self.state),
+        }
         if terminated or truncated:
             info["is_success"] = status == dyn.GOAL
         return obs, reward, terminated, truncated, info

@@ -1,0 +1,119 @@
+"""Steps per CPU-second of every pamdp env, scalar and batched, under uniformly random actions.
+
+Run ``python benchmarks/bench_envs.py --cpu 1`` (a few minutes); it rewrites ``benchmarks/env_speed.md``, keeping
+its section ``## Notes (written by hand)``. For each registered env (Hard Move at each n of the benchmark suite):
+the scalar env from ``gymnasium.make`` (resets included) and the batched env at ``--num-envs`` copies
+(autoresets included), each the median over ``--repeats`` timings of ``time.process_time`` (this process's CPU
+time, which another process on the core does not inflate). Actions are sampled before timing. An env whose
+module is missing or fails to build is skipped, and the record says which and why.
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime as dt
+import os
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import gymnasium
+
+import pamdp  # noqa: F401  (registers the envs)
+from pamdp.envs import _REGISTRATIONS
+
+sys.path.insert(0, str(Path(__file__).parent))
+from _record import machine, write_record  # noqa: E402
+
+HERE = Path(__file__).parent
+SUITE_KWARGS = {"pamdp/HardMove-v0": [{"n": n} for n in (4, 6, 8, 10)]}
+MIN_ENV_STEPS = 20_000  # env steps per timed repeat (batched: batched steps times copies)
+
+
+def cases() -> list[tuple[str, dict]]:
+    return [(env_id, kw) for env_id in _REGISTRATIONS for kw in SUITE_KWARGS.get(env_id, [{}])]
+
+
+def scalar_rate(env, actions, steps: int) -> float:
+    start = time.process_time()
+    for k in range(steps):
+        _, _, terminated, truncated, _ = env.step(actions[k % len(actions)])
+        if terminated or truncated:
+            env.reset()
+    return steps / (time.process_time() - start)
+
+
+def batched_rate(env, actions, steps: int) -> float:
+    start = time.process_time()
+    for k in range(steps):
+        env.step(actions[k % len(actions)])
+    return steps * env.num_envs / (time.process_time() - start)
+
+
+def measure(env_id: str, kwargs: dict, num_envs: int, repeats: int, scalar_steps: int) -> tuple[float, float]:
+    """Median scalar and batched env-steps per CPU-second."""
+    scalar = gymnasium.make(env_id, **kwargs)
+    scalar.reset(seed=0)
+    scalar.action_space.seed(0)
+    actions = [scalar.action_space.sample() for _ in range(1000)]
+    batched = gymnasium.make_vec(env_id, num_envs=num_envs, vectorization_mode="vector_entry_point", **kwargs)
+    batched.reset(seed=0)
+    batched.action_space.seed(0)
+    batched_actions = [batched.action_space.sample() for _ in range(16)]
+    batched_steps = max(1, MIN_ENV_STEPS // num_envs)
+    scalar_rate(scalar, actions, 200)  # Numba's compilation and the first resets, untimed
+    batched_rate(batched, batched_actions, 5)
+    rates = {"scalar": [], "batched": []}
+    for _ in range(repeats):
+        rates["scalar"].append(scalar_rate(scalar, actions, scalar_steps))
+        rates["batched"].append(batched_rate(batched, batched_actions, batched_steps))
+    scalar.close()
+    batched.close()
+    return statistics.median(rates["scalar"]), statistics.median(rates["batched"])
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--num-envs", type=int, default=1024)
+    p.add_argument("--repeats", type=int, default=5)
+    p.add_argument("--scalar-steps", type=int, default=5_000)
+    p.add_argument("--cpu", type=int, default=None, help="pin this process to one core (as taskset -c N)")
+    p.add_argument("--record", default=str(HERE / "env_speed.md"))
+    a = p.parse_args()
+    if a.cpu is not None:
+        os.sched_setaffinity(0, {a.cpu})
+    rows, skipped = [], []
+    for env_id, kwargs in cases():
+        name = env_id + (f" {kwargs}" if kwargs else "")
+        try:
+            scalar, batched = measure(env_id, kwargs, a.num_envs, a.repeats, a.scalar_steps)
+        except Exception as exc:  # a domain whose module has not landed, or does not build
+            skipped.append(f"- {name}: {type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}")
+            continue
+        rows.append(f"| {name} | {scalar:,.0f} | {batched:,.0f} | {batched / scalar:,.0f}x |")
+        print(rows[-1], flush=True)
+    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, cwd=HERE)
+    lines = [
+        "# Environment speed: steps per CPU-second, scalar and batched",
+        "",
+        f"- command: `python {' '.join(sys.argv)}` (commit {commit.stdout.strip()})",
+        f"- date: {dt.datetime.now().isoformat(timespec='minutes')}",
+        f"- machine: {machine()}",
+        f"- uniformly random actions sampled before timing; median of {a.repeats} timings of this process's CPU "
+        f"time; scalar: {a.scalar_steps:,} steps of `gymnasium.make`'s env a timing, resets included; batched: "
+        f"{a.num_envs:,} copies, at least {MIN_ENV_STEPS:,} env steps a timing, autoresets included"
+        + (f"; pinned to core {a.cpu}" if a.cpu is not None else ""),
+        "",
+        f"| env | scalar steps/s | batched steps/s ({a.num_envs:,} copies) | batched / scalar |",
+        "|---|---|---|---|",
+        *rows,
+    ]
+    if skipped:
+        lines += ["", "Skipped (not importable or not built at this commit):", *skipped]
+    write_record(lines, a.record)
+
+
+if __name__ == "__main__":
+    main()

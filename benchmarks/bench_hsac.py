@@ -1,0 +1,105 @@
+"""Hybrid SAC on Platform, flat and hierarchical forms (hsac_platform.toml): 5 seeds x 300k samples each.
+
+    taskset -c 0 python benchmarks/bench_hsac.py [--seeds 0,1,2,3,4] [--forms flat,hierarchical] [--out DIR]
+
+Runs one at a time, seed by seed, the two forms alternating (so that a cut-short invocation still compares the
+forms), and rewrites benchmarks/hsac_platform.md after every run: the greedy return of each finished seed (1000
+episodes) with the median and mean per form, and the cost per sample (CPU seconds from each run's progress.csv).
+The runs go to DIR/hsac_platform/FORM/seedN (default results/bench) and resume where they stopped, so a rerun
+continues the benchmark; the record keeps its hand-written notes.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import datetime as dt
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+from _record import HERE, machine, write_record
+
+from pamdp.experiments import load_experiment
+from pamdp.experiments.runner import is_finished, run_all
+from pamdp.experiments.status import epoch_seconds
+
+RECORD = HERE / "hsac_platform.md"
+
+
+def _progress(run: Path) -> list[dict]:
+    if not (run / "progress.csv").exists():
+        return []
+    with open(run / "progress.csv", newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def _arm_lines(label: str, jobs) -> list[str]:
+    """One row of the table: the finished seeds' greedy returns, their median and mean, the cost per sample."""
+    returns, costs, partial = [], [], []
+    for spec, out in jobs:
+        rows = _progress(out)
+        if is_finished(out, spec):
+            returns.append((spec.seed, json.loads((out / "evaluation.json").read_text())["mean_return"]))
+            steps = float(rows[-1]["time/total_timesteps"])
+            costs.append(sum(epoch_seconds(r) for r in rows) / steps * 1e3)
+        elif rows:
+            evals = [r for r in rows if r.get("eval/mean_return")]
+            last = f", greedy {float(evals[-1]['eval/mean_return']):.3f} (100 episodes)" if evals else ""
+            partial.append(f"seed {spec.seed} at {int(float(rows[-1]['time/total_timesteps'])):,} samples{last}")
+    values = np.array([r for _, r in returns])
+    per_seed = ", ".join(f"{s}: {r:.3f}" for s, r in returns) or "-"
+    median = f"{np.median(values):.3f}" if len(values) else "-"
+    mean = f"{values.mean():.3f} +- {values.std():.3f}" if len(values) else "-"
+    cost = f"{np.median(costs):.2f}" if costs else "-"
+    row = f"| {label} | {len(returns)} of {len(jobs)} | {per_seed} | {median} | {mean} | {cost} |"
+    return [row] + ([f"| {label} (unfinished) | | {'; '.join(partial)} | | | |"] if partial else [])
+
+
+def write(exp, arms: dict, command: str) -> None:
+    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, cwd=HERE)
+    lines = [
+        f"# {exp.description}",
+        "",
+        f"- command: `{command}` (commit {commit.stdout.strip()})",
+        f"- date: {dt.datetime.now().isoformat(timespec='minutes')} (rewritten after every finished run)",
+        f"- machine: {machine()}",
+        f"- {exp.total_steps:,} samples per run, one run at a time; greedy return: 1000 episodes of the final model",
+        "",
+        "| form | seeds done | greedy return per seed | median | mean +- std | CPU ms per sample |",
+        "|---|---|---|---|---|---|",
+    ]
+    for label, jobs in arms.items():
+        lines += _arm_lines(label, jobs)
+    lines += [
+        "",
+        "CPU ms per sample: the run's CPU time in training (its greedy evaluations left out) over its samples, "
+        "median over the finished seeds.",
+    ]
+    write_record(lines, RECORD)
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--seeds", default=None)
+    p.add_argument("--forms", default="flat,hierarchical")
+    p.add_argument("--out", default="results/bench")
+    a = p.parse_args()
+    exp = load_experiment(HERE / "hsac_platform.toml")
+    seeds = [int(s) for s in a.seeds.split(",")] if a.seeds else list(exp.seeds)
+    forms = a.forms.split(",")
+    arms = {form: [(s, exp.run_dir(a.out, s)) for s in exp.specs(seeds, labels=[form])] for form in forms}
+    command = "python " + " ".join(sys.argv)
+    write(exp, arms, command)
+    for i in range(len(seeds)):  # seed by seed, the forms alternating
+        for form in forms:
+            spec, out = arms[form][i]
+            if not is_finished(out, spec):
+                run_all([(spec, str(out))], workers=1)
+                write(exp, arms, command)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,421 @@
+"""Hybrid SAC: soft actor-critic over parameterized actions (Delalleau, Peter, Alonso & Logut 2019, "Discrete
+and Continuous Action Representation for Practical RL in Video Games", arXiv 1912.11077).
+
+The policy ``pi(a, x | s) = pi_d(a | s) * pi_c(x | s, a)`` has a categorical ``pi_d`` over the K discrete actions
+and a tanh-squashed Gaussian ``pi_c``: ``x = tanh(u)``, ``u ~ N(mu, sigma)``, so ``x`` stays in ``[-1, 1]`` and
+
+    log pi_c(x | s, a) = sum_i [ log N(u_i; mu_i, sigma_i) - log(1 - tanh(u_i)^2) ]
+
+over the ``m_a`` parameters of action ``a`` (none for a parameterless action, which adds no continuous entropy).
+``pi_c`` comes in two forms (``form``):
+
+- ``flat`` (Delalleau et al.): one network on the state outputs the K logits and the means and log-stds of the
+  parameters of *every* action (``sum_a m_a`` of each);
+- ``hierarchical`` (the seed paper, Wei, Wicke & Luke 2018): ``pi_d`` is a network on the state and ``pi_c`` one
+  on ``[s, onehot(a)]`` with ``2 m`` outputs (``m = max_a m_a``), evaluated for every action in one batched pass.
+
+Either way every action's parameters are drawn at each step, ``x_all = (x_0, ..., x_{K-1})``; the env gets the
+chosen action's. Twin critics ``Q_i(s, ., x_all)`` have one output per discrete action, as P-DQN's. Soft
+Q-learning with the exact expectation over the next discrete action (a sample of its parameters), twice the
+clipped minimum of the target critics:
+
+    V(s') = sum_a' pi_d(a'|s') [ min_i Q'_i(s', x'_all)_a' - alpha_c log pi_c(x'_a'|s',a') - alpha_d log pi_d(a'|s') ]
+    y = r + gamma (1 - terminated) V(s')
+
+The policy minimises ``E_s sum_a pi_d(a|s) [alpha_d log pi_d(a|s) + alpha_c log pi_c(x_a|s,a) - min_i Q_i(s,
+x_all)_a]`` (the exact expectation over ``a``, reparameterised ``x``). Each part has its own temperature, tuned
+towards its own target entropy: ``alpha_d`` towards ``target_entropy_d * log(allowed actions)``, ``alpha_c``
+towards ``target_entropy_c`` nats per parameter of the expected action (``sum_a pi_d(a) m_a`` parameters), by
+descent on ``log alpha * (H - target)`` (:func:`temperature_gradient`): a policy more random than its target lowers
+its temperature. Critic targets follow the critics softly (``tau``).
+
+With ``action_mask`` the actions the env's ``info["action_mask"]`` forbids get probability zero, in acting and
+in the target's expectation (the next state's mask is stored with the transition).
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+import torch
+import torch.nn.functional as F
+from torch import nn
+
+from pamdp.algos.base import Algorithm
+from pamdp.algos.offpolicy import (
+    OffPolicyConfig,
+    OffPolicyLoop,
+    gradient_step,
+    optimizer_step,
+    shared_setting,
+    soft_updater,
+)
+from pamdp.algos.replay import ReplayBuffer, transition_fields
+from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
+from pamdp.distributions import MASKED, masked_logits
+from pamdp.policies import ACTIVATIONS, mlp
+from pamdp.spaces import HybridActionSpace
+
+if TYPE_CHECKING:
+    from typing_extensions import Self
+
+__all__ = ["HybridSAC", "HybridSACConfig", "SquashedHybrid", "HybridSACActor", "TwinQ", "temperature_gradient"]
+
+FORMS = ("flat", "hierarchical")
+LOG_STD_MIN, LOG_STD_MAX = -5.0, 2.0
+_LOG_2PI = math.log(2.0 * math.pi)
+
+
+@dataclasses.dataclass(frozen=True)
+class HybridSACConfig(OffPolicyConfig, AlgoConfig):
+    """Hybrid SAC's settings. The defaults are the ``paper`` preset: Delalleau et al.'s structure (flat form, two
+    temperatures tuned automatically) with soft actor-critic's published settings (Haarnoja et al. 2018), since
+    the text of Delalleau et al.'s appendix was not at hand; values taken from SAC or set here are marked."""
+
+    form: str = setting(
+        "flat",
+        "pi_c's form: flat (one network outputs every action's parameters, Delalleau et al.) or hierarchical "
+        "(pi_c(x|s,a) on [s, onehot(a)], the seed paper's).",
+        one_of(FORMS),
+    )
+    hidden_sizes: tuple[int, ...] = setting(
+        (256, 256), "Hidden layers of each policy network and each critic (SAC's: 256-256; assumed).", LAYERS
+    )
+    activation: str = setting("relu", "Hidden activation: relu, leaky_relu, tanh or elu.", one_of(ACTIVATIONS))
+    actor_lr: float = setting(3e-4, "Adam learning rate of the policy (SAC: 3e-4; assumed).", POSITIVE)
+    critic_lr: float = setting(3e-4, "Adam learning rate of the twin critics (SAC: 3e-4; assumed).", POSITIVE)
+    alpha_lr: float = setting(
+        3e-4,
+        "Adam learning rate of the two log-temperatures (SAC: 3e-4; assumed); 0 keeps them at their initial values.",
+        NON_NEGATIVE,
+    )
+    init_alpha_d: float = setting(1.0, "Initial temperature of pi_d's entropy (SAC: 1; assumed).", POSITIVE)
+    init_alpha_c: float = setting(1.0, "Initial temperature of pi_c's entropy (SAC: 1; assumed).", POSITIVE)
+    target_entropy_d: float = setting(
+        0.98,
+        "pi_d's target entropy as a fraction of the uniform distribution's over the allowed actions, log(allowed) "
+        "(SAC-discrete, Christodoulou 2019: 0.98; assumed).",
+        interval(0, 1),
+    )
+    target_entropy_c: float = setting(
+        -1.0,
+        "pi_c's target entropy in nats per parameter of the chosen action (SAC: -1 per action dimension; assumed).",
+        Check(lambda v: v < math.log(2.0), "a number below log 2 (the uniform's entropy on [-1, 1])"),
+    )
+    tau: float = setting(0.005, "Soft target-update rate of the critics (SAC: 0.005).", interval(0, 1, low_open=True))
+    batch_size: int = shared_setting("batch_size", 256, "SAC: 256; assumed")
+    learning_starts: int = setting(
+        10_000, "Samples in the replay buffer before the first update (SAC: 10 000; assumed).", at_least(0)
+    )
+
+    @classmethod
+    def presets(cls) -> dict[str, Self]:
+        # "tuned" (the command line's default): sized for a laptop CPU, with 64 batched env copies, networks of
+        # 64-64, a tenth of an update per sample on batches of 128 (an update costs about the same at 64 or 128 here),
+        # lower initial temperatures (Platform's returns sum to at most 1, so an entropy bonus of 1 nat a step would
+        # dominate them) and a discrete target entropy of half the uniform's; how it learns:
+        # benchmarks/hsac_platform.md.
+        return {
+            "paper": cls(),
+            "tuned": cls(
+                num_envs=64,
+                hidden_sizes=(64, 64),
+                batch_size=128,
+                updates_per_step=0.1,
+                target_entropy_d=0.5,
+                learning_starts=2_000,
+                buffer_size=200_000,
+                init_alpha_d=0.1,
+                init_alpha_c=0.1,
+                actor_lr=1e-3,
+                critic_lr=1e-3,
+                alpha_lr=1e-3,
+                tau=0.01,
+            ),
+        }
+
+
+@dataclasses.dataclass
+class SquashedHybrid:
+    """A batch of hybrid distributions with tanh-squashed Gaussian parameters, every action's at once.
+
+    Attributes:
+        logits: ``(B, K)`` logits of ``pi_d``, masked actions already at :data:`~pamdp.distributions.MASKED`.
+        mean: ``(B, K, m)`` means of the pre-squash Gaussians ``u``, per action and padded parameter.
+        log_std: ``(B, K, m)`` their log standard deviations.
+        param_mask: ``(K, m)`` float, 1 where action ``a`` uses padded parameter ``i``.
+    """
+
+    logits: torch.Tensor
+    mean: torch.Tensor
+    log_std: torch.Tensor
+    param_mask: torch.Tensor
+
+    @property
+    def log_probs_d(self) -> torch.Tensor:
+        """``(B, K)`` normalised ``log pi_d(a | s)``."""
+        return F.log_softmax(self.logits, dim=-1)
+
+    @property
+    def probs_d(self) -> torch.Tensor:
+        return F.softmax(self.logits, dim=-1)
+
+    def entropy_d(self) -> torch.Tensor:
+        """``(B,)`` the entropy of ``pi_d`` (masked actions contribute nothing)."""
+        return -(self.probs_d * self.log_probs_d).sum(-1)
+
+    def rsample(self, generator: torch.Generator | None = None) -> tuple[torch.Tensor, torch.Tensor]:
+        """Reparameterised pre-squash ``u`` and parameters ``x = tanh(u)`` of every action, ``(B, K, m)`` each;
+        unused entries are zero."""
+        noise = torch.randn(self.mean.shape, generator=generator, dtype=self.mean.dtype, device=self.mean.device)
+        u = (self.mean + self.log_std.exp() * noise) * self.param_mask
+        return u, torch.tanh(u)
+
+    def log_prob_c(self, u: torch.Tensor) -> torch.Tensor:
+        """``(B, K)``: ``log pi_c(tanh(u_a) | s, a)`` for every action, over its own ``m_a`` parameters only.
+
+        ``log(1 - tanh(u)^2) = 2 (log 2 - u - softplus(-2 u))``, which stays finite where ``tanh(u)`` rounds to 1.
+        """
+        z = (u - self.mean) * torch.exp(-self.log_std)
+        gaussian = -0.5 * z.pow(2) - self.log_std - 0.5 * _LOG_2PI
+        log_det = 2.0 * (math.log(2.0) - u - F.softplus(-2.0 * u))
+        return ((gaussian - log_det) * self.param_mask).sum(-1)
+
+    def sample_discrete(self, generator: torch.Generator | None = None) -> torch.Tensor:
+        """``(B,)`` actions drawn from ``pi_d``."""
+        return torch.multinomial(self.probs_d, 1, generator=generator).squeeze(-1)
+
+    def mode(self) -> tuple[torch.Tensor, torch.Tensor]:
+        """The greedy action: ``argmax_a pi_d(a | s)`` and ``tanh`` of its Gaussian's mean, ``(B,)`` and ``(B, m)``."""
+        a = self.logits.argmax(-1)
+        return a, torch.tanh(self.mean[torch.arange(len(a), device=a.device), a]) * self.param_mask[a]
+
+
+class HybridSACActor(nn.Module):
+    """The policy in one of two forms (see the module docstring); ``forward(obs, mask)`` is a :class:`SquashedHybrid`.
+
+    ``flat``: ``mlp(s) -> [logits (K) | means (sum_a m_a) | log-stds (sum_a m_a)]``, the parameter blocks laid
+    out in the padded ``(K, m)`` form by index. ``hierarchical``: ``pi_d = mlp(s) -> K`` and
+    ``pi_c = mlp([s, onehot(a)]) -> [means (m) | log-stds (m)]`` for every ``a``.
+    """
+
+    def __init__(self, obs_dim: int, hybrid: HybridActionSpace, form: str, hidden_sizes, activation: str):
+        super().__init__()
+        if form not in FORMS:
+            raise ValueError(f"form = {form!r}; expected one of {', '.join(FORMS)}")
+        self.form, self.n_actions, self.m = form, hybrid.n_actions, hybrid.max_param_size
+        mask = hybrid.param_mask
+        self.register_buffer("param_mask", torch.as_tensor(mask, dtype=torch.float32))
+        # where action a's padded parameter i sits in the all-actions vector (0 where unused)
+        index = np.where(mask, hybrid.param_offsets[:, None] + np.arange(self.m), 0)
+        self.register_buffer("param_index", torch.as_tensor(index, dtype=torch.long).view(-1))
+        self.total = total = hybrid.total_param_size
+        # the all-actions vector's entries in the flattened padded (K * m) layout
+        self.register_buffer("flat_index", torch.as_tensor(np.flatnonzero(mask), dtype=torch.long))
+        if form == "flat":
+            self.net = mlp(obs_dim, hidden_sizes, self.n_actions + 2 * total, activation)
+            heads = [self.net[-1]]
+        else:
+            self.pi_d = mlp(obs_dim, hidden_sizes, self.n_actions, activation)
+            self.pi_c = mlp(obs_dim + self.n_actions, hidden_sizes, 2 * self.m, activation)
+            heads = [self.pi_d[-1], self.pi_c[-1]]
+        for head in heads:  # start near uniform, centred, with unit noise (as HybridPolicy does)
+            nn.init.uniform_(head.weight, -3e-3, 3e-3)
+            nn.init.zeros_(head.bias)
+
+    def _padded(self, flat: torch.Tensor) -> torch.Tensor:
+        """``(B, sum_a m_a)`` all-actions values as ``(B, K, m)``, zero where unused."""
+        return flat[:, self.param_index].view(-1, self.n_actions, self.m) * self.param_mask
+
+    def forward(self, obs: torch.Tensor, mask: torch.Tensor | None = None) -> SquashedHybrid:
+        if self.form == "flat":
+            logits, means, log_stds = self.net(obs).split([self.n_actions, self.total, self.total], dim=-1)
+            mean, log_std = self._padded(means), self._padded(log_stds)
+        else:
+            batch = obs.shape[0]
+            eye = torch.eye(self.n_actions, dtype=obs.dtype, device=obs.device).expand(batch, -1, -1)
+            every = torch.cat([obs.unsqueeze(1).expand(batch, self.n_actions, obs.shape[-1]), eye], dim=-1)
+            mean, log_std = self.pi_c(every).split(self.m, dim=-1)
+            logits = self.pi_d(obs)
+        log_std = log_std.clamp(LOG_STD_MIN, LOG_STD_MAX)
+        return SquashedHybrid(masked_logits(logits, mask), mean, log_std, self.param_mask)
+
+    def flat_params(self, x: torch.Tensor) -> torch.Tensor:
+        """Every action's parameters ``(B, K, m)`` as the critics' all-actions vector ``(B, sum_a m_a)``."""
+        return x.reshape(x.shape[0], -1)[:, self.flat_index]
+
+
+class TwinQ(nn.Module):
+    """Two critics ``Q_i(s, x_all)``, each with K outputs: ``Q_i(s, a, x_all)`` for every discrete action ``a``."""
+
+    def __init__(self, obs_dim: int, hybrid: HybridActionSpace, hidden_sizes, activation: str):
+        super().__init__()
+        size = obs_dim + hybrid.total_param_size
+        self.q1 = mlp(size, hidden_sizes, hybrid.n_actions, activation)
+        self.q2 = mlp(size, hidden_sizes, hybrid.n_actions, activation)
+
+    def forward(self, obs: torch.Tensor, params: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        inp = torch.cat([obs, params], dim=-1)
+        return self.q1(inp), self.q2(inp)
+
+
+class Temperatures(nn.Module):
+    """The log-temperatures ``log alpha_d`` and ``log alpha_c`` of the two entropy terms."""
+
+    def __init__(self, alpha_d: float, alpha_c: float):
+        super().__init__()
+        self.log_alpha_d = nn.Parameter(torch.tensor(math.log(alpha_d)))
+        self.log_alpha_c = nn.Parameter(torch.tensor(math.log(alpha_c)))
+
+
+def temperature_gradient(entropy: torch.Tensor, target: torch.Tensor | float) -> torch.Tensor:
+    """The gradient in ``log alpha`` of SAC's temperature loss ``mean(log alpha * (H - target))``, the entropy
+    estimates ``H`` held fixed: ``mean(H - target)``.
+
+    Descent lowers the temperature of a policy more random than its target, raises it for one less random, and
+    leaves it where the entropy meets the target.
+    """
+    return (entropy - target).mean()
+
+
+class HybridSAC(Algorithm):
+    """Hybrid SAC (Delalleau et al. 2019), flat or hierarchical (``form``). See the module docstring."""
+
+    config_class = HybridSACConfig
+    config: HybridSACConfig
+
+    def _build(self) -> None:
+        cfg, h = self.config, self.hybrid
+        self.actor = HybridSACActor(self.obs_dim, h, cfg.form, cfg.hidden_sizes, cfg.activation)
+        self.critic = TwinQ(self.obs_dim, h, cfg.hidden_sizes, cfg.activation)
+        self.critic_target = copy.deepcopy(self.critic).requires_grad_(False)
+        self.temperatures = Temperatures(cfg.init_alpha_d, cfg.init_alpha_c)
+        self.actor_optimizer = torch.optim.Adam(self.actor.parameters(), lr=cfg.actor_lr, fused=True)
+        self.critic_optimizer = torch.optim.Adam(self.critic.parameters(), lr=cfg.critic_lr, fused=True)
+        self.alpha_optimizer = torch.optim.Adam(self.temperatures.parameters(), lr=cfg.alpha_lr, fused=True)
+        self._actor_params, self._critic_params = list(self.actor.parameters()), list(self.critic.parameters())
+        self._actor_step = gradient_step(self.actor_optimizer, cfg.grad_clip)
+        self._critic_step = gradient_step(self.critic_optimizer, cfg.grad_clip)
+        self.param_sizes = torch.as_tensor(h.param_sizes, dtype=torch.float32, device=self.device)
+        fields = transition_fields(
+            self.obs_dim,
+            h.max_param_size,
+            masks=h.n_actions if cfg.action_mask else 0,
+            params=((h.total_param_size,), np.float32),  # every action's drawn parameters: what the critics saw
+        )
+        self.replay = ReplayBuffer(cfg.buffer_size, fields, self.device)
+        self.loop = OffPolicyLoop(cfg, h, self.replay)
+        self._soft_update = soft_updater([(self.critic_target, self.critic)])
+
+    def _modules(self):
+        return {
+            "actor": self.actor,
+            "critic": self.critic,
+            "critic_target": self.critic_target,
+            "temperatures": self.temperatures,
+        }
+
+    def _optimizers(self):
+        return {"actor": self.actor_optimizer, "critic": self.critic_optimizer, "temperatures": self.alpha_optimizer}
+
+    def _extra_state(self, replay):
+        return {"loop": self.loop.state_dict(replay)}
+
+    def _load_extra_state(self, state):
+        self.loop.load_state_dict(state["loop"])
+
+    @property
+    def alphas(self) -> tuple[float, float]:
+        """The current temperatures ``(alpha_d, alpha_c)``."""
+        t = self.temperatures
+        return float(t.log_alpha_d.detach().exp()), float(t.log_alpha_c.detach().exp())
+
+    # -- acting ----------------------------------------------------------------------------------
+    def _act(self, obs, deterministic, mask=None):
+        dist = self.actor(obs, mask)
+        if deterministic:
+            return dist.mode()
+        a, x, _ = self._sample(dist)
+        return a, x
+
+    def _sample(self, dist: SquashedHybrid):
+        """``a ~ pi_d``, every action's ``x ~ pi_c``: the chosen action's parameters ``(B, m)`` and all of them."""
+        a = dist.sample_discrete(self.torch_gen)
+        _, x_all = dist.rsample(self.torch_gen)
+        return a, x_all[torch.arange(len(a), device=a.device), a], x_all
+
+    def _explore(self, obs: torch.Tensor, step: int, episode_start: np.ndarray, mask=None):
+        a, x, x_all = self._sample(self.actor(obs, mask))
+        return a, x, {"params": self.actor.flat_params(x_all).cpu().numpy()}
+
+    # -- learning --------------------------------------------------------------------------------
+    def _run_epoch(self) -> dict[str, float]:
+        stats = self.loop.run_epoch(self.vec_env, self._explore, self._update, self.num_timesteps, self.np_rng)
+        stats["train/alpha_d"], stats["train/alpha_c"] = self.alphas
+        return stats
+
+    def soft_value(self, dist: SquashedHybrid, critic: TwinQ, obs: torch.Tensor, alpha_d, alpha_c):
+        """Per state and discrete action, ``min_i Q_i(s, x_all)_a - alpha_c log pi_c(x_a|s,a) - alpha_d log
+        pi_d(a|s)`` at a reparameterised draw of ``x_all``, ``(B, K)``, with ``log pi_c`` ``(B, K)``."""
+        u, x_all = dist.rsample(self.torch_gen)
+        q1, q2 = critic(obs, self.actor.flat_params(x_all))
+        log_pc = dist.log_prob_c(u)
+        return torch.minimum(q1, q2) - alpha_c * log_pc - alpha_d * dist.log_probs_d, log_pc
+
+    def _alpha_tensors(self) -> tuple[torch.Tensor, torch.Tensor]:
+        t = self.temperatures
+        return t.log_alpha_d.detach().exp(), t.log_alpha_c.detach().exp()
+
+    @torch.no_grad()
+    def target_value(self, next_obs: torch.Tensor, next_mask: torch.Tensor | None = None) -> torch.Tensor:
+        """``V(s')`` ``(B,)``: the soft value under the target critics, exact over the next discrete action
+        (masked ones weigh nothing), at one draw of every action's parameters."""
+        dist = self.actor(next_obs, next_mask)
+        soft_q, _ = self.soft_value(dist, self.critic_target, next_obs, *self._alpha_tensors())
+        return (dist.probs_d * soft_q).sum(-1)
+
+    def temperature_step(self, entropy_d, target_d, entropy_c, target_c) -> None:
+        """One Adam step of each log-temperature along :func:`temperature_gradient` of its part's entropy."""
+        optimizer_step(
+            self.alpha_optimizer, [temperature_gradient(entropy_d, target_d), temperature_gradient(entropy_c, target_c)]
+        )
+
+    def _update(self) -> dict[str, float]:
+        """One soft Q step of both critics, one policy step, one step of each temperature, the target update."""
+        cfg = self.config
+        b = self.replay.sample(cfg.batch_size, self.np_rng)
+        obs, next_obs = b["obs"], b["next_obs"]
+        mask, next_mask = b.get("mask"), b.get("next_mask")  # with the action_mask setting only
+        alpha_d, alpha_c = self._alpha_tensors()
+        y = b["reward"] + cfg.gamma * (~b["terminated"]).float() * self.target_value(next_obs, next_mask)
+        a = b["a"][:, None]
+        q1, q2 = (q.gather(1, a).squeeze(1) for q in self.critic(obs, b["params"]))
+        critic_loss = F.mse_loss(q1, y) + F.mse_loss(q2, y)
+        self._critic_step(torch.autograd.grad(critic_loss, self._critic_params))
+
+        dist = self.actor(obs, mask)
+        soft_q, log_pc = self.soft_value(dist, self.critic, obs, alpha_d, alpha_c)
+        p = dist.probs_d
+        actor_loss = -(p * soft_q).sum(-1).mean()
+        self._actor_step(torch.autograd.grad(actor_loss, self._actor_params))  # the critics' weights: no gradient
+
+        with torch.no_grad():
+            entropy_d = dist.entropy_d()
+            allowed = (dist.logits > MASKED / 2).sum(-1) if mask is not None else self.hybrid.n_actions
+            target_d = cfg.target_entropy_d * torch.as_tensor(allowed, dtype=p.dtype).log()
+            p = p.detach()
+            entropy_c = -(p * log_pc.detach()).sum(-1)  # of the expected action's parameters
+            target_c = cfg.target_entropy_c * (p * self.param_sizes).sum(-1)
+        self.temperature_step(entropy_d, target_d, entropy_c, target_c)
+        self._soft_update(cfg.tau)
+        return {
+            "losses/critic_loss": float(critic_loss.detach()),
+            "losses/actor_loss": float(actor_loss.detach()),
+            "train/q_mean": float(q1.detach().mean()),
+            "train/entropy_d": float(entropy_d.mean()),
+            "train/entropy_c": float(entropy_c.mean()),
+        }
