@@ -66,6 +66,23 @@ def test_to_env_batch_matches_scalar():
             np.testing.assert_array_equal(bp[k][i], sp[k])
 
 
+def test_to_env_batch_of_many_equal_boxes_matches_scalar():
+    """Hard Move's shape (2^n boxes of one parameter, each with its own bounds) takes the one-block path."""
+    rng = np.random.default_rng(0)
+    lows = rng.uniform(-3, 0, size=16)
+    boxes = tuple(spaces.Box(np.float32(lo), np.float32(lo + 1 + k), (1,), np.float32) for k, lo in enumerate(lows))
+    hs = HybridActionSpace.from_gym(spaces.Tuple((spaces.Discrete(16), spaces.Tuple(boxes))))
+    a = rng.integers(16, size=50)
+    x = rng.uniform(-1.2, 1.2, size=(50, 1))
+    ba, bp = hs.to_env_batch(a, x)
+    assert len(bp) == 16 and all(p.shape == (50, 1) and p.dtype == np.float32 for p in bp)
+    for i in range(50):
+        sa, sp = hs.to_env(a[i], x[i])
+        assert ba[i] == sa
+        for k in range(16):
+            np.testing.assert_array_equal(bp[k][i], sp[k])
+
+
 @pytest.mark.parametrize(
     "space",
     [

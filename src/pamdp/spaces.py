@@ -10,6 +10,7 @@ constant-size parameter policy), and map affinely to each action's box at the en
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from gymnasium import spaces
@@ -87,25 +88,25 @@ class HybridActionSpace:
         """``sum_a m_a``, the size of PADDPG's all-parameters output."""
         return sum(self.param_sizes)
 
-    @property
+    @cached_property
     def param_offsets(self) -> np.ndarray:
         """``o_a = m_0 + ... + m_{a-1}``: where action ``a``'s parameters start in the all-parameters vector."""
-        return np.concatenate([[0], np.cumsum(self.param_sizes)[:-1]]).astype(np.int64)
+        return _frozen(np.concatenate([[0], np.cumsum(self.param_sizes)[:-1]]).astype(np.int64))
 
-    @property
+    @cached_property
     def param_mask(self) -> np.ndarray:
         """Boolean ``(K, m)``: entry ``[a, i]`` is true where action ``a`` uses padded parameter ``i``."""
         mask = np.zeros((self.n_actions, self.max_param_size), dtype=bool)
         for a, m in enumerate(self.param_sizes):
             mask[a, :m] = True
-        return mask
+        return _frozen(mask)
 
-    @property
+    @cached_property
     def padded_low(self) -> np.ndarray:
         """``(K, m)`` lower bounds, padded with -1 (unused entries map identically)."""
         return self._padded(self.lows, -1.0)
 
-    @property
+    @cached_property
     def padded_high(self) -> np.ndarray:
         """``(K, m)`` upper bounds, padded with +1."""
         return self._padded(self.highs, 1.0)
@@ -114,7 +115,12 @@ class HybridActionSpace:
         out = np.full((self.n_actions, self.max_param_size), fill, dtype=np.float64)
         for a, b in enumerate(bounds):
             out[a, : b.shape[0]] = b
-        return out
+        return _frozen(out)
+
+    @cached_property
+    def _mid32(self) -> np.ndarray:
+        """``(K, m)`` float32 centres of the boxes (what the actions not taken are given)."""
+        return _frozen((0.5 * (self.padded_low + self.padded_high)).astype(np.float32))
 
     # -- scaling ------------------------------------------------------------------------------
     def scale(self, a, x_unit) -> np.ndarray:
@@ -153,6 +159,13 @@ class HybridActionSpace:
         """A batch of agent actions as a vector env's action: ``(a[N], (p_0[N, m_0], ...))``."""
         a = np.asarray(a, dtype=np.int64)
         x = self.scale(a, x_unit)
+        sizes = set(self.param_sizes)
+        if len(sizes) == 1 and self.n_actions > 8:  # one (K, N, m) block instead of K passes over the batch
+            m = sizes.pop()
+            block = np.empty((self.n_actions, len(a), m), dtype=np.float32)
+            block[:] = self._mid32[:, None, :]
+            block[a, np.arange(len(a))] = x[:, :m]
+            return (a, tuple(block))
         params = []
         for b, (lo, hi) in enumerate(zip(self.lows, self.highs)):
             p = np.where((a == b)[:, None], x[:, : lo.shape[0]], 0.5 * (lo + hi))
@@ -182,3 +195,9 @@ class HybridActionSpace:
                 ),
             )
         )
+
+
+def _frozen(array: np.ndarray) -> np.ndarray:
+    """``array`` made read-only: the space's cached tables are shared by every caller."""
+    array.setflags(write=False)
+    return array
