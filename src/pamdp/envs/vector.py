@@ -48,7 +48,7 @@ from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-__all__ = ["RandomStreams", "BatchedVectorEnv", "copy_seeds"]
+__all__ = ["RandomStreams", "BatchedVectorEnv", "copy_seeds", "check_render_mode", "split_actions", "column"]
 
 DRAWS = ("standard_normal", "random")
 """The generator methods a stream can draw with (both exist on ``Generator`` and ``RandomState``)."""
@@ -65,6 +65,42 @@ def copy_seeds(seed, num_copies: int) -> list:
         if all(s is None or (isinstance(s, (int, np.integer)) and not isinstance(s, bool)) for s in seed):
             return [None if s is None else int(s) for s in seed]
     raise ValueError(f"seed={seed!r}; expected None, an int, or a list of {num_copies} ints (or None), one per copy")
+
+
+def check_render_mode(render_mode, modes) -> None:
+    """``ValueError`` unless ``render_mode`` is None or one of ``modes``."""
+    if render_mode is not None and render_mode not in modes:
+        raise ValueError(f"render_mode={render_mode!r} is not supported; expected one of {[None, *modes]}")
+
+
+def split_actions(actions, domain: str, n: int, expected: str, n_actions=None, n_params=None) -> tuple:
+    """Check the form of a batch of ``n`` actions ``(a, params)``: ``a`` an int array of shape ``(n,)``
+    (in ``0..n_actions - 1`` unless ``n_actions`` is None), ``params`` a tuple or list of ``n_params``
+    (None: not checked). Returns ``(a, params)`` as given; a bad part raises ``ValueError`` naming it and
+    the ``expected`` form."""
+    if not isinstance(actions, (tuple, list)) or len(actions) != 2:
+        raise ValueError(f"invalid batch of {domain} actions {actions!r}; expected {expected}")
+    a = np.asarray(actions[0])
+    if a.shape != (n,) or a.dtype.kind not in "iu":
+        raise ValueError(f"invalid discrete actions {actions[0]!r}; expected {expected}")
+    if n_actions is not None and (a.min() < 0 or a.max() >= n_actions):
+        bad = (a < 0) | (a >= n_actions)
+        raise ValueError(f"discrete actions {a[bad]} at indices {np.flatnonzero(bad)}; expected {expected}")
+    params = actions[1]
+    if n_params is not None and (not isinstance(params, (tuple, list)) or len(params) != n_params):
+        raise ValueError(f"invalid parameters {params!r}; expected {expected}")
+    return a, params
+
+
+def column(p, n: int, name: int | str, expected: str) -> np.ndarray:
+    """One parameter of ``n`` copies given with shape ``(n,)`` or ``(n, 1)`` and a numeric dtype, as an
+    array of shape ``(n,)`` (dtype kept); ``ValueError`` otherwise, naming ``name`` (an int ``i`` reads
+    "parameter i")."""
+    p = np.asarray(p)
+    if p.shape not in ((n,), (n, 1)) or p.dtype.kind not in "iuf":
+        name = f"parameter {name}" if isinstance(name, int) else name
+        raise ValueError(f"invalid {name} of shape {p.shape}: {p!r}; expected {expected}")
+    return p.reshape(n)
 
 
 class RandomStreams:
@@ -161,9 +197,7 @@ class BatchedVectorEnv(VectorEnv):
             or max_episode_steps < 1
         ):
             raise ValueError(f"max_episode_steps must be a positive integer or None, got {max_episode_steps!r}")
-        modes = single_env.metadata["render_modes"]
-        if render_mode is not None and render_mode not in modes:
-            raise ValueError(f"render_mode={render_mode!r} is not supported; expected one of {[None, *modes]}")
+        check_render_mode(render_mode, single_env.metadata["render_modes"])
         self.metadata = {**self.metadata, "render_fps": single_env.metadata["render_fps"]}
         self.num_envs = int(num_envs)
         self.max_episode_steps = max_episode_steps

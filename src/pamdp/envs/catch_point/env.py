@@ -19,15 +19,13 @@ catch; the registration's 25-step limit is ``truncated``. The dynamics are ``pam
 from __future__ import annotations
 
 import math
-import numbers
 
-import gymnasium
 import numpy as np
 from gymnasium import spaces
 
 import pamdp.envs.particle as particle
 from pamdp.envs.catch_point.render import draw_catch_point
-from pamdp.envs.vector import RandomStreams
+from pamdp.envs.scalar import ScalarEnv, split_action
 
 __all__ = ["CatchPointEnv", "catch_point_action_space", "parse_action", "THETA_MAX"]
 
@@ -51,7 +49,7 @@ def observation_space() -> spaces.Box:
     return spaces.Box(-np.inf, np.inf, shape=(particle.OBS_SIZE,), dtype=np.float64)
 
 
-class CatchPointEnv(gymnasium.Env):
+class CatchPointEnv(ScalarEnv):
     """Catch Point as a Gymnasium env (see the module docstring for the task).
 
     Action: ``(a, (theta, catch))``: ``theta`` an array of shape ``(1,)`` (or a plain number), used as
@@ -75,35 +73,19 @@ class CatchPointEnv(gymnasium.Env):
     """
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": particle.RENDER_FPS}
+    observe = staticmethod(particle.observe)
+    obs_size = particle.OBS_SIZE
 
     def __init__(self, render_mode: str | None = None):
-        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
-            raise ValueError(
-                f"render_mode={render_mode!r} is not supported; expected one of "
-                f"{[None, *self.metadata['render_modes']]}"
-            )
-        self.render_mode = render_mode
-        self.action_space = catch_point_action_space()
-        self.observation_space = observation_space()
-        self._states = np.zeros((1, particle.STATE_SIZE))  # one row: the batched env's layout at N = 1
-        self._streams = RandomStreams(1, "random", particle.RESET_DRAWS)
+        states = np.zeros((1, particle.STATE_SIZE))  # one row: the batched env's layout at N = 1
+        super().__init__(
+            render_mode, catch_point_action_space(), observation_space(), states, "random", particle.RESET_DRAWS
+        )
         self._last_action: int | None = None
-
-    @property
-    def state(self) -> np.ndarray:
-        """A copy of the state row: agent position and velocity, target, failed catches."""
-        return self._states[0].copy()
-
-    def _observation(self) -> np.ndarray:
-        out = np.empty((1, particle.OBS_SIZE))
-        particle.observe(self._states, out)
-        return out[0]
 
     def reset(self, *, seed: int | None = None, options: dict | None = None):
         super().reset(seed=seed)
-        streams = self._streams
-        streams.follow(0, self.np_random)
-        streams.refill(particle.RESET_DRAWS)
+        streams = self._stream(particle.RESET_DRAWS)
         streams.cursors[0] = particle.reset(self._states[0], streams.buffers[0], streams.cursors[0])
         self._last_action = None
         return self._observation(), {"failed_catches": 0}
@@ -115,23 +97,13 @@ class CatchPointEnv(gymnasium.Env):
         info = {"failed_catches": int(self._states[0, particle.FAILS]), "is_success": caught}
         return self._observation(), reward, terminated, False, info
 
-    def render(self):
-        if self.render_mode == "rgb_array":
-            return draw_catch_point(self._states[0], self._last_action)
-        return None
+    def _frame(self):
+        return draw_catch_point(self._states[0], self._last_action)
 
 
 def parse_action(action) -> tuple[int, float]:
     """Check one Catch Point ``action``; return ``(a, theta)`` with ``theta`` a float64."""
-    if not isinstance(action, (tuple, list)) or len(action) != 2:
-        raise ValueError(f"invalid Catch Point action {action!r}; expected {EXPECTED}")
-    a, params = action
-    if isinstance(a, np.ndarray) and a.shape == ():
-        a = a.item()
-    if isinstance(a, bool) or not isinstance(a, numbers.Integral) or not 0 <= a <= 1:
-        raise ValueError(f"invalid discrete action {a!r}; expected {EXPECTED}")
-    if not isinstance(params, (tuple, list)) or len(params) != 2:
-        raise ValueError(f"invalid parameters {params!r}; expected {EXPECTED}")
+    a, params = split_action(action, "Catch Point", 2, 2, EXPECTED)
     theta, catch = np.asarray(params[0]), np.asarray(params[1])
     if theta.shape not in ((), (1,)) or theta.dtype.kind not in "iuf":
         raise ValueError(f"invalid angle {params[0]!r}; expected {EXPECTED}")
@@ -140,4 +112,4 @@ def parse_action(action) -> tuple[int, float]:
     value = float(theta.reshape(()))
     if not math.isfinite(value):
         raise ValueError(f"the angle is {value}; expected {EXPECTED}")
-    return int(a), value
+    return a, value

@@ -27,15 +27,14 @@ The dynamics are ``dynamics.step`` (compiled), shared with the batched envs in `
 
 from __future__ import annotations
 
-import numbers
-
 import gymnasium
 import numpy as np
 from gymnasium import spaces
 
 import pamdp.envs.goal.dynamics as dyn
 from pamdp.envs.goal.render import RENDER_FPS, draw_goal
-from pamdp.envs.vector import RandomStreams
+from pamdp.envs.scalar import ScalarEnv, split_action
+from pamdp.envs.vector import split_actions
 
 __all__ = ["GoalEnv", "HardGoalEnv", "hard_goal_shot", "BUFFER_SIZE"]
 
@@ -60,7 +59,7 @@ def hard_goal_shot(j, p):
     return (_SHOT_RANGE * (q + 1)) / 2.0 + _SHOT_LOW
 
 
-class GoalEnv(gymnasium.Env):
+class GoalEnv(ScalarEnv):
     """Robot Soccer Goal as a Gymnasium env (see the module docstring for the task).
 
     Action: ``(a, (p_kick, p_shoot_left, p_shoot_right))``, ``p_kick`` of shape ``(2,)`` and the others
@@ -85,17 +84,13 @@ class GoalEnv(gymnasium.Env):
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": RENDER_FPS}
 
+    observe = staticmethod(dyn.observe)
+    obs_size = dyn.OBS_SIZE
+
     def __init__(self, render_mode: str | None = None):
-        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
-            raise ValueError(
-                f"render_mode={render_mode!r} is not supported; expected one of "
-                f"{[None, *self.metadata['render_modes']]}"
-            )
-        self.render_mode = render_mode
-        self.action_space = self.make_action_space()
-        self.observation_space = spaces.Box(-np.inf, np.inf, shape=(dyn.OBS_SIZE,), dtype=np.float64)
-        self._states = np.zeros((1, dyn.STATE_SIZE))  # one row: the batched env's layout at N = 1
-        self._streams = RandomStreams(1, "random", BUFFER_SIZE)
+        obs_space = spaces.Box(-np.inf, np.inf, shape=(dyn.OBS_SIZE,), dtype=np.float64)
+        states = np.zeros((1, dyn.STATE_SIZE))  # one row: the batched env's layout at N = 1
+        super().__init__(render_mode, self.make_action_space(), obs_space, states, "random", BUFFER_SIZE)
         self._trace = np.empty((256 if render_mode else 0, dyn.TRACE_SIZE))
         self._substeps = 0
         self._started = False
@@ -119,16 +114,9 @@ class GoalEnv(gymnasium.Env):
         ``ball`` = [x, y, vx, vy], ``time`` = the agent steps taken this episode."""
         return {k: v[0] for k, v in _state_dict(self._states).items()}
 
-    def _observation(self) -> np.ndarray:
-        out = np.empty((1, dyn.OBS_SIZE))
-        dyn.observe(self._states, out)
-        return out[0]
-
     def reset(self, *, seed: int | None = None, options: dict | None = None):
         super().reset(seed=seed)
-        streams = self._streams
-        streams.follow(0, self.np_random)
-        streams.refill(dyn.RESET_DRAWS)
+        streams = self._stream(dyn.RESET_DRAWS)
         streams.cursors[0] = dyn.reset(self._states[0], streams.buffers[0], streams.cursors[0])
         self._substeps = 0
         self._started = True
@@ -155,19 +143,15 @@ class GoalEnv(gymnasium.Env):
             info["is_success"] = bool(terminated and reward == dyn.GOAL_REWARD)
         return self._observation(), reward, terminated, truncated, info
 
-    def render(self):
-        if self.render_mode == "rgb_array":
-            s = self._states[0]
-            return draw_goal(*(s[k] for k in (dyn.PX, dyn.PY, dyn.PHI, dyn.KX, dyn.KY, dyn.PSI, dyn.BX, dyn.BY)))
-        return None
+    def _frame(self):
+        s = self._states[0]
+        return draw_goal(*(s[k] for k in (dyn.PX, dyn.PY, dyn.PHI, dyn.KX, dyn.KY, dyn.PSI, dyn.BX, dyn.BY)))
 
     def render_substeps(self) -> list[np.ndarray]:
         """With ``render_mode="rgb_array"``: one frame per sub-step of the last step (none after a reset or
         on the time-limit step), the last one equal to :meth:`render`'s. ``pamdp.envs.rendering.record_episode``
         plays these."""
-        if self.render_mode != "rgb_array":
-            raise ValueError(f"render_substeps needs render_mode='rgb_array', got {self.render_mode!r}")
-        return [draw_goal(*row) for row in self._trace[: self._substeps]]
+        return self._substep_frames(draw_goal)
 
     # -- actions ------------------------------------------------------------------------------------
     def _expected(self, n: int | None = None) -> str:
@@ -184,17 +168,8 @@ class GoalEnv(gymnasium.Env):
 
     def _check_action(self, action) -> tuple[int, list]:
         """Check one action's form; return ``a`` and the parameters as arrays of their box's shape."""
-        expected = self._expected()
-        if not isinstance(action, (tuple, list)) or len(action) != 2:
-            raise ValueError(f"invalid Goal action {action!r}; expected {expected}")
-        a, params = action
-        if isinstance(a, np.ndarray) and a.shape == ():
-            a = a.item()
-        if isinstance(a, bool) or not isinstance(a, numbers.Integral) or not 0 <= a < self.action_space[0].n:
-            raise ValueError(f"invalid discrete action {a!r}; expected {expected}")
-        boxes = self.action_space[1]
-        if not isinstance(params, (tuple, list)) or len(params) != len(boxes):
-            raise ValueError(f"invalid parameters {params!r}; expected {expected}")
+        expected, boxes = self._expected(), self.action_space[1]
+        a, params = split_action(action, "Goal", self.action_space[0].n, len(boxes), expected)
         arrays = []
         for i, (p, box) in enumerate(zip(params, boxes)):
             arr = np.asarray(p)
@@ -203,25 +178,16 @@ class GoalEnv(gymnasium.Env):
             if not np.isfinite(arr).all():
                 raise ValueError(f"parameter {i} is {p!r}; expected {expected}")
             arrays.append(arr.reshape(box.shape))
-        return int(a), arrays
+        return a, arrays
 
     def check_actions(self, actions, n: int) -> tuple[np.ndarray, list]:
         """Check a batch of ``n`` actions (``batch_space`` of the action space); return ``a`` (n,) and the
         parameters as float64 arrays ``(n, size)``."""
         expected = self._expected(n)
-        if not isinstance(actions, (tuple, list)) or len(actions) != 2:
-            raise ValueError(f"invalid batch of Goal actions {actions!r}; expected {expected}")
-        a = np.asarray(actions[0])
-        if a.shape != (n,) or a.dtype.kind not in "iu":
-            raise ValueError(f"invalid discrete actions {actions[0]!r}; expected {expected}")
-        bad = (a < 0) | (a >= self.action_space[0].n)
-        if bad.any():
-            raise ValueError(f"discrete actions {a[bad]} at indices {np.flatnonzero(bad)}; expected {expected}")
         boxes = self.action_space[1]
-        if not isinstance(actions[1], (tuple, list)) or len(actions[1]) != len(boxes):
-            raise ValueError(f"invalid parameters {actions[1]!r}; expected {expected}")
+        a, params = split_actions(actions, "Goal", n, expected, self.action_space[0].n, len(boxes))
         arrays = []
-        for i, (p, box) in enumerate(zip(actions[1], boxes)):
+        for i, (p, box) in enumerate(zip(params, boxes)):
             p = np.asarray(p)
             size = box.shape[0]
             if p.shape not in ((n, size), (n,) if size == 1 else (n, size)) or p.dtype.kind not in "iuf":

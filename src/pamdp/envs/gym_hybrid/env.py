@@ -31,7 +31,7 @@ from gymnasium import spaces
 
 import pamdp.envs.gym_hybrid.dynamics as dyn
 from pamdp.envs.gym_hybrid.render import RENDER_FPS, draw_gym_hybrid
-from pamdp.envs.vector import RandomStreams
+from pamdp.envs.scalar import ScalarEnv, number, split_action
 
 __all__ = ["MovingEnv", "SlidingEnv", "gym_hybrid_action_space", "parse_action", "check_settings"]
 
@@ -67,7 +67,7 @@ def check_settings(**settings) -> np.ndarray:
     return row
 
 
-class GymHybridEnv(gymnasium.Env):
+class GymHybridEnv(ScalarEnv):
     """What Moving and Sliding share; :class:`MovingEnv` and :class:`SlidingEnv` choose the agent.
 
     Action: ``(a, (p_accelerate, p_turn, p_break))`` with ``a`` in {0, 1, 2}, ``p_accelerate`` and ``p_turn``
@@ -108,27 +108,15 @@ class GymHybridEnv(gymnasium.Env):
         penalty: float = 0.001,
         break_value: float = 0.1,
     ):
-        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
-            raise ValueError(
-                f"render_mode={render_mode!r} is not supported; expected one of "
-                f"{[None, *self.metadata['render_modes']]}"
-            )
-        self.render_mode = render_mode
+        obs_space = spaces.Box(-np.inf, np.inf, shape=(dyn.OBS_SIZE,), dtype=np.float64)
+        # Exactly one reset's numbers at a time, so np_random holds no number drawn ahead between resets.
+        states = dyn.INITIAL_STATE[None].copy()  # one row: the batched env's layout at N = 1
+        super().__init__(render_mode, gym_hybrid_action_space(), obs_space, states, "random", dyn.DRAWS_PER_RESET)
         self.settings = check_settings(
             max_turn=max_turn, max_acceleration=max_acceleration, delta_t=delta_t, max_step=max_step,
             penalty=penalty, break_value=break_value,
         )  # fmt: skip
-        self.action_space = gym_hybrid_action_space()
-        self.observation_space = spaces.Box(-np.inf, np.inf, shape=(dyn.OBS_SIZE,), dtype=np.float64)
-        self._states = dyn.INITIAL_STATE[None].copy()  # one row: the batched env's layout at N = 1
-        # Exactly one reset's numbers at a time, so np_random holds no number drawn ahead between resets.
-        self._streams = RandomStreams(1, "random", dyn.DRAWS_PER_RESET)
         self._started = False
-
-    @property
-    def state(self) -> np.ndarray:
-        """A copy of the state row (indices ``dynamics.X`` ... ``dynamics.SIN_PHI``)."""
-        return self._states[0].copy()
 
     def _observation(self) -> np.ndarray:
         out = np.empty((1, dyn.OBS_SIZE))
@@ -137,9 +125,7 @@ class GymHybridEnv(gymnasium.Env):
 
     def reset(self, *, seed: int | None = None, options: dict | None = None):
         super().reset(seed=seed)
-        streams = self._streams
-        streams.follow(0, self.np_random)
-        streams.refill(dyn.DRAWS_PER_RESET)
+        streams = self._stream(dyn.DRAWS_PER_RESET)
         streams.cursors[0] = dyn.reset(self._states, 0, streams.buffers, streams.cursors[0])
         self._started = True
         return self._observation(), {}
@@ -151,10 +137,8 @@ class GymHybridEnv(gymnasium.Env):
         reward, terminated, goal = dyn.step(self._states, 0, a, p, self.settings, self.sliding)
         return self._observation(), reward, terminated, False, {"is_success": goal} if terminated else {}
 
-    def render(self):
-        if self.render_mode == "rgb_array":
-            return draw_gym_hybrid(self._states[0], self.sliding)
-        return None
+    def _frame(self):
+        return draw_gym_hybrid(self._states[0], self.sliding)
 
 
 class MovingEnv(GymHybridEnv):
@@ -174,25 +158,8 @@ def parse_action(action) -> tuple[int, float]:
     """Check one gym-hybrid ``action``; return ``(a, p)`` with ``p`` the chosen action's parameter as a
     float64, not yet clipped (0.0 for break)."""
     expected = f"{ACTION_FORM} numbers or shape-(1,) arrays, p_break of shape (0,)"
-    if not isinstance(action, (tuple, list)) or len(action) != 2:
-        raise ValueError(f"invalid gym-hybrid action {action!r}; expected {expected}")
-    a, params = action
-    if isinstance(a, np.ndarray) and a.shape == ():
-        a = a.item()
-    if isinstance(a, bool) or not isinstance(a, numbers.Integral) or not 0 <= a <= 2:
-        raise ValueError(f"invalid discrete action {a!r}; expected {expected}")
-    if not isinstance(params, (tuple, list)) or len(params) != 3:
-        raise ValueError(f"invalid parameters {params!r}; expected {expected}")
-    values = []
-    for i in range(2):
-        arr = np.asarray(params[i])
-        if arr.shape not in ((), (1,)) or arr.dtype.kind not in "iuf":
-            raise ValueError(f"invalid parameter {i} {params[i]!r}; expected {expected}")
-        v = float(arr.reshape(()))
-        if not math.isfinite(v):
-            raise ValueError(f"parameter {i} is {v}; expected {expected}")
-        values.append(v)
+    a, params = split_action(action, "gym-hybrid", 3, 3, expected)
+    values = [number(params[0], 0, expected), number(params[1], 1, expected)]
     if np.shape(params[2]) != (0,):
         raise ValueError(f"invalid break parameter {params[2]!r}; expected {expected}")
-    a = int(a)
     return a, values[a] if a < 2 else 0.0

@@ -10,17 +10,13 @@ batched env ``batched.HardMoveVectorEnv``.
 
 from __future__ import annotations
 
-import math
-import numbers
-
-import gymnasium
 import numpy as np
 from gymnasium import spaces
 
 import pamdp.envs.particle as particle
 from pamdp.envs.hard_move.motions import check_size, motion_table
 from pamdp.envs.hard_move.render import draw_hard_move
-from pamdp.envs.vector import RandomStreams
+from pamdp.envs.scalar import ScalarEnv, number, split_action
 
 __all__ = ["HardMoveEnv", "hard_move_action_space", "parse_action"]
 
@@ -32,7 +28,7 @@ def hard_move_action_space(n: int) -> spaces.Tuple:
     return spaces.Tuple((spaces.Discrete(k), spaces.Tuple(tuple(spaces.Box(**box) for _ in range(k)))))
 
 
-class HardMoveEnv(gymnasium.Env):
+class HardMoveEnv(ScalarEnv):
     """Hard Move with ``n`` actuators as a Gymnasium env (see the module docstring for the task).
 
     Action: ``(a, (p_0, ..., p_{2^n - 1}))`` with each ``p`` an array of shape ``(1,)`` (or a plain
@@ -55,37 +51,20 @@ class HardMoveEnv(gymnasium.Env):
     """
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": particle.RENDER_FPS}
+    observe = staticmethod(particle.observe)
+    obs_size = particle.OBS_SIZE
 
     def __init__(self, n: int = 4, render_mode: str | None = None):
         self.n = check_size(n)
-        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
-            raise ValueError(
-                f"render_mode={render_mode!r} is not supported; expected one of "
-                f"{[None, *self.metadata['render_modes']]}"
-            )
-        self.render_mode = render_mode
-        self.action_space = hard_move_action_space(self.n)
-        self.observation_space = spaces.Box(-np.inf, np.inf, shape=(particle.OBS_SIZE,), dtype=np.float64)
+        obs_space = spaces.Box(-np.inf, np.inf, shape=(particle.OBS_SIZE,), dtype=np.float64)
+        states = np.zeros((1, particle.STATE_SIZE))  # one row: the batched env's layout at N = 1
+        super().__init__(render_mode, hard_move_action_space(self.n), obs_space, states, "random", particle.RESET_DRAWS)
         self.motions = motion_table(self.n)
-        self._states = np.zeros((1, particle.STATE_SIZE))  # one row: the batched env's layout at N = 1
-        self._streams = RandomStreams(1, "random", particle.RESET_DRAWS)
         self._last_action: tuple[int, float] | None = None
-
-    @property
-    def state(self) -> np.ndarray:
-        """A copy of the state row: agent position and velocity, target (and an unused counter)."""
-        return self._states[0].copy()
-
-    def _observation(self) -> np.ndarray:
-        out = np.empty((1, particle.OBS_SIZE))
-        particle.observe(self._states, out)
-        return out[0]
 
     def reset(self, *, seed: int | None = None, options: dict | None = None):
         super().reset(seed=seed)
-        streams = self._streams
-        streams.follow(0, self.np_random)
-        streams.refill(particle.RESET_DRAWS)
+        streams = self._stream(particle.RESET_DRAWS)
         streams.cursors[0] = particle.reset(self._states[0], streams.buffers[0], streams.cursors[0])
         self._last_action = None
         return self._observation(), {}
@@ -97,10 +76,8 @@ class HardMoveEnv(gymnasium.Env):
         self._last_action = (a, p)
         return self._observation(), reward, terminated, False, {"is_success": terminated}
 
-    def render(self):
-        if self.render_mode == "rgb_array":
-            return draw_hard_move(self._states[0], self.n, *(self._last_action or (None, 0.0)))
-        return None
+    def _frame(self):
+        return draw_hard_move(self._states[0], self.n, *(self._last_action or (None, 0.0)))
 
 
 def parse_action(action, n_actions: int) -> tuple[int, float]:
@@ -109,20 +86,8 @@ def parse_action(action, n_actions: int) -> tuple[int, float]:
     expected = (
         f"(a, (p_0, ..., p_{n_actions - 1})) with a in 0..{n_actions - 1} and p_a a finite number or shape-(1,) array"
     )
-    if not isinstance(action, (tuple, list)) or len(action) != 2:
-        raise ValueError(f"invalid Hard Move action {action!r}; expected {expected}")
-    a, params = action
-    if isinstance(a, np.ndarray) and a.shape == ():
-        a = a.item()
-    if isinstance(a, bool) or not isinstance(a, numbers.Integral) or not 0 <= a < n_actions:
-        raise ValueError(f"invalid discrete action {a!r}; expected {expected}")
+    a, params = split_action(action, "Hard Move", n_actions, None, expected)
     if not isinstance(params, (tuple, list)) or len(params) != n_actions:
         given = f"{len(params)} boxes" if isinstance(params, (tuple, list)) else f"a {type(params).__name__}"
         raise ValueError(f"invalid parameters ({given}); expected {expected}")
-    p = np.asarray(params[a])
-    if p.shape not in ((), (1,)) or p.dtype.kind not in "iuf":
-        raise ValueError(f"invalid parameter p_{a} = {params[a]!r}; expected {expected}")
-    value = float(p.reshape(()))
-    if not math.isfinite(value):
-        raise ValueError(f"parameter p_{a} is {value}; expected {expected}")
-    return int(a), value
+    return a, number(params[a], f"parameter p_{a}", expected)

@@ -24,16 +24,12 @@ The dynamics are ``physics.step`` (compiled), shared with the batched env ``batc
 
 from __future__ import annotations
 
-import math
-import numbers
-
-import gymnasium
 import numpy as np
 from gymnasium import spaces
 
 import pamdp.envs.platform.physics as physics
 from pamdp.envs.platform.render import RENDER_FPS, draw_platform
-from pamdp.envs.vector import RandomStreams
+from pamdp.envs.scalar import ScalarEnv, number, split_action
 
 __all__ = ["PlatformEnv", "ZeroNoise", "platform_action_space", "parse_action", "BUFFER_SIZE"]
 
@@ -59,7 +55,7 @@ def platform_action_space() -> spaces.Tuple:
     return spaces.Tuple((spaces.Discrete(3), spaces.Tuple(boxes)))
 
 
-class PlatformEnv(gymnasium.Env):
+class PlatformEnv(ScalarEnv):
     """The Platform domain as a Gymnasium env (see the module docstring for the task).
 
     Action: ``(a, (p_run, p_hop, p_leap))`` with ``a`` in {0, 1, 2} and each ``p`` an array of shape
@@ -87,17 +83,13 @@ class PlatformEnv(gymnasium.Env):
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": RENDER_FPS}
 
+    observe = staticmethod(physics.observe)
+    obs_size = physics.OBS_SIZE
+
     def __init__(self, render_mode: str | None = None):
-        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
-            raise ValueError(
-                f"render_mode={render_mode!r} is not supported; expected one of "
-                f"{[None, *self.metadata['render_modes']]}"
-            )
-        self.render_mode = render_mode
-        self.action_space = platform_action_space()
-        self.observation_space = spaces.Box(0.0, 1.0, shape=(physics.OBS_SIZE,), dtype=np.float64)
-        self._states = physics.INITIAL_STATE[None].copy()  # one row: the batched env's layout at N = 1
-        self._streams = RandomStreams(1, "standard_normal", BUFFER_SIZE)
+        obs_space = spaces.Box(0.0, 1.0, shape=(physics.OBS_SIZE,), dtype=np.float64)
+        states = physics.INITIAL_STATE[None].copy()  # one row: the batched env's layout at N = 1
+        super().__init__(render_mode, platform_action_space(), obs_space, states, "standard_normal", BUFFER_SIZE)
         self._trace = np.empty((physics.MAX_SUBSTEPS if render_mode else 0, physics.TRACE_SIZE))
         self._substeps = 0
 
@@ -106,11 +98,6 @@ class PlatformEnv(gymnasium.Env):
         """A copy of the internal state: ``player`` = [x, y, vx, vy], ``enemies`` = [[x, dx], [x, dx]]."""
         s = self._states[0]
         return {"player": s[physics.X : physics.VY + 1].copy(), "enemies": s[physics.E1X :].reshape(2, 2).copy()}
-
-    def _observation(self) -> np.ndarray:
-        out = np.empty((1, physics.OBS_SIZE))
-        physics.observe(self._states, out)
-        return out[0]
 
     # -- Gymnasium API --------------------------------------------------------------------------
     def reset(self, *, seed: int | None = None, options: dict | None = None):
@@ -121,49 +108,26 @@ class PlatformEnv(gymnasium.Env):
 
     def step(self, action):
         a, p = parse_action(action)
-        streams = self._streams
-        streams.follow(0, self.np_random)
-        streams.refill(physics.MAX_DRAWS)
+        streams = self._stream(physics.MAX_DRAWS)
         reward, terminated, substeps, streams.cursors[0] = physics.step(
             self._states[0], a, p, streams.buffers[0], streams.cursors[0], self._trace
         )
         self._substeps = substeps
         return self._observation(), reward, terminated, False, {"substeps": substeps}
 
-    def render(self):
-        if self.render_mode == "rgb_array":
-            s = self._states[0]
-            return draw_platform(s[physics.X], s[physics.Y], s[physics.E1X], s[physics.E2X])
-        return None
+    def _frame(self):
+        s = self._states[0]
+        return draw_platform(s[physics.X], s[physics.Y], s[physics.E1X], s[physics.E2X])
 
     def render_substeps(self) -> list[np.ndarray]:
         """With ``render_mode="rgb_array"``: one frame per sub-step of the last step (none after a reset),
         the last one equal to :meth:`render`'s. ``pamdp.envs.rendering.record_episode`` plays these."""
-        if self.render_mode != "rgb_array":
-            raise ValueError(f"render_substeps needs render_mode='rgb_array', got {self.render_mode!r}")
-        return [draw_platform(*row) for row in self._trace[: self._substeps]]
+        return self._substep_frames(draw_platform)
 
 
 def parse_action(action) -> tuple[int, float]:
     """Check one Platform ``action``; return ``(a, p)``: ``p`` is ``p_a`` clipped into its box, a float64."""
     expected = "(a, (p_run, p_hop, p_leap)) with a in {0, 1, 2} and each p a finite number or shape-(1,) array"
-    if not isinstance(action, (tuple, list)) or len(action) != 2:
-        raise ValueError(f"invalid Platform action {action!r}; expected {expected}")
-    a, params = action
-    if isinstance(a, np.ndarray) and a.shape == ():
-        a = a.item()
-    if isinstance(a, bool) or not isinstance(a, numbers.Integral) or not 0 <= a <= 2:
-        raise ValueError(f"invalid discrete action {a!r}; expected {expected}")
-    if not isinstance(params, (tuple, list)) or len(params) != 3:
-        raise ValueError(f"invalid parameters {params!r}; expected {expected}")
-    values = []
-    for i, p in enumerate(params):
-        arr = np.asarray(p)
-        if arr.shape not in ((), (1,)) or arr.dtype.kind not in "iuf":
-            raise ValueError(f"invalid parameter {i} {p!r}; expected {expected}")
-        v = float(arr.reshape(()))
-        if not math.isfinite(v):
-            raise ValueError(f"parameter {i} is {v}; expected {expected}")
-        values.append(v)
-    a = int(a)
+    a, params = split_action(action, "Platform", 3, 3, expected)
+    values = [number(p, i, expected) for i, p in enumerate(params)]
     return a, min(max(values[a], 0.0), physics.PARAM_MAX[a])
