@@ -12,7 +12,7 @@ import numpy as np
 import pamdp.envs.particle as particle
 from pamdp.envs.catch_point.env import CatchPointEnv
 from pamdp.envs.catch_point.render import draw_catch_point
-from pamdp.envs.vector import BatchedVectorEnv
+from pamdp.envs.vector import BatchedVectorEnv, column, split_actions
 
 __all__ = ["CatchPointVectorEnv", "action_arrays"]
 
@@ -105,17 +105,9 @@ def expected_actions(n: int) -> str:
 def action_arrays(actions, n: int) -> tuple[np.ndarray, np.ndarray]:
     """A batch of ``n`` Catch Point actions as ``a`` (n,) int64 and ``theta`` (n,) float64, its structure,
     shapes and dtypes checked (``ValueError``); the compiled step checks the values."""
-    if not isinstance(actions, (tuple, list)) or len(actions) != 2:
-        raise ValueError(f"invalid batch of Catch Point actions {actions!r}; expected {expected_actions(n)}")
-    a = np.asarray(actions[0])
-    if a.shape != (n,) or a.dtype.kind not in "iu":
-        raise ValueError(f"invalid discrete actions {actions[0]!r}; expected {expected_actions(n)}")
-    params = actions[1]
-    if not isinstance(params, (tuple, list)) or len(params) != 2:
-        raise ValueError(f"invalid parameters {params!r}; expected {expected_actions(n)}")
-    theta, catch = np.asarray(params[0]), np.shape(params[1])
-    if theta.shape not in ((n,), (n, 1)) or theta.dtype.kind not in "iuf":
-        raise ValueError(f"invalid angles of shape {theta.shape}: {params[0]!r}; expected {expected_actions(n)}")
+    expected = expected_actions(n)
+    a, params = split_actions(actions, "Catch Point", n, expected, n_params=2)
+    theta, catch = column(params[0], n, "angles", expected), np.shape(params[1])
     if catch not in ((n, 0), (n, 1)):
-        raise ValueError(f"invalid catch parameters of shape {catch}; expected {expected_actions(n)}")
-    return a.astype(np.int64, copy=False), theta.astype(np.float64, copy=False).reshape(n)
+        raise ValueError(f"invalid catch parameters of shape {catch}; expected {expected}")
+    return a.astype(np.int64, copy=False), theta.astype(np.float64, copy=False)

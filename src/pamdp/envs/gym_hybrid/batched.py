@@ -13,7 +13,7 @@ import numpy as np
 import pamdp.envs.gym_hybrid.dynamics as dyn
 from pamdp.envs.gym_hybrid.env import ACTION_FORM, MovingEnv, SlidingEnv
 from pamdp.envs.gym_hybrid.render import draw_gym_hybrid
-from pamdp.envs.vector import BatchedVectorEnv
+from pamdp.envs.vector import BatchedVectorEnv, column, split_actions
 
 __all__ = ["MovingVectorEnv", "SlidingVectorEnv", "parse_actions"]
 
@@ -107,20 +107,11 @@ def parse_actions(actions, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Check a batch of ``n`` gym-hybrid actions; return ``a`` (n,) and the accelerate and turn parameters (n,),
     float32 or float64 as given (the compiled step widens them to float64), not yet clipped."""
     expected = f"{ACTION_FORM} arrays of shape ({n}, 1) or ({n},), p_break of shape ({n}, 0); a of shape ({n},)"
-    if not isinstance(actions, (tuple, list)) or len(actions) != 2:
-        raise ValueError(f"invalid batch of gym-hybrid actions {actions!r}; expected {expected}")
-    a = np.asarray(actions[0])
-    if a.shape != (n,) or a.dtype.kind not in "iu":
-        raise ValueError(f"invalid discrete actions {actions[0]!r}; expected {expected}")
-    params = actions[1]
-    if not isinstance(params, (tuple, list)) or len(params) != 3:
-        raise ValueError(f"invalid parameters {params!r}; expected {expected}")
+    a, params = split_actions(actions, "gym-hybrid", n, expected, n_params=3)
     columns = []
     for i in range(2):
-        p = np.asarray(params[i])
-        if p.shape not in ((n,), (n, 1)) or p.dtype.kind not in "iuf":
-            raise ValueError(f"invalid parameter {i} of shape {p.shape}: {p!r}; expected {expected}")
-        columns.append(p.reshape(n) if p.dtype in (np.float32, np.float64) else p.reshape(n).astype(np.float64))
+        p = column(params[i], n, i, expected)
+        columns.append(p if p.dtype in (np.float32, np.float64) else p.astype(np.float64))
     if np.shape(params[2]) != (n, 0):
         raise ValueError(f"invalid break parameters of shape {np.shape(params[2])}; expected {expected}")
     bad = dyn.first_bad_action(a, *columns)  # one compiled pass instead of a NumPy pass per check

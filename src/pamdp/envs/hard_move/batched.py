@@ -14,7 +14,7 @@ import numpy as np
 import pamdp.envs.particle as particle
 from pamdp.envs.hard_move.env import HardMoveEnv
 from pamdp.envs.hard_move.render import draw_hard_move
-from pamdp.envs.vector import BatchedVectorEnv
+from pamdp.envs.vector import BatchedVectorEnv, split_actions
 
 __all__ = ["HardMoveVectorEnv", "parse_actions"]
 
@@ -122,16 +122,8 @@ def parse_actions(actions, n: int, n_actions: int) -> tuple[np.ndarray, np.ndarr
         f"each p an array of shape ({n}, 1) or ({n},), or all of them stacked in one array of shape "
         f"({n_actions}, {n}, 1) or ({n_actions}, {n})"
     )
-    if not isinstance(actions, (tuple, list)) or len(actions) != 2:
-        raise ValueError(f"invalid batch of Hard Move actions {actions!r}; expected {expected}")
-    a = np.asarray(actions[0])
-    if a.shape != (n,) or a.dtype.kind not in "iu":
-        raise ValueError(f"invalid discrete actions {actions[0]!r}; expected {expected}")
-    if a.min() < 0 or a.max() >= n_actions:
-        bad = (a < 0) | (a >= n_actions)
-        raise ValueError(f"discrete actions {a[bad]} at indices {np.flatnonzero(bad)}; expected {expected}")
+    a, params = split_actions(actions, "Hard Move", n, expected, n_actions)
     a = a.astype(np.int64, copy=False)
-    params = actions[1]
     if not isinstance(params, np.ndarray):
         if not isinstance(params, (tuple, list)) or len(params) != n_actions:
             given = f"{len(params)} boxes" if isinstance(params, (tuple, list)) else f"a {type(params).__name__}"

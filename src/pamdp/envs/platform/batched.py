@@ -12,7 +12,7 @@ import numpy as np
 import pamdp.envs.platform.physics as physics
 from pamdp.envs.platform.env import BUFFER_SIZE, PlatformEnv
 from pamdp.envs.platform.render import draw_platform
-from pamdp.envs.vector import BatchedVectorEnv
+from pamdp.envs.vector import BatchedVectorEnv, column, split_actions
 
 __all__ = ["PlatformVectorEnv", "parse_actions"]
 
@@ -99,23 +99,10 @@ def parse_actions(actions, n: int) -> tuple[np.ndarray, np.ndarray]:
         f"(a, (p_run, p_hop, p_leap)) with a an int array of shape ({n},) in 0..2 and each p a finite "
         f"array of shape ({n}, 1) or ({n},)"
     )
-    if not isinstance(actions, (tuple, list)) or len(actions) != 2:
-        raise ValueError(f"invalid batch of Platform actions {actions!r}; expected {expected}")
-    a = np.asarray(actions[0])
-    if a.shape != (n,) or a.dtype.kind not in "iu":
-        raise ValueError(f"invalid discrete actions {actions[0]!r}; expected {expected}")
-    bad = (a < 0) | (a > 2)
-    if bad.any():
-        raise ValueError(f"discrete actions {a[bad]} at indices {np.flatnonzero(bad)}; expected {expected}")
-    params = actions[1]
-    if not isinstance(params, (tuple, list)) or len(params) != 3:
-        raise ValueError(f"invalid parameters {params!r}; expected {expected}")
+    a, params = split_actions(actions, "Platform", n, expected, 3, 3)
     columns = []
     for i, p in enumerate(params):
-        p = np.asarray(p)
-        if p.shape not in ((n,), (n, 1)) or p.dtype.kind not in "iuf":
-            raise ValueError(f"invalid parameter {i} of shape {p.shape}: {p!r}; expected {expected}")
-        p = p.reshape(n).astype(np.float64)
+        p = column(p, n, i, expected).astype(np.float64)
         if not np.isfinite(p).all():
             raise ValueError(f"parameter {i} contains {p[~np.isfinite(p)]}; expected {expected}")
         columns.append(p)
