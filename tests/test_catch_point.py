@@ -1,13 +1,12 @@
 """Catch Point against the recordings of HyAR's original and ``shared/specs/catch_point.md``; the batched env
-against the scalar one. ``replay`` serves ``test_hard_move.py`` too (the same particle world)."""
+against the scalar one. ``check_particle`` serves ``test_hard_move.py`` too (the same particle world)."""
 
-import json
 import math
-from pathlib import Path
 
 import gymnasium
 import numpy as np
 import pytest
+from domain_replay import load_cases, replay
 from gymnasium.utils.env_checker import check_env
 from gymnasium.vector import SyncVectorEnv
 
@@ -16,8 +15,7 @@ import pamdp.envs.particle as particle
 from pamdp.envs.catch_point import CatchPointEnv, CatchPointVectorEnv
 from pamdp.spaces import HybridActionSpace
 
-DATA = Path(__file__).parent / "data"
-CASES = json.loads((DATA / "catch_point_traces.json").read_text())
+CASES = load_cases("catch_point_traces.json")
 # The spec's observation box is (-inf, inf); Gymnasium's checker warns about any unbounded box.
 # (and about boxes other than [-1, 1]: the angle's is [-pi, pi]).
 checker_warnings_ok = pytest.mark.filterwarnings(
@@ -32,35 +30,13 @@ def move(theta):
 CATCH = (1, (np.array([0.5], np.float32), np.zeros(0, np.float32)))
 
 
-def replay(case) -> tuple[int, int]:
-    """Replay a recorded case with the README's protocol: observations and rewards within 1e-12, flags
-    exact, the raw state too. Returns (records bit-identical in observation and reward, records)."""
-    env = gymnasium.make(case["env_id"], **case["env_kwargs"])
-    env.reset(seed=0)
-    env.unwrapped.np_random = np.random.RandomState(case["seed"])
-    boxes = env.action_space[1]
-    identical = records = 0
-    for rec in case["trace"]:
-        if rec.get("event") == "end":
-            break
-        if rec.get("event") == "reset":
-            obs, info = env.reset()
-            reward = rec_reward = 0.0
-        else:
-            params = [np.zeros(b.shape, b.dtype) for b in boxes]
-            params[rec["act_index"]] = np.array(rec["param"], dtype=boxes[rec["act_index"]].dtype)
-            obs, reward, terminated, truncated, info = env.step((rec["act_index"], tuple(params)))
-            rec_reward = rec["reward"]
-            assert (terminated, truncated) == (rec["terminal"], rec["truncated"]), f"step {rec['t']}"
-            assert info["is_success"] == (rec["kind"] in ("caught", "reached")), f"step {rec['t']}"
-        np.testing.assert_allclose(obs, rec["obs"], rtol=0, atol=1e-12, err_msg=f"step {rec['t']}")
-        assert reward == pytest.approx(rec_reward, rel=0, abs=1e-12), f"step {rec['t']}"
-        raw, state = rec["raw"], env.unwrapped.state
-        expected = [*raw["agent_pos"], *raw["agent_vel"], *raw["landmark_pos"], raw.get("failed_catches", 0)]
-        np.testing.assert_allclose(state, expected, rtol=0, atol=1e-12, err_msg=f"step {rec['t']}")
-        identical += bool(np.array_equal(obs, rec["obs"]) and reward == rec_reward)
-        records += 1
-    return identical, records
+def check_particle(rec, env, info, where):
+    """The particle world's extras: ``is_success`` on every step, the raw state on every record."""
+    if rec.get("event") != "reset":
+        assert info["is_success"] == (rec["kind"] in ("caught", "reached")), where
+    raw = rec["raw"]
+    expected = [*raw["agent_pos"], *raw["agent_vel"], *raw["landmark_pos"], raw.get("failed_catches", 0)]
+    np.testing.assert_allclose(env.state, expected, rtol=0, atol=1e-12, err_msg=where)
 
 
 def policy(i, obs, rng):
@@ -76,7 +52,7 @@ def policy(i, obs, rng):
 # --- the original, replayed -------------------------------------------------------------------------
 @pytest.mark.parametrize("case", CASES, ids=[f"{c['seed']}-{c['kinds'][0]}" for c in CASES])
 def test_replays_the_recordings_of_the_original(case):
-    identical, records = replay(case)
+    identical, records = replay(case, check_particle)
     print(f"catch point {case['seed']}: {identical} of {records} records bit-identical")
     assert records == len(case["trace"]) - 1
 

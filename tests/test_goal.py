@@ -2,13 +2,13 @@
 ``tests/data/goal_traces.json`` and ``hard_goal_traces.json``), the spec's worked numbers, and the batched
 envs against the scalar ones."""
 
-import json
 import math
 import pathlib
 
 import gymnasium
 import numpy as np
 import pytest
+from domain_replay import load_cases, params_for, replay
 from gymnasium.utils.env_checker import check_env
 from gymnasium.vector import SyncVectorEnv
 
@@ -24,60 +24,30 @@ from pamdp.envs.goal import (
 )
 from pamdp.spaces import HybridActionSpace
 
-DATA = pathlib.Path(__file__).parent / "data"
-TRACE_FILES = {"pamdp/Goal-v0": "goal_traces.json", "pamdp/HardGoal-v0": "hard_goal_traces.json"}
-CASES = [case for name in TRACE_FILES.values() for case in json.loads((DATA / name).read_text())]
+CASES = load_cases("goal_traces.json", "hard_goal_traces.json")
+ENV_IDS = ["pamdp/Goal-v0", "pamdp/HardGoal-v0"]
 LONG_CASES = {910367, 920148}
 """The two 100-step cases: their kicks' directions come from NumPy's arctan2 in the original, which on the
 recordings' AVX-512 build differs from libm's ``atan2`` (used here) in the last bit for some inputs."""
 
 
-def params_for(space, a, values):
-    """The parameter tuple of ``space`` with action ``a``'s box set to ``values``, the others zero."""
-    params = [np.zeros(box.shape, box.dtype) for box in space[1]]
-    params[a] = np.asarray(values, dtype=space[1][a].dtype).reshape(space[1][a].shape)
-    return tuple(params)
-
-
-def replay(case):
-    """The README's protocol: yields each record with what the env returned for it."""
-    env = gymnasium.make(case["env_id"], **case["env_kwargs"])
-    env.reset(seed=0)
-    env.unwrapped.np_random = np.random.RandomState(case["seed"])
-    for rec in case["trace"]:
-        if rec.get("event") == "end":
-            return
-        if rec.get("event") == "reset":
-            obs, info = env.reset()
-            yield rec, (obs, None, None, None, info)
-        else:
-            a = rec["act_index"]
-            yield rec, env.step((a, params_for(env.action_space, a, rec["param"])))
+def check_goal(rec, env, info, where):
+    """Goal's extras: the sub-steps of every record, and success reported at an episode's end (a goal)."""
+    assert info["substeps"] == rec["substeps"], where
+    if rec.get("terminal") or rec.get("truncated"):  # the Gymnasium way of reporting success
+        assert info["is_success"] == (rec["kind"] == "goal"), where
+    else:
+        assert "is_success" not in info, where
 
 
 @pytest.mark.parametrize("case", CASES, ids=[f"{c['domain']}-{c['seed']}" for c in CASES])
 def test_replays_the_original(case):
-    identical = steps = 0
-    for rec, (obs, reward, terminated, truncated, info) in replay(case):
-        where = f"seed {case['seed']}, t={rec['t']}"
-        np.testing.assert_allclose(obs, rec["obs"], rtol=0, atol=1e-12, err_msg=where)
-        assert info["substeps"] == rec["substeps"], where
-        exact = np.array_equal(obs, rec["obs"])
-        if reward is not None:
-            assert abs(reward - rec["reward"]) <= 1e-12, where
-            assert (terminated, truncated) == (rec["terminal"], rec["truncated"]), where
-            exact = exact and reward == rec["reward"]
-            if terminated or truncated:  # the Gymnasium way of reporting success: at the end, a goal
-                assert info["is_success"] == (rec["kind"] == "goal"), where
-            else:
-                assert "is_success" not in info, where
-        identical += exact
-        steps += 1
+    identical, records = replay(case, check_goal)
     assert case["kinds"] == [rec["kind"] for rec in case["trace"] if rec.get("kind")]
     if case["seed"] not in LONG_CASES:
-        assert identical == steps  # bit for bit
+        assert identical == records  # bit for bit
     else:
-        assert identical >= steps // 20
+        assert identical >= records // 20
 
 
 def test_observation_of_recorded_states_is_bit_exact():
@@ -210,7 +180,7 @@ def test_the_100th_step_ends_the_episode_without_moving():
 
 
 @pytest.mark.filterwarnings("ignore:.*(infinity|symmetric and normalized)")  # the spec's spaces
-@pytest.mark.parametrize("env_id", list(TRACE_FILES))
+@pytest.mark.parametrize("env_id", ENV_IDS)
 def test_check_env(env_id):
     check_env(gymnasium.make(env_id, render_mode="rgb_array").unwrapped, skip_render_check=False)
 
@@ -223,7 +193,7 @@ def test_spaces():
     assert goal.action_space[0].n == 3 and boxes == [([0.0, -15.0], [40.0, 15.0], np.float32), shoot, shoot]
     assert hard.action_space[0].n == 11 and len(hard.action_space[1]) == 11
     assert all(b.low.tolist() == [-1.0] and b.high.tolist() == [1.0] for b in hard.action_space[1][1:])
-    for env_id in TRACE_FILES:
+    for env_id in ENV_IDS:
         assert gymnasium.spec(env_id).max_episode_steps is None  # the env's own 100-step rule
 
 

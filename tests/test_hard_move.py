@@ -2,14 +2,14 @@
 against the scalar one, with n = 4 to 10 actuators."""
 
 import json
-from pathlib import Path
 
 import gymnasium
 import numpy as np
 import pytest
+from domain_replay import DATA, load_cases, replay
 from gymnasium.utils.env_checker import check_env
 from gymnasium.vector import SyncVectorEnv
-from test_catch_point import replay
+from test_catch_point import check_particle
 
 import pamdp  # noqa: F401  (registers the envs)
 import pamdp.envs.particle as particle
@@ -17,8 +17,7 @@ from pamdp.envs.hard_move import HardMoveEnv, HardMoveVectorEnv, motion_table
 from pamdp.envs.hard_move.motions import actuators
 from pamdp.spaces import HybridActionSpace
 
-DATA = Path(__file__).parent / "data"
-CASES = json.loads((DATA / "hard_move_traces.json").read_text())
+CASES = load_cases("hard_move_traces.json")
 MOTIONS = json.loads((DATA / "hard_move_motions.json").read_text())
 unbounded_ok = pytest.mark.filterwarnings("ignore:.*observation space (minimum|maximum) value")
 
@@ -38,7 +37,7 @@ def homing(obs, motions):
 # --- the original, replayed -------------------------------------------------------------------------
 @pytest.mark.parametrize("case", CASES, ids=[f"n{c['env_kwargs']['n']}-{c['seed']}" for c in CASES])
 def test_replays_the_recordings_of_the_original(case):
-    identical, records = replay(case)
+    identical, records = replay(case, check_particle)
     print(f"hard move n={case['env_kwargs']['n']} {case['seed']}: {identical} of {records} records bit-identical")
     assert records == len(case["trace"]) - 1
 
