@@ -85,26 +85,25 @@ def split_action(action, domain: str, n_actions: int, n_params: int | None, expe
     if not isinstance(action, (tuple, list)) or len(action) != 2:
         raise ValueError(f"invalid {domain} action {action!r}; expected {expected}")
     a, params = action
-    if isinstance(a, np.ndarray) and a.shape == ():
-        a = a.item()
-    if isinstance(a, bool) or not isinstance(a, numbers.Integral) or not 0 <= a < n_actions:
+    if not isinstance(a, (int, np.integer)) or isinstance(a, bool):  # the usual types skip the slower ABC test
+        if isinstance(a, np.ndarray) and a.shape == ():
+            a = a.item()
+        if isinstance(a, bool) or not isinstance(a, numbers.Integral):
+            raise ValueError(f"invalid discrete action {a!r}; expected {expected}")
+    if not 0 <= a < n_actions:
         raise ValueError(f"invalid discrete action {a!r}; expected {expected}")
     if n_params is not None and (not isinstance(params, (tuple, list)) or len(params) != n_params):
         raise ValueError(f"invalid parameters {params!r}; expected {expected}")
     return int(a), params
 
 
-def number(p, name: int | str, expected: str) -> float:
-    """A parameter given as a number or a shape-``(1,)`` array, as a finite float64; ``ValueError``
-    otherwise, naming ``name`` (an int ``i`` reads "parameter i")."""
+def number(p, i: int, expected: str, label: str = "parameter ") -> float:
+    """Parameter ``i`` given as a number or a shape-``(1,)`` array, as a finite float64; ``ValueError``
+    otherwise, naming it ``label`` followed by ``i``."""
     arr = np.asarray(p)
     if arr.shape not in ((), (1,)) or arr.dtype.kind not in "iuf":
-        raise ValueError(f"invalid {_name(name)} {p!r}; expected {expected}")
-    v = float(arr.reshape(()))
+        raise ValueError(f"invalid {label}{i} {p!r}; expected {expected}")
+    v = float(arr.item())
     if not math.isfinite(v):
-        raise ValueError(f"{_name(name)} is {v}; expected {expected}")
+        raise ValueError(f"{label}{i} is {v}; expected {expected}")
     return v
-
-
-def _name(name: int | str) -> str:
-    return f"parameter {name}" if isinstance(name, int) else name

@@ -90,4 +90,4 @@ def parse_action(action, n_actions: int) -> tuple[int, float]:
     if not isinstance(params, (tuple, list)) or len(params) != n_actions:
         given = f"{len(params)} boxes" if isinstance(params, (tuple, list)) else f"a {type(params).__name__}"
         raise ValueError(f"invalid parameters ({given}); expected {expected}")
-    return a, number(params[a], f"parameter p_{a}", expected)
+    return a, number(params[a], a, expected, "parameter p_")
