@@ -7,6 +7,8 @@ The copies run ``particle.catch_point_step``, the scalar env's dynamics, in one 
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 import pamdp.envs.particle as particle
@@ -95,6 +97,7 @@ class CatchPointVectorEnv(BatchedVectorEnv):
         return info
 
 
+@functools.cache  # the check of every batch needs it
 def expected_actions(n: int) -> str:
     return (
         f"(a, (theta, catch)) with a an int array of shape ({n},) in {{0, 1}}, theta a finite array of "
