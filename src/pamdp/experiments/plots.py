@@ -153,7 +153,7 @@ def seeds_label(agg: dict[str, np.ndarray], total: int) -> str:
     """``5 seeds``, or, for an arm still training, ``3 seeds, 1 past epoch 12``: how many seeds each part of the
     curve stands on."""
     if not len(agg["seeds"]) or agg["seeds"].min() == total:
-        return f"{total} seeds"
+        return f"{total} seed{'s' * (total != 1)}"
     full = int((agg["seeds"] == total).sum())  # seeds only drop out along the curve
     return f"{total} seeds, {int(agg['seeds'][-1])} past epoch {full}"
 
