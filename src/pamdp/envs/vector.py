@@ -31,7 +31,9 @@ How a domain plugs in (``envs/platform/batched.py`` is a worked example):
     the batch of ``actions``, reset the copies where ``resetting`` is true (next-step autoreset), step the
     others with draws from ``self.streams.buffers`` / ``self.streams.cursors`` (advanced in place), and
     return everything for every copy. The shell then zeroes the resetting copies' rewards and flags and
-    adds the time limit.
+    adds the time limit;
+  * ``_frames() -> tuple``: one picture per copy, which :meth:`~BatchedVectorEnv.render` returns with
+    ``render_mode="rgb_array"``.
 
 The shell does the rest: argument checks, seeding, ``options={"reset_mask": mask}``, next-step autoreset
 (the step after an episode ends returns the copy's reset observation, reward 0, both flags false), the
@@ -264,7 +266,14 @@ class BatchedVectorEnv(VectorEnv):
         self._autoreset = terminated | truncated
         return obs, rewards, terminated, truncated, infos
 
+    def render(self):
+        """One frame per copy (a tuple) with ``render_mode="rgb_array"``, else None."""
+        return self._frames() if self.render_mode == "rgb_array" else None
+
     # -- the domain's part ------------------------------------------------------------------------
+    def _frames(self) -> tuple:
+        raise NotImplementedError
+
     def _reset_copies(self, mask: np.ndarray, options: dict | None):
         raise NotImplementedError
 

@@ -60,9 +60,7 @@ class CatchPointVectorEnv(BatchedVectorEnv):
         """A copy of the copies' state rows ``(N, STATE_SIZE)`` (indices in ``pamdp.envs.particle``)."""
         return self._states.copy()
 
-    def render(self):
-        if self.render_mode != "rgb_array":
-            return None
+    def _frames(self) -> tuple:
         return tuple(draw_catch_point(s, a) for s, a in zip(self._states, self._last_actions))
 
     # -- the shell's hooks ------------------------------------------------------------------------

@@ -62,9 +62,7 @@ class GoalVectorEnv(BatchedVectorEnv):
         ``ball`` (N, 4), ``time`` (N,)."""
         return _state_dict(self._states)
 
-    def render(self):
-        if self.render_mode != "rgb_array":
-            return None
+    def _frames(self) -> tuple:
         return tuple(draw_goal(*(s[k] for k in _DRAWN)) for s in self._states)
 
     # -- the shell's hooks ------------------------------------------------------------------------

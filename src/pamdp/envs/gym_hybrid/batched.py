@@ -64,9 +64,7 @@ class GymHybridVectorEnv(BatchedVectorEnv):
         """A copy of the copies' state rows, ``(N, dynamics.STATE_SIZE)``."""
         return self._states.copy()
 
-    def render(self):
-        if self.render_mode != "rgb_array":
-            return None
+    def _frames(self) -> tuple:
         return tuple(draw_gym_hybrid(s, self.sliding) for s in self._states)
 
     # -- the shell's hooks ------------------------------------------------------------------------

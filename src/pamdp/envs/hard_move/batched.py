@@ -71,9 +71,7 @@ class HardMoveVectorEnv(BatchedVectorEnv):
         """A copy of the copies' state rows ``(N, STATE_SIZE)`` (indices in ``pamdp.envs.particle``)."""
         return self._states.copy()
 
-    def render(self):
-        if self.render_mode != "rgb_array":
-            return None
+    def _frames(self) -> tuple:
         return tuple(
             draw_hard_move(s, self.n, None if a < 0 else int(a), float(p))
             for s, a, p in zip(self._states, self._last_actions, self._last_params)

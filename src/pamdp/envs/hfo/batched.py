@@ -69,9 +69,7 @@ class HalfFieldOffenseVectorEnv(BatchedVectorEnv):
                 dyn.seed_stream(self.copy_streams[i], rng.random(4))
                 self._stream_sources[i] = rng
 
-    def render(self):
-        if self.render_mode != "rgb_array":
-            return None
+    def _frames(self) -> tuple:
         return tuple(draw_half_field(s) for s in self.states)
 
     def _reset_copies(self, mask, options):

@@ -59,9 +59,7 @@ class PlatformVectorEnv(BatchedVectorEnv):
             "enemies": s[:, physics.E1X :].reshape(-1, 2, 2).copy(),
         }
 
-    def render(self):
-        if self.render_mode != "rgb_array":
-            return None
+    def _frames(self) -> tuple:
         X, Y, E1X, E2X = physics.X, physics.Y, physics.E1X, physics.E2X
         return tuple(draw_platform(s[X], s[Y], s[E1X], s[E2X]) for s in self._states)
 
