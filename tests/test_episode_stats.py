@@ -31,17 +31,17 @@ def test_tracker_by_hand_with_successes_and_an_autoreset_step():
     assert stats["charts/episodes"] == 2
     assert stats["charts/episodic_return"] == pytest.approx((5.0 + 4.0) / 2)
     assert stats["charts/episodic_length"] == pytest.approx((3 + 2) / 2)
-    assert stats["charts/goal_rate"] == 0.5 and stats["charts/steps_to_goal"] == 3.0
+    assert stats["charts/success_rate"] == 0.5 and stats["charts/steps_to_success"] == 3.0
     assert tracker.pop() == {}
 
 
 def test_no_success_figures_without_reports_and_no_steps_to_success_without_one():
     tracker = EpisodeTracker(1)
     tracker.step(np.array([1.0]), np.array([True]), np.array([True]))
-    assert "charts/goal_rate" not in tracker.pop()
+    assert "charts/success_rate" not in tracker.pop()
     tracker.step(np.array([1.0]), np.array([True]), np.array([True]), {"is_success": np.array([False])})
     stats = tracker.pop()
-    assert stats["charts/goal_rate"] == 0.0 and "charts/steps_to_goal" not in stats
+    assert stats["charts/success_rate"] == 0.0 and "charts/steps_to_success" not in stats
 
 
 def test_success_figures_count_only_the_episodes_whose_end_reported_it():
@@ -51,7 +51,7 @@ def test_success_figures_count_only_the_episodes_whose_end_reported_it():
     tracker.step(np.array([1.0]), np.array([True]), np.array([True]), {"is_success": np.array([True])})
     stats = tracker.pop()
     assert stats["charts/episodes"] == 2
-    assert stats["charts/goal_rate"] == 1.0 and stats["charts/steps_to_goal"] == 2.0
+    assert stats["charts/success_rate"] == 1.0 and stats["charts/steps_to_success"] == 2.0
 
 
 class Coin(gymnasium.Env):
@@ -125,7 +125,7 @@ def test_off_policy_epoch_reports_the_success_rate_the_env_saw():
     rate, steps = env.expected()
     assert stats["charts/episodes"] == len(env.lengths) >= 100
     assert 0 < sum(s is None for s in env.reports) < len(env.reports)  # truncated episodes, not counted
-    assert stats["charts/goal_rate"] == pytest.approx(rate) and stats["charts/steps_to_goal"] == pytest.approx(steps)
+    assert stats["charts/success_rate"] == pytest.approx(rate) and stats["charts/steps_to_success"] == pytest.approx(steps)
 
 
 def test_patrpo_logs_the_success_rate_only_where_the_env_reports_it():
@@ -133,9 +133,9 @@ def test_patrpo_logs_the_success_rate_only_where_the_env_reports_it():
     for env, expected in ((coins(4), True), ("pamdp/Platform-v0", False)):
         seen: list[dict] = []
         PATRPO(env, config).learn(500, progress_bar=False, callback=lambda algo, stats, seen=seen: seen.append(stats))
-        assert ("charts/goal_rate" in seen[-1]) == expected, env
+        assert ("charts/success_rate" in seen[-1]) == expected, env
         if expected:
-            assert seen[-1]["charts/goal_rate"] == pytest.approx(env.expected()[0])
+            assert seen[-1]["charts/success_rate"] == pytest.approx(env.expected()[0])
 
 
 def test_evaluation_reports_the_success_rate_the_env_saw():
@@ -147,5 +147,5 @@ def test_evaluation_reports_the_success_rate_the_env_saw():
         gymnasium.registry.pop("test/Coin-v0")
     assert result["episodes"] == 400
     # success probability 0.6 among the terminated episodes (80%): within 5 standard errors
-    assert abs(result["goal_rate"] - 0.6) < 5 * np.sqrt(0.24 / 320)
-    assert 1 <= result["mean_steps_to_goal"] <= 6
+    assert abs(result["success_rate"] - 0.6) < 5 * np.sqrt(0.24 / 320)
+    assert 1 <= result["mean_steps_to_success"] <= 6

@@ -385,3 +385,29 @@ def test_hfo_allows_kick_exactly_when_the_kick_is_sent():
         if (term | trunc).any():
             break
     assert kicks == {True, False}
+
+
+class CountingLine(MaskedLine):
+    """MaskedLine counting masked picks across the copies ``evaluate`` makes itself."""
+
+    picks = 0
+
+    def step(self, action):
+        CountingLine.picks += not self._mask()[int(action[0])]
+        return super().step(action)
+
+
+@pytest.mark.parametrize("action_mask", [True, False], ids=["masked", "unmasked"])
+def test_evaluation_acts_within_the_mask_when_the_model_was_trained_with_it(action_mask):
+    from pamdp.evaluation import evaluate
+
+    cls = algorithm_class("patrpo")
+    model = cls(gymnasium.vector.SyncVectorEnv([MaskedLine] * 2), small_config(cls, action_mask))
+    gymnasium.register("test/CountingLine-v0", entry_point=CountingLine)
+    CountingLine.picks = 0
+    try:
+        result = evaluate(model, episodes=40, seed=1, deterministic=False, num_envs=4, env_id="test/CountingLine-v0")
+    finally:
+        gymnasium.registry.pop("test/CountingLine-v0")
+    assert result["episodes"] == 40
+    assert (CountingLine.picks == 0) if action_mask else (CountingLine.picks > 0)

@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from pamdp.algos.logger import success_summary, successes
-from pamdp.algos.vector_env import make_vector_env
+from pamdp.algos.vector_env import info_action_masks, make_vector_env
 
 if TYPE_CHECKING:
     from pamdp.algos.base import Algorithm
@@ -46,10 +46,12 @@ def evaluate(
     ep_return, ep_length = np.zeros(num_envs), np.zeros(num_envs, dtype=np.int64)
     done_count = np.zeros(num_envs, dtype=np.int64)
     prev_done = np.zeros(num_envs, dtype=bool)
-    obs, _ = env.reset(seed=seed)
+    obs, info = env.reset(seed=seed)
+    masked = model.config.action_mask  # the env's info["action_mask"], as in training
     try:
         while np.any(done_count < quota):
-            action = model.predict(obs, deterministic=deterministic)
+            mask = info_action_masks(info, num_envs, model.hybrid.n_actions) if masked else None
+            action = model.predict(obs, deterministic=deterministic, action_mask=mask)
             obs, reward, terminated, truncated, info = env.step(action)
             valid = ~prev_done
             ep_return += np.where(valid, reward, 0.0)

@@ -230,7 +230,7 @@ class Algorithm:
             run_dir: where to write ``progress.csv``, TensorBoard logs (``tb/``) and ``checkpoint.pt``.
             checkpoint_every: epochs between checkpoints (with ``run_dir``).
             eval_every: epochs between greedy evaluations (0: none), logged as ``eval/mean_return`` (and
-                ``eval/goal_rate`` where the env reports ``is_success``). They play ``eval_episodes`` episodes on
+                ``eval/success_rate`` where the env reports ``is_success``). They play ``eval_episodes`` episodes on
                 separate env copies seeded ``10_000 + seed`` and draw nothing from the training's random streams.
         """
         from tqdm.auto import tqdm
@@ -293,8 +293,8 @@ class Algorithm:
     def _greedy_evaluation(self, episodes: int) -> dict[str, float]:
         result = evaluate(self, episodes=episodes, seed=10_000 + self.config.seed)
         stats = {"eval/mean_return": result["mean_return"], "eval/mean_length": result["mean_length"]}
-        if "goal_rate" in result:
-            stats["eval/goal_rate"] = result["goal_rate"]
+        if "success_rate" in result:
+            stats["eval/success_rate"] = result["success_rate"]
         return stats
 
     def save(self, path: str | os.PathLike, replay: bool | None = None) -> None:
