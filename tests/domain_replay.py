@@ -1,11 +1,12 @@
-"""The recordings of the original domains in ``tests/data``, replayed with the protocol of
-``shared/specs/domain_traces/README.md``: the domains' tests share it and add their own checks."""
+"""What the domains' tests share: the recordings of the original domains in ``tests/data`` replayed with the
+protocol of ``shared/specs/domain_traces/README.md``, a batched step against scalar envs', refused actions."""
 
 import json
 from pathlib import Path
 
 import gymnasium
 import numpy as np
+import pytest
 
 DATA = Path(__file__).parent / "data"
 
@@ -23,10 +24,9 @@ def params_for(space, a, values) -> tuple:
 
 
 def replay(case: dict, check=None) -> tuple[int, int]:
-    """Replay ``case`` from a fresh env driven by ``RandomState(seed)``: every observation and reward within
-    1e-12 of the recording, the flags exact; then ``check(rec, env, info, where)`` asserts the domain's own
-    (``env`` unwrapped, ``where`` names the record). Returns (records bit-identical in observation and
-    reward, records), resets counted as records with reward 0."""
+    """Replay ``case`` driven by ``RandomState(seed)``: observations and rewards within 1e-12 of the recording,
+    flags exact, then ``check(rec, env.unwrapped, info, where)``. Returns (records bit-identical in
+    observation and reward, records); a reset is a record with reward 0."""
     env = gymnasium.make(case["env_id"], **case["env_kwargs"])
     env.reset(seed=0)
     env.unwrapped.np_random = np.random.RandomState(case["seed"])
@@ -50,3 +50,19 @@ def replay(case: dict, check=None) -> tuple[int, int]:
         identical += bool(np.array_equal(obs, rec["obs"]) and reward == rec_reward)
         records += 1
     return identical, records
+
+
+def assert_same_step(got, want, where: str, keys=None) -> None:
+    """A batched step's ``(obs, rewards, terminated, truncated, infos)`` equal to ``want``'s (a
+    ``SyncVectorEnv`` of scalar envs): the four arrays and the infos ``keys`` (default: all of ``want``'s)."""
+    for k in range(4):
+        np.testing.assert_array_equal(got[k], want[k], err_msg=f"{where}, output {k}")
+    for key in want[4] if keys is None else keys:
+        np.testing.assert_array_equal(got[4][key], want[4][key], err_msg=f"{where}, {key}")
+
+
+def assert_refused(env, action, *words: str) -> None:
+    """``env.step(action)`` raises ``ValueError`` with each of ``words`` in its message."""
+    with pytest.raises(ValueError) as err:
+        env.step(action)
+    assert all(w in str(err.value) for w in words), str(err.value)

@@ -6,7 +6,7 @@ import math
 import gymnasium
 import numpy as np
 import pytest
-from domain_replay import load_cases, replay
+from domain_replay import assert_same_step, load_cases, replay
 from gymnasium.utils.env_checker import check_env
 from gymnasium.vector import SyncVectorEnv
 
@@ -196,10 +196,7 @@ def test_copy_i_equals_a_scalar_env_seeded_with_seed_plus_i(n, seed):
             (np.stack([p[0] for _, p in actions]), np.zeros((n, 0), np.float32)),
         )
         got, want = venv.step(batch), ref.step(batch)
-        for k in range(4):
-            np.testing.assert_array_equal(got[k], want[k], err_msg=f"step {t}, output {k}")
-        for key in want[4]:
-            np.testing.assert_array_equal(got[4][key], want[4][key], err_msg=f"step {t}, {key}")
+        assert_same_step(got, want, f"step {t}")
         np.testing.assert_array_equal(venv.unwrapped.states, [e.unwrapped.state for e in ref.envs])
         ended = got[2] | got[3]
         endings |= {("caught" if r > 4 else "budget" if r == 0 else "time") for r in got[1][ended]}

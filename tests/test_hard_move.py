@@ -6,7 +6,7 @@ import json
 import gymnasium
 import numpy as np
 import pytest
-from domain_replay import DATA, load_cases, replay
+from domain_replay import DATA, assert_same_step, load_cases, replay
 from gymnasium.utils.env_checker import check_env
 from gymnasium.vector import SyncVectorEnv
 from test_catch_point import check_particle
@@ -156,10 +156,7 @@ def test_copy_i_equals_a_scalar_env_seeded_with_seed_plus_i(n_actuators, copies,
         params[a, np.arange(copies), 0] = p
         batch = (a, tuple(params))
         got, want = venv.step(batch), ref.step(batch)
-        for j in range(4):
-            np.testing.assert_array_equal(got[j], want[j], err_msg=f"step {t}, output {j}")
-        for key in want[4]:
-            np.testing.assert_array_equal(got[4][key], want[4][key], err_msg=f"step {t}, {key}")
+        assert_same_step(got, want, f"step {t}")
         np.testing.assert_array_equal(venv.unwrapped.states, [e.unwrapped.state for e in ref.envs])
         ended += got[2].sum(), (got[3] & ~got[2]).sum()
     assert ended.all()  # reached and timed out: autoresets after both compared
@@ -174,8 +171,7 @@ def test_stacked_parameters_read_as_the_tuple_of_boxes():
         a = rng.integers(0, 1024, 64)
         params = rng.uniform(-1, 1, (1024, 64, 1)).astype(np.float32)
         got, want = venv_stacked.step((a, params)), venv_tuple.step((a, tuple(params[:, :, 0])))
-        for j in range(4):
-            np.testing.assert_array_equal(got[j], want[j])
+        assert_same_step(got, want, "stacked", keys=())
 
 
 @pytest.mark.parametrize(
