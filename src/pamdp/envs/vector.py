@@ -16,10 +16,11 @@ take; the compiled step never calls back.
 
 How a domain plugs in (``envs/platform/batched.py`` is a worked example):
 
-- The scalar env keeps ``RandomStreams(1, draw, capacity)`` and, before each step, calls
-  ``streams.follow(0, self.np_random)`` (which drops the buffer when ``np_random`` was replaced, e.g. by
-  ``numpy.random.RandomState(S)`` or by ``reset(seed=...)``), then ``streams.refill(need)``, and hands
-  ``streams.buffers[0]`` and ``streams.cursors[0]`` to the per-copy step; the step returns the new cursor.
+- The scalar env subclasses ``pamdp.envs.scalar.ScalarEnv``, which keeps ``RandomStreams(1, draw,
+  capacity)``; before a step that draws, ``self._stream(need)`` follows ``self.np_random`` (dropping the
+  buffer when ``np_random`` was replaced, e.g. by ``numpy.random.RandomState(S)`` or by
+  ``reset(seed=...)``) and tops it up; the env hands ``buffers[0]`` and ``cursors[0]`` to the per-copy
+  step, which returns the new cursor.
 - The batched env subclasses :class:`BatchedVectorEnv`, sets the class attributes ``draw`` (the generator
   method: ``"standard_normal"`` or ``"random"``), ``draws_per_step`` (the most numbers one copy can take
   in one step, reset included) and ``buffer_size``, calls ``super().__init__(num_envs, single_env,
