@@ -36,7 +36,7 @@ def _distribution(batch: int) -> SquashedHybrid:
     logits = torch.tensor([[0.3, -0.2, 0.6]], dtype=torch.float64)
     mean = torch.tensor([[[0.4, -1.1], [7.0, 7.0], [1.3, 7.0]]], dtype=torch.float64)
     log_std = torch.tensor([[[-0.5, 0.2], [3.0, 3.0], [-0.9, 3.0]]], dtype=torch.float64)
-    mask = torch.as_tensor(HYBRID.param_mask, dtype=torch.float64)
+    mask = torch.tensor(HYBRID.param_mask, dtype=torch.float64)
     return SquashedHybrid(logits.expand(batch, -1), mean.expand(batch, -1, -1), log_std.expand(batch, -1, -1), mask)
 
 
@@ -44,7 +44,7 @@ def _squashed_entropy(mu: float, sigma: float) -> float:
     """The differential entropy of tanh(N(mu, sigma)) by quadrature over u: E[-log N(u) + log(1 - tanh(u)^2)]."""
     u = np.linspace(mu - 12 * sigma, mu + 12 * sigma, 200_001)
     density = np.exp(-0.5 * ((u - mu) / sigma) ** 2) / (sigma * math.sqrt(2 * math.pi))
-    integrand = density * (-np.log(density + 1e-300) + np.log1p(-np.tanh(u) ** 2 + 1e-300))
+    integrand = density * (-np.log(density + 1e-300) + np.log1p(-(np.tanh(u) ** 2) + 1e-300))
     return float(np.sum(integrand) * (u[1] - u[0]))
 
 
@@ -102,7 +102,9 @@ def test_entropies_match_quadrature():
     u, _ = dist.rsample(gen)
     a = dist.sample_discrete(gen)
     mean, std = dist.mean[0], dist.log_std[0].exp()
-    h_c = [sum(_squashed_entropy(float(mean[k, i]), float(std[k, i])) for i in range(m)) for k, m in enumerate([2, 0, 1])]
+    h_c = [
+        sum(_squashed_entropy(float(mean[k, i]), float(std[k, i])) for i in range(m)) for k, m in enumerate([2, 0, 1])
+    ]
     estimate = -dist.log_prob_c(u).mean(0)  # the single-draw estimates the updates use, averaged
     torch.testing.assert_close(estimate, torch.tensor(h_c, dtype=torch.float64), atol=0.01, rtol=0)
     p = dist.probs_d[0].numpy()
@@ -166,7 +168,7 @@ def test_target_is_the_exact_expectation_over_next_actions(masked):
         mean, std = dist.mean.double(), dist.log_std.double().exp()
         chosen = torch.arange(n), a
         normal = Normal(mean[chosen][:, 0], std[chosen][:, 0])
-        log_pc = normal.log_prob(u[chosen][:, 0]) - torch.log1p(-x_all[chosen][:, 0].double() ** 2)
+        log_pc = normal.log_prob(u[chosen][:, 0]) - torch.log1p(-(x_all[chosen][:, 0].double() ** 2))
         q1, q2 = model.critic_target(obs, model.actor.flat_params(x_all))
         q = torch.minimum(q1, q2)[chosen].double()
         sampled = q - 0.2 * log_pc - 0.3 * log_pd
