@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from pamdp.experiments import load_experiment
-from pamdp.experiments.plots import write_report
+from pamdp.experiments.report import write_report
 from pamdp.experiments.runner import is_finished, run_all
 from pamdp.experiments.status import epoch_seconds
 

@@ -125,7 +125,9 @@ def test_off_policy_epoch_reports_the_success_rate_the_env_saw():
     rate, steps = env.expected()
     assert stats["charts/episodes"] == len(env.lengths) >= 100
     assert 0 < sum(s is None for s in env.reports) < len(env.reports)  # truncated episodes, not counted
-    assert stats["charts/success_rate"] == pytest.approx(rate) and stats["charts/steps_to_success"] == pytest.approx(steps)
+    assert stats["charts/success_rate"] == pytest.approx(rate) and stats["charts/steps_to_success"] == pytest.approx(
+        steps
+    )
 
 
 def test_patrpo_logs_the_success_rate_only_where_the_env_reports_it():

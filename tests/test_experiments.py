@@ -267,7 +267,8 @@ def test_a_killed_worker_fails_its_run_alone(tmp_path):
 
 
 def test_greedy_evaluations_get_their_own_figure(tmp_path):
-    from pamdp.experiments.plots import GREEDY_METRIC, aggregate, write_report
+    from pamdp.experiments.plots import GREEDY_METRIC, aggregate
+    from pamdp.experiments.report import write_report
 
     header = "time/total_timesteps,charts/episodic_return,eval/mean_return\n"
     evals = {0: [0.2, 0.6], 1: [0.4, 1.0]}  # every second epoch of four
@@ -289,7 +290,8 @@ def test_greedy_evaluations_get_their_own_figure(tmp_path):
 
 
 def test_training_success_rates_get_their_own_figure_under_either_name(tmp_path):
-    from pamdp.experiments.plots import SUCCESS_METRIC, aggregate, write_report
+    from pamdp.experiments.plots import SUCCESS_METRIC, aggregate
+    from pamdp.experiments.report import write_report
 
     # soccer's runs on disk logged the rate as charts/goal_rate; runs since as charts/success_rate
     for name, column in (("soccer", "charts/goal_rate"), ("goal", "charts/success_rate")):
@@ -312,7 +314,8 @@ def test_training_success_rates_get_their_own_figure_under_either_name(tmp_path)
 
 
 def test_an_arm_still_training_keeps_its_finished_seeds_curves(tmp_path):
-    from pamdp.experiments.plots import aggregate, results_table, write_report
+    from pamdp.experiments.plots import aggregate, results_table
+    from pamdp.experiments.report import write_report
 
     returns = {0: [0.1, 0.5, 0.9], 1: [0.3, 0.7, 1.3], 2: [0.0]}  # seed 2 has just started
     for seed, values in returns.items():
@@ -332,7 +335,8 @@ def test_an_arm_still_training_keeps_its_finished_seeds_curves(tmp_path):
 
 
 def test_curves_are_drawn_over_epochs_as_the_paper_unless_epoch_sizes_differ(tmp_path):
-    from pamdp.experiments.plots import aggregate, write_report, x_axis
+    from pamdp.experiments.plots import aggregate, x_axis
+    from pamdp.experiments.report import write_report
 
     def runs(name, steps):
         run = tmp_path / name / "seed0"
@@ -459,7 +463,7 @@ def _suite_run(root, label, env, seed, env_kwargs=None, evaluation=None, greedy=
 
 
 def test_the_suite_table_puts_each_domains_runs_beside_hyars_numbers(tmp_path):
-    from pamdp.experiments.plots import write_report
+    from pamdp.experiments.report import write_report
 
     root = tmp_path / "benchmark-suite"
     for seed, rate in enumerate((0.5, 0.7, 0.9)):

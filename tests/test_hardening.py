@@ -170,7 +170,8 @@ def write_run(path, algo, env, returns, label=None):
 
 
 def test_plot_averages_only_runs_of_one_algorithm_and_env(tmp_path):
-    from pamdp.experiments.plots import find_groups, write_report
+    from pamdp.experiments.plots import find_groups
+    from pamdp.experiments.report import write_report
 
     write_run(tmp_path / "runs" / "a", "patrpo", "pamdp/Platform-v0", [0.2, 0.4])
     write_run(tmp_path / "runs" / "b", "pdqn", "pamdp/HalfFieldOffense-v0", [0.8, 1.0])

@@ -326,7 +326,7 @@ def cmd_train(args) -> int:
 # -- reproduce, plot --------------------------------------------------------------------------------
 def cmd_reproduce(args) -> int:
     from pamdp.experiments import load_experiment
-    from pamdp.experiments.plots import write_report
+    from pamdp.experiments.report import write_report
 
     exp = load_experiment(args.name)
     file = next((p for p in (Path(args.out), *Path(args.out).parents) if p.exists() and not p.is_dir()), None)
@@ -362,7 +362,7 @@ def cmd_reproduce(args) -> int:
 
 
 def cmd_plot(args) -> int:
-    from pamdp.experiments.plots import write_report
+    from pamdp.experiments.report import write_report
 
     _print_report(write_report(args.dirs, args.out or args.dirs[0], args.title, args.x))
     return 0

@@ -1,0 +1,66 @@
+"""An experiment's report: its figures, per-epoch aggregate and results table (:mod:`pamdp.experiments.plots`),
+and for runs on the benchmark suite's domains their table beside HyAR's (:mod:`pamdp.experiments.suite`)."""
+
+from __future__ import annotations
+
+import csv
+import os
+from pathlib import Path
+
+import numpy as np
+
+from pamdp.experiments.plots import EXTRA_FIGURES, aggregate, find_groups, plot_curves, results_table
+from pamdp.experiments.suite import plot_domains, suite_table
+
+__all__ = ["write_report"]
+
+
+def write_report(
+    roots: list[str | os.PathLike], out: str | os.PathLike, title: str = "", x: str = "auto"
+) -> dict[str, Path]:
+    """Curves (PNG, SVG), the per-epoch aggregate (CSV) and the results table (markdown) into ``out``.
+
+    ``x``: the curves' x axis, as in :func:`plot_curves`.
+
+    Runs that logged greedy evaluations during training (``eval_every``) also get ``greedy.png`` and
+    ``greedy.svg``: the mean +- std across seeds of those evaluations, at the epochs where they were made. Runs on
+    an env that reports episode outcomes (``info["is_success"]``) get ``success_rate.png`` and ``.svg``: the
+    training success rate per epoch (epochs logged before a run recorded it are left out), and with
+    ``eval_every`` ``greedy_success_rate.png`` and ``.svg``, that of the greedy evaluations. Runs on the benchmark
+    suite's domains also get ``suite.md``, their table beside HyAR's published one, and a figure per domain
+    (:mod:`pamdp.experiments.suite`).
+    """
+    groups = find_groups(roots)
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    png, svg = plot_curves(groups, out / "curves", title, x=x)
+    extra = {}
+    for name, metric, (png_key, svg_key) in EXTRA_FIGURES:
+        logged = {label: runs for label, runs in groups.items() if np.isfinite(aggregate(runs, metric)["mean"]).any()}
+        if logged:
+            extra[png_key], extra[svg_key] = plot_curves(logged, out / name, title, metric, x)
+    csv_path = out / "curves.csv"
+    with open(csv_path, "w", newline="") as f:
+        writer = csv.writer(f)
+        writer.writerow(["setting", "epoch", "timesteps", "mean_return", "std_return", "seeds"])
+        for label, runs in groups.items():
+            agg = aggregate(runs)
+            for i in range(len(agg["epoch"])):
+                writer.writerow(
+                    [
+                        label,
+                        int(agg["epoch"][i]),
+                        int(agg["steps"][i]),
+                        agg["mean"][i],
+                        agg["std"][i],
+                        int(agg["seeds"][i]),
+                    ]
+                )
+    table = out / "results.md"
+    table.write_text(results_table(groups) + "\n")
+    suite = suite_table(groups)
+    if suite:  # runs on the benchmark suite's domains: their table beside HyAR's, and a figure per domain
+        (out / "suite.md").write_text(suite + "\n")
+        extra["suite"] = out / "suite.md"
+        extra.update({f"{p.stem}_{p.suffix[1:]}": p for p in plot_domains(groups, out)})
+    return {"png": png, "svg": svg, "csv": csv_path, "table": table, **extra}
