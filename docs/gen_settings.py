@@ -4,7 +4,9 @@ Each table sits between two marker comments, ``<!-- settings:NAME start -->`` an
 ``<!-- settings:NAME end -->``, where ``NAME`` is a config class below; everything between the markers is
 replaced. A row per ``dataclasses.fields(Config)``: the name, the type, the default, the value in each
 preset that differs from the default (blank where it does not), the field's ``metadata["help"]`` and the values
-its check accepts (``Config.check_of(name)``).
+its check accepts (``Config.check_of(name)``). Between ``<!-- domain-presets start -->`` and
+``<!-- domain-presets end -->``: the presets chosen by the env (``pamdp.algos.domain_presets.DOMAIN_PRESETS``),
+each override with its source.
 
     python docs/gen_settings.py            # rewrite docs/algorithms.md in place
     python docs/gen_settings.py --check    # exit 1 if the tables are out of date (for CI)
@@ -20,12 +22,14 @@ import typing
 from pathlib import Path
 
 from pamdp.algos import ALGORITHMS, algorithm_class
+from pamdp.algos.domain_presets import DOMAIN_PRESETS
 
 UNCONSTRAINED = {bool: "True or False", int: "any integer", float: "any finite number"}
 # every registered algorithm's config, so that a new algorithm's table is asked for (its markers) and written
 CONFIGS = {c.__name__: c for c in (algorithm_class(name).config_class for name in ALGORITHMS)}
 DOC = Path(__file__).with_name("algorithms.md")
 BLOCK = re.compile(r"(<!-- settings:(\w+) start -->\n)(.*?)(<!-- settings:\2 end -->)", re.DOTALL)
+DOMAIN_BLOCK = re.compile(r"(<!-- domain-presets start -->\n)(.*?)(<!-- domain-presets end -->)", re.DOTALL)
 
 
 def _value(v) -> str:
@@ -69,6 +73,20 @@ def table(config_class) -> str:
     return "\n".join(lines) + "\n"
 
 
+def domain_table() -> str:
+    """The markdown table of the presets chosen by the env."""
+    lines = [
+        "| algorithm | env | preset | over | settings (source) | note |",
+        "|---|---|---|---|---|---|",
+    ]
+    for (algo, env_id), p in DOMAIN_PRESETS.items():
+        over = "" if p.base == p.name else f"`{p.base}`"
+        settings = "; ".join(f"`{n} = {_value(v)}` ({src})" for n, v, src in p.overrides) or "the preset as it is"
+        note = p.note.replace("|", "\\|")
+        lines.append(f"| `{algo}` | `{env_id}` | `{p.name}` | {over} | {settings} | {note} |")
+    return "\n".join(lines) + "\n"
+
+
 def render(text: str) -> str:
     def replace(m: re.Match) -> str:
         name = m.group(2)
@@ -76,7 +94,8 @@ def render(text: str) -> str:
             raise SystemExit(f"unknown config {name!r} in a settings marker; expected one of {', '.join(CONFIGS)}")
         return m.group(1) + table(CONFIGS[name]) + m.group(4)
 
-    return BLOCK.sub(replace, text)
+    text = BLOCK.sub(replace, text)
+    return DOMAIN_BLOCK.sub(lambda m: m.group(1) + domain_table() + m.group(3), text)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -85,7 +104,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     text = DOC.read_text()
     found = {m.group(2) for m in BLOCK.finditer(text)}
-    missing = sorted(set(CONFIGS) - found)
+    missing = sorted(set(CONFIGS) - found) + ([] if DOMAIN_BLOCK.search(text) else ["domain-presets"])
     if missing:
         print(f"{DOC}: no settings markers for {', '.join(missing)}", file=sys.stderr)
         return 1
