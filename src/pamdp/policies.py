@@ -123,7 +123,7 @@ class HybridPolicy(nn.Module):
         self.pi_d = mlp(self.obs_dim, hidden_sizes, self.n_actions, activation)
         self.pi_c = mlp(self.obs_dim + self.n_actions, hidden_sizes, self.param_size, activation, nn.Tanh)
         self.log_std = nn.Parameter(torch.full((self.n_actions, self.param_size), float(init_log_std)))
-        self.register_buffer("mask", torch.as_tensor(action_space.param_mask))
+        self.register_buffer("mask", torch.tensor(action_space.param_mask))
         # Small final layers start both policies near uniform / centred, as rllab and Spinning Up do.
         for head in (self.pi_d[-1], self.pi_c[-2]):
             nn.init.uniform_(head.weight, -3e-3, 3e-3)
