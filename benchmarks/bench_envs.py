@@ -57,7 +57,8 @@ def measure(env_id: str, kwargs: dict, num_envs: int, repeats: int, scalar_steps
     scalar = gymnasium.make(env_id, **kwargs)
     scalar.reset(seed=0)
     scalar.action_space.seed(0)
-    actions = [scalar.action_space.sample() for _ in range(1000)]
+    k = scalar.action_space[0].n  # a sample draws every action's box: fewer distinct actions where K is large
+    actions = [scalar.action_space.sample() for _ in range(max(20, min(1000, 20_000 // k)))]
     batched = gymnasium.make_vec(env_id, num_envs=num_envs, vectorization_mode="vector_entry_point", **kwargs)
     batched.reset(seed=0)
     batched.action_space.seed(0)
