@@ -217,7 +217,7 @@ class ActionRepresentation(nn.Module):
         self.act = ACTIVATIONS[activation]()
         self.param_head = nn.Linear(hidden_sizes[-1], self.param_size)
         self.dynamics_head = mlp(hidden_sizes[-1], hidden_sizes[-1:], obs_dim, activation)
-        self.register_buffer("mask", torch.as_tensor(hybrid.param_mask, dtype=torch.float32))
+        self.register_buffer("mask", torch.tensor(hybrid.param_mask, dtype=torch.float32))
 
     def encode(self, obs: torch.Tensor, a: torch.Tensor, x: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
         """Mean and log-std of ``q(z | x, s, e_a)``."""

@@ -210,7 +210,7 @@ class GumbelHybridPolicy(nn.Module):
         self.pi_d = mlp(obs_dim, hidden_sizes, self.n_actions, activation)
         self.pi_c = mlp(obs_dim + self.n_actions, hidden_sizes, self.param_size, activation)
         self.log_std = nn.Parameter(torch.full((self.n_actions, self.param_size), float(init_log_std)))
-        self.register_buffer("mask", torch.as_tensor(hybrid.param_mask, dtype=torch.float32))
+        self.register_buffer("mask", torch.tensor(hybrid.param_mask, dtype=torch.float32))
         # Small final layers start pi_d near uniform and pi_c near the centre of the parameter box.
         for head in (self.pi_d[-1], self.pi_c[-1]):
             nn.init.uniform_(head.weight, -3e-3, 3e-3)
