@@ -1,0 +1,131 @@
+"""Every algorithm on Half Field Offense 1v0 (hfo_learning.toml, issue 27): greedy goal rate and steps to goal.
+
+    nice python benchmarks/bench_hfo_learning.py [--runs "PATRPO tuned,MP-DQN"] [--seeds 0,1,2] [--workers 2]
+        [--out DIR] [--record-only]
+
+Runs the chosen arms (default: every arm of the file) seed by seed, each resuming from its checkpoint, and after
+every finished run rewrites benchmarks/hfo_learning.md: per arm, each finished seed's greedy goal rate and mean
+steps to goal over 1000 episodes, their medians over seeds (the issue's measure), the cost per sample, and the
+figures of the greedy goal rate during training. ``--record-only`` trains nothing: it writes the record from the
+runs already under DIR (``pamdp reproduce benchmarks/hfo_learning.toml --out DIR`` makes the same runs).
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import datetime as dt
+import json
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+from _record import HERE, machine, write_record
+
+from pamdp.algos.logger import success_of
+from pamdp.experiments import load_experiment
+from pamdp.experiments.report import write_report
+from pamdp.experiments.runner import is_finished, run_all
+from pamdp.experiments.status import epoch_seconds
+
+RECORD = HERE / "hfo_learning.md"
+
+
+def _rows(run: Path) -> list[dict]:
+    if not (run / "progress.csv").exists():
+        return []
+    with open(run / "progress.csv", newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def _arm_row(label: str, jobs) -> str:
+    """One line of the table: the finished seeds' goal rates and steps, their medians, the cost per sample, and
+    where the unfinished seeds stand."""
+    done, costs, partial = [], [], []
+    for spec, out in jobs:
+        rows = _rows(out)
+        if is_finished(out, spec):
+            rate, steps = success_of(json.loads((out / "evaluation.json").read_text()))
+            done.append((spec.seed, rate, steps))
+            costs.append(sum(epoch_seconds(r) for r in rows) / float(rows[-1]["time/total_timesteps"]) * 1e3)
+        elif rows:
+            evals = [r for r in rows if r.get("eval/success_rate")]
+            last = f", greedy {float(evals[-1]['eval/success_rate']):.2f} (100 episodes)" if evals else ""
+            partial.append(f"seed {spec.seed} at {int(float(rows[-1]['time/total_timesteps'])):,}{last}")
+    per_seed = ", ".join(f"{s}: {r:.3f} in {n:.1f}" if n else f"{s}: {r:.3f}" for s, r, n in done)
+    rates = [r for _, r, _ in done]
+    steps = [n for _, _, n in done if n]
+    return (
+        f"| {label} | {jobs[0][0].total_steps:,} | {len(done)} of {len(jobs)} | {per_seed or '-'} "
+        f"| {f'{np.median(rates):.3f}' if rates else '-'} | {f'{np.median(steps):.1f}' if steps else '-'} "
+        f"| {f'{np.median(costs):.2f}' if costs else '-'} | {'; '.join(partial) or '-'} |"
+    )
+
+
+def write(exp, arms: dict, out_root: str, command: str) -> None:
+    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, cwd=HERE)
+    lines = [
+        f"# {exp.description}",
+        "",
+        f"- command: `{command}` (commit {commit.stdout.strip()})",
+        f"- date: {dt.datetime.now().isoformat(timespec='minutes')} (rewritten after every finished run)",
+        f"- machine: {machine()}",
+        "- each arm with the preset its `--env` picks unless named, `action_mask = true` unless the label says "
+        "\"no mask\" ([hfo_learning.toml](hfo_learning.toml)); goal rate and steps to goal: 1000 greedy episodes "
+        "of each seed's final model",
+        "",
+        "| arm | samples | seeds done | goal rate in steps, per seed | median goal rate | median steps to goal "
+        "| CPU ms per sample | unfinished |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    lines += [_arm_row(label, jobs) for label, jobs in arms.items()]
+    lines += [
+        "",
+        "CPU ms per sample: the run's CPU time in training (its greedy evaluations left out) over its samples, "
+        "median over the finished seeds. Unfinished: each started seed's samples so far and its last greedy "
+        "evaluation.",
+    ]
+    started = [out.parent for jobs in arms.values() for _, out in jobs if _rows(out)]
+    if started:
+        report = write_report(list(dict.fromkeys(started)), Path(out_root) / exp.name / "report-hfo_learning")
+        for key, name in (("greedy_success_png", "greedy goal rate"), ("success_png", "training goal rate")):
+            if key in report:
+                figure = HERE / "results" / f"hfo_learning_{key.removesuffix('_png')}.png"
+                figure.parent.mkdir(exist_ok=True)
+                shutil.copy(report[key], figure)
+                lines += ["", f"![{name}](results/{figure.name})"]
+        lines += [
+            "",
+            "Greedy goal rate: 100 greedy episodes every `eval_every` epochs, mean +- std over seeds. Training goal "
+            "rate: the share of each epoch's (stochastic, exploring) episodes that scored.",
+        ]
+    write_record(lines, RECORD)
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--runs", default=None, help="comma-separated arm labels (default: all)")
+    p.add_argument("--seeds", default=None)
+    p.add_argument("--workers", type=int, default=1)
+    p.add_argument("--out", default="results/bench")
+    p.add_argument("--record-only", action="store_true", help="train nothing, write the record")
+    a = p.parse_args()
+    exp = load_experiment(HERE / "hfo_learning.toml")
+    seeds = [int(s) for s in a.seeds.split(",")] if a.seeds else list(exp.seeds)
+    labels = a.runs.split(",") if a.runs else [r.label for r in exp.runs]
+    arms = {label: [(s, exp.run_dir(a.out, s)) for s in exp.specs(seeds, labels=[label])] for label in labels}
+    command = "python " + " ".join(sys.argv)
+    write(exp, arms, a.out, command)
+    if a.record_only:
+        return
+    for i in range(len(seeds)):  # seed by seed across the arms, so that a cut-short invocation compares them
+        todo = [arms[label][i] for label in labels if not is_finished(arms[label][i][1], arms[label][i][0])]
+        if todo:
+            run_all([(spec, str(out)) for spec, out in todo], workers=a.workers)
+            write(exp, arms, a.out, command)
+
+
+if __name__ == "__main__":
+    main()
