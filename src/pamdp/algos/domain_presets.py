@@ -21,7 +21,7 @@ from __future__ import annotations
 import dataclasses
 from typing import Any
 
-__all__ = ["DomainPreset", "DOMAIN_PRESETS", "domain_preset", "domain_presets_of"]
+__all__ = ["DomainPreset", "DOMAIN_PRESETS", "MASSON_GOAL_START", "domain_preset", "domain_presets_of"]
 
 HFO = "pamdp/HalfFieldOffense-v0"
 MPDQN_HFO = "MP-DQN's HFO script"
@@ -111,10 +111,32 @@ def _mpdqn_hybrid(name: str, note: str, *more: tuple[str, Any, str]) -> DomainPr
     )
 
 
+def _linear_map(n_obs: int, rows: tuple[tuple[float, dict[int, float]], ...]) -> tuple[float, ...]:
+    """A :attr:`~pamdp.algos.pdqn.PDQNConfig.param_passthrough` value from one ``(bias, {feature: weight})`` per
+    parameter: each row the ``n_obs`` weights, then the bias."""
+    return tuple(v for bias, weights in rows for v in (*(weights.get(i, 0.0) for i in range(n_obs)), bias))
+
+
+# Masson's hand-set start, in [-1, 1] units of pamdp's Goal observation (features 10, 11: the ball's x, y; 14, 15:
+# the unit vector from the keeper to the ball) and parameters (kick-to x, y; shoot-left y; shoot-right y), as MP-DQN's
+# Goal script sets its passthrough layer (``initialise_params``, with ``scale_actions``). In metres it is Masson's
+# kick to x = Bx + 2.5 + 1.25 f14, y = (5/6) By + (5/3) f15 (the port reads only x: it kicks towards (x, x)),
+# and shots 1 m inside either post, y = +-6.01.
+MASSON_GOAL_START = _linear_map(
+    17,
+    (
+        (-0.375, {10: 0.5, 14: 0.0625}),
+        (0.0, {11: 5 / 6, 15: 1 / 9}),
+        (6.01 / 7.01, {}),
+        (-6.01 / 7.01, {}),
+    ),
+)
+
 GOAL_NOTE = (
-    "Masson's hand-set initial parameter weights (MP-DQN's Goal runs start from them) are not used: the "
-    "parameter network starts at random, the start later work reports MP-DQN failing from. Not reproduced: the "
-    "script's reward scale 1/50 and its output layers initialised with std 1e-5."
+    "The parameter network starts from Masson's hand-set linear weights, as MP-DQN's Goal runs did "
+    "(param_passthrough: their fixed passthrough layer; a config file's param_passthrough = [] starts it at "
+    "random, the start later work reports MP-DQN failing from). Not reproduced: the script's reward scale 1/50 "
+    "and the std 1e-5 of its output layers (the Q-network's is pamdp's default, the actor's starts at zero)."
 )
 
 DOMAIN_PRESETS: dict[tuple[str, str], DomainPreset] = {
@@ -148,6 +170,7 @@ DOMAIN_PRESETS: dict[tuple[str, str], DomainPreset] = {
         ("buffer_size", 20_000, MPDQN_GOAL),
         ("learning_starts", 128, MPDQN_GOAL),
         ("grad_clip", 1.0, MPDQN_GOAL),
+        ("param_passthrough", MASSON_GOAL_START, f"{MPDQN_GOAL}: Masson's initial weights"),
     ),
     ("pdqn", "pamdp/HardGoal-v0"): _mpdqn_hybrid(
         "hard_goal", "MP-DQN's Goal settings do not apply (ten actions); the tuned preset with multi-pass."

@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import math
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -53,7 +54,17 @@ from pamdp.algos.offpolicy import (
     uniform_actions,
 )
 from pamdp.algos.replay import ReplayBuffer, transition_fields
-from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, at_least, interval, one_of, setting
+from pamdp.algos.settings import (
+    LAYERS,
+    NON_NEGATIVE,
+    POSITIVE,
+    AlgoConfig,
+    Check,
+    at_least,
+    interval,
+    one_of,
+    setting,
+)
 from pamdp.distributions import masked_logits
 from pamdp.policies import ACTIVATIONS, mlp
 from pamdp.spaces import HybridActionSpace
@@ -81,6 +92,18 @@ class PDQNConfig(OffPolicyConfig, AlgoConfig):
         "invert",
         "Keeping parameters in [-1, 1]: invert (inverting gradients, Bester et al.), squash (Tanh) or zero.",
         one_of(BOUNDS),
+    )
+    param_passthrough: tuple[float, ...] = setting(
+        (),
+        "A fixed linear start of the parameters (Bester et al.'s passthrough layer, how their Goal runs start from "
+        "Masson's hand-set weights): a map from the observation to every action's parameters, in [-1, 1] units, "
+        "added to the actor's output and never trained. One row per parameter of the all-actions vector, each the "
+        "observation's weights then a bias, flattened row by row; with it the actor's output layer starts at zero, "
+        "so the first policy is the map. Empty: none. Needs bound invert or zero.",
+        Check(
+            lambda v: not v or (len(v) >= 2 and all(math.isfinite(x) for x in v)),
+            "none, or finite numbers in rows of the observation's weights and a bias",
+        ),
     )
     q_lr: float = setting(1e-3, "Adam learning rate of the Q-network (Bester et al.: 1e-3).", POSITIVE)
     actor_lr: float = setting(
@@ -130,6 +153,16 @@ class PDQNConfig(OffPolicyConfig, AlgoConfig):
         500, "Samples in the replay buffer before the first update (assumed: 500).", at_least(0)
     )
 
+    def __post_init__(self):
+        super().__post_init__()
+        # The map is added to an unbounded output, as the original's (which has no Tanh version): a Tanh before it
+        # would no longer keep the parameters in [-1, 1].
+        if self.param_passthrough and self.bound == "squash":
+            raise ValueError(
+                "PDQNConfig.param_passthrough is set with bound = 'squash'; expected bound 'invert' or 'zero', "
+                "or no passthrough"
+            )
+
     @classmethod
     def presets(cls) -> dict[str, Self]:
         # "paper": Bester et al.'s text as recalled here (not re-read; never their code); grad_clip, learning_starts,
@@ -161,20 +194,49 @@ def param_blocks(hybrid: HybridActionSpace) -> np.ndarray:
 
 
 class ParamActor(nn.Module):
-    """``x(s)``: every action's parameters, concatenated (``sum_a m_a`` outputs; Tanh with ``squash``)."""
+    """``x(s)``: every action's parameters, concatenated (``sum_a m_a`` outputs; Tanh with ``squash``).
 
-    def __init__(self, obs_dim: int, hybrid: HybridActionSpace, hidden_sizes, activation: str, squash: bool):
+    With ``passthrough`` (:attr:`PDQNConfig.param_passthrough`), ``x(s) = net(s) + W s + b`` with ``W`` and ``b``
+    fixed buffers, and ``net``'s output layer starts at zero, so the first ``x`` is the linear map: Bester et al.'s
+    passthrough layer (their ``ParamActor``), whose output layer their Goal script draws with a tiny std instead.
+    """
+
+    def __init__(
+        self,
+        obs_dim: int,
+        hybrid: HybridActionSpace,
+        hidden_sizes,
+        activation: str,
+        squash: bool,
+        passthrough: tuple[float, ...] = (),
+    ):
         super().__init__()
-        self.net = mlp(obs_dim, hidden_sizes, hybrid.total_param_size, activation, nn.Tanh if squash else None)
+        n = hybrid.total_param_size
+        self.net = mlp(obs_dim, hidden_sizes, n, activation, nn.Tanh if squash else None)
+        weight = bias = None
+        if passthrough:
+            if len(passthrough) != n * (obs_dim + 1):
+                raise ValueError(
+                    f"PDQNConfig.param_passthrough has {len(passthrough)} numbers; expected {n * (obs_dim + 1)} for "
+                    f"this env: {n} parameters x ({obs_dim} observation features + 1 bias), row by row"
+                )
+            table = torch.tensor(passthrough, dtype=torch.float32).view(n, obs_dim + 1)
+            weight, bias = table[:, :-1].contiguous(), table[:, -1].contiguous()
+            nn.init.zeros_(self.net[-1].weight)
+            nn.init.zeros_(self.net[-1].bias)
+        self.register_buffer("passthrough_weight", weight)
+        self.register_buffer("passthrough_bias", bias)
         # Where action a's padded parameter i sits in the flat vector: offset_a + i (0 where unused).
         offsets = hybrid.param_offsets
         mask = hybrid.param_mask
         index = np.where(mask, offsets[:, None] + np.arange(hybrid.max_param_size), 0)
         self.register_buffer("param_index", torch.as_tensor(index, dtype=torch.long))
-        self.register_buffer("param_mask", torch.as_tensor(mask, dtype=torch.float32))
+        self.register_buffer("param_mask", torch.tensor(mask, dtype=torch.float32))
 
     def forward(self, obs: torch.Tensor) -> torch.Tensor:
-        return self.net(obs)
+        if self.passthrough_weight is None:
+            return self.net(obs)
+        return self.net(obs) + F.linear(obs, self.passthrough_weight, self.passthrough_bias)
 
     def select(self, params: torch.Tensor, a: torch.Tensor) -> torch.Tensor:
         """Action ``a``'s parameters out of the flat vectors ``params``, padded with zeros to ``m = max_a m_a``."""
@@ -212,7 +274,9 @@ class PDQN(Algorithm):
 
     def _build(self) -> None:
         cfg, h = self.config, self.hybrid
-        self.actor = ParamActor(self.obs_dim, h, cfg.hidden_sizes, cfg.activation, squash=cfg.bound == "squash")
+        self.actor = ParamActor(
+            self.obs_dim, h, cfg.hidden_sizes, cfg.activation, cfg.bound == "squash", cfg.param_passthrough
+        )
         self.q_net = QNetwork(self.obs_dim, h, cfg.hidden_sizes, cfg.activation, cfg.multi_pass)
         self.actor_target = copy.deepcopy(self.actor).requires_grad_(False)
         self.q_target = copy.deepcopy(self.q_net).requires_grad_(False)
