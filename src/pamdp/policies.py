@@ -17,7 +17,7 @@ from torch import nn
 from pamdp.distributions import HybridDistribution, masked_logits
 from pamdp.spaces import HybridActionSpace
 
-__all__ = ["ACTIVATIONS", "mlp", "LinearizedMLP", "HybridPolicy", "ValueNetwork"]
+__all__ = ["ACTIVATIONS", "mlp", "every_action_linear", "LinearizedMLP", "HybridPolicy", "ValueNetwork"]
 
 ACTIVATIONS = {"relu": nn.ReLU, "tanh": nn.Tanh, "leaky_relu": nn.LeakyReLU, "elu": nn.ELU}
 
@@ -40,6 +40,23 @@ def mlp(
     if output_activation is not None:
         layers.append(output_activation())
     return nn.Sequential(*layers)
+
+
+def every_action_linear(
+    obs: torch.Tensor, weight: torch.Tensor, bias: torch.Tensor | None, a: torch.Tensor | None = None
+) -> torch.Tensor:
+    """``F.linear(cat([obs, onehot(k)]), weight, bias)`` for every action ``k``: ``(B, K, out)``; given actions
+    ``a`` ``(B,)``, for ``k = a`` only: ``(B, out)``.
+
+    The one-hot part of the input selects column ``k`` of the weight's last ``K`` columns, so the ``B * K``
+    inputs of width ``d + K`` are never built: one ``(B, out)`` product for the state plus a broadcast add,
+    ``K`` times cheaper than the product over the one-hots. Linear in ``(weight, bias)``, so the same function
+    maps parameter tangents (:class:`LinearizedMLP`'s ``first``).
+    """
+    d = obs.shape[-1]
+    state = F.linear(obs, weight[:, :d], bias)
+    columns = weight[:, d:].T
+    return state.unsqueeze(-2) + columns if a is None else state + columns[a]
 
 
 def _activation_slope(module: nn.Module, pre: torch.Tensor, out: torch.Tensor) -> torch.Tensor:
@@ -66,15 +83,22 @@ class LinearizedMLP:
     Args:
         net: a ``Sequential`` of ``Linear`` layers and elementwise activations (what :func:`mlp` builds).
         inputs: the network's input, which does not depend on its parameters.
+        first: ``(weight, bias) -> pre-activation`` of the first layer, to use in place of
+            ``F.linear(inputs, weight, bias)`` (the same linear map, computed another way, e.g. by
+            :func:`every_action_linear`); ``inputs`` is then unused.
     """
 
-    def __init__(self, net: nn.Sequential, inputs: torch.Tensor):
-        self.steps: list[tuple[nn.Linear, torch.Tensor] | torch.Tensor] = []  # (layer, its input) or a slope
+    def __init__(self, net: nn.Sequential, inputs: torch.Tensor | None, first: Callable | None = None):
+        self.steps: list[tuple[nn.Linear, torch.Tensor | None] | torch.Tensor] = []  # (layer, input) or a slope
+        self.first = first
         h = inputs
-        for module in net:
-            out = module(h)
+        for i, module in enumerate(net):
+            if i == 0 and first is not None:
+                out, h = first(module.weight, module.bias), None
+            else:
+                out = module(h)
             if isinstance(module, nn.Linear):
-                self.steps.append((module, h.detach()))
+                self.steps.append((module, None if h is None else h.detach()))
             else:
                 self.steps.append(_activation_slope(module, h.detach(), out.detach()))
             h = out
@@ -90,7 +114,7 @@ class LinearizedMLP:
                     layer, h = step
                     d_weight = next(tangents)
                     d_bias = next(tangents) if layer.bias is not None else None
-                    dz = F.linear(h, d_weight, d_bias)
+                    dz = self.first(d_weight, d_bias) if h is None else F.linear(h, d_weight, d_bias)
                     dh = dz if dh is None else dz + F.linear(dh, layer.weight)
                 else:
                     dh = step * dh
@@ -133,17 +157,38 @@ class HybridPolicy(nn.Module):
         """``pi_c``'s mean for the (batched) one-hot actions ``onehot`` (any leading shape)."""
         return self.pi_c(torch.cat([obs, onehot], dim=-1))
 
-    def _every_action(self, obs: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
-        """``obs`` ``(B, obs_dim)`` repeated for each action, ``(B, K, obs_dim)``, beside the one-hots ``(B, K, K)``."""
-        batch = obs.shape[0]
-        eye = torch.eye(self.n_actions, dtype=obs.dtype, device=obs.device)
-        return obs.unsqueeze(1).expand(batch, self.n_actions, self.obs_dim), eye.expand(batch, -1, -1)
+    def every_param_mean(self, obs: torch.Tensor) -> torch.Tensor:
+        """``pi_c``'s means for every action at ``obs`` ``(B, obs_dim)``: ``(B, K, m)``, ``param_means`` of every
+        one-hot in one pass (its first layer by :func:`every_action_linear`)."""
+        first = self.pi_c[0]
+        return self.pi_c[1:](every_action_linear(obs, first.weight, first.bias))
 
     def forward(self, obs: torch.Tensor, action_mask: torch.Tensor | None = None) -> HybridDistribution:
         """The distribution at ``obs`` ``(B, obs_dim)``, with ``pi_c`` evaluated for every action in one pass;
         ``action_mask`` (bool ``(B, K)``, True = allowed) restricts ``pi_d`` to the allowed actions."""
-        means = self.param_means(*self._every_action(obs))
+        means = self.every_param_mean(obs)
         return HybridDistribution(masked_logits(self.pi_d(obs), action_mask), means, self.log_std, self.mask)
+
+    def act(
+        self,
+        obs: torch.Tensor,
+        action_mask: torch.Tensor | None = None,
+        deterministic: bool = False,
+        generator: torch.Generator | None = None,
+    ) -> tuple[torch.Tensor, torch.Tensor]:
+        """``forward(obs, action_mask)``'s ``mode()`` or ``sample(generator)`` (the same draws), with ``pi_c`` run for
+        the chosen action only: acting needs no other action's mean."""
+        logits = masked_logits(self.pi_d(obs), action_mask)
+        if deterministic:
+            a = logits.argmax(dim=-1)
+        else:
+            a = torch.multinomial(F.softmax(logits, dim=-1), 1, generator=generator).squeeze(-1)
+        first = self.pi_c[0]
+        mu = self.pi_c[1:](every_action_linear(obs, first.weight, first.bias, a))
+        if not deterministic:
+            noise = torch.randn(mu.shape, generator=generator, dtype=mu.dtype, device=mu.device)
+            mu = mu + self.log_std[a].exp() * noise
+        return a, mu * self.mask[a]
 
     def linearize(
         self, obs: torch.Tensor
@@ -156,7 +201,7 @@ class HybridPolicy(nn.Module):
         Fisher-vector product needs no mask beyond the old distribution's.
         """
         lin_d = LinearizedMLP(self.pi_d, obs)
-        lin_c = LinearizedMLP(self.pi_c, torch.cat(self._every_action(obs), dim=-1))
+        lin_c = LinearizedMLP(self.pi_c, None, lambda weight, bias: every_action_linear(obs, weight, bias))
         names_d = [f"pi_d.{n}" for n, _ in self.pi_d.named_parameters()]
         names_c = [f"pi_c.{n}" for n, _ in self.pi_c.named_parameters()]
 

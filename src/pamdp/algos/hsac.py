@@ -57,7 +57,7 @@ from pamdp.algos.offpolicy import (
 from pamdp.algos.replay import ReplayBuffer, transition_fields
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
 from pamdp.distributions import MASKED, masked_logits
-from pamdp.policies import ACTIVATIONS, mlp
+from pamdp.policies import ACTIVATIONS, every_action_linear, mlp
 from pamdp.spaces import HybridActionSpace
 
 if TYPE_CHECKING:
@@ -236,10 +236,9 @@ class HybridSACActor(nn.Module):
             logits, means, log_stds = self.net(obs).split([self.n_actions, self.total, self.total], dim=-1)
             mean, log_std = self._padded(means), self._padded(log_stds)
         else:
-            batch = obs.shape[0]
-            eye = torch.eye(self.n_actions, dtype=obs.dtype, device=obs.device).expand(batch, -1, -1)
-            every = torch.cat([obs.unsqueeze(1).expand(batch, self.n_actions, obs.shape[-1]), eye], dim=-1)
-            mean, log_std = self.pi_c(every).split(self.m, dim=-1)
+            first = self.pi_c[0]  # pi_c of every one-hot, without building the B * K inputs
+            every = self.pi_c[1:](every_action_linear(obs, first.weight, first.bias))
+            mean, log_std = every.split(self.m, dim=-1)
             logits = self.pi_d(obs)
         log_std = log_std.clamp(LOG_STD_MIN, LOG_STD_MAX)
         return SquashedHybrid(masked_logits(logits, mask), mean, log_std, self.param_mask)

@@ -102,8 +102,8 @@ class Rollout:
         while n_valid < n_samples:
             with torch.no_grad():
                 mask = None if masks is None else torch.from_numpy(masks).to(device)
-                dist = policy(torch.as_tensor(np.asarray(obs, dtype=np.float32), device=device), mask)
-                a, x = dist.sample(torch_gen)
+                obs_t = torch.as_tensor(np.asarray(obs, dtype=np.float32), device=device)
+                a, x = policy.act(obs_t, mask, False, torch_gen)
             a, x = a.cpu().numpy(), x.cpu().numpy()
             next_obs, reward, terminated, truncated, info = env.step(hybrid.to_env_batch(a, x))
             valid = ~prev_done

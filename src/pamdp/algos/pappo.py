@@ -180,8 +180,7 @@ class PAPPO(Algorithm):
         return {"adam": self.optimizer}
 
     def _act(self, obs, deterministic, mask=None):
-        dist = self.policy(obs, mask)
-        return dist.mode() if deterministic else dist.sample(self.torch_gen)
+        return self.policy.act(obs, mask, deterministic, self.torch_gen)
 
     def _values(self, obs: np.ndarray, t: np.ndarray) -> np.ndarray:
         return network_values(self.value, obs)

@@ -50,7 +50,7 @@ from pamdp.algos.offpolicy import (
 from pamdp.algos.replay import ReplayBuffer, transition_fields
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
 from pamdp.distributions import masked_logits
-from pamdp.policies import ACTIVATIONS, mlp
+from pamdp.policies import ACTIVATIONS, every_action_linear, mlp
 from pamdp.spaces import HybridActionSpace
 
 if TYPE_CHECKING:
@@ -247,10 +247,11 @@ class GumbelHybridPolicy(nn.Module):
         ``critic(obs_k, onehots, x)`` is ``Q(s, k, x_k)`` for every ``k`` in one batched pass.
         """
         batch, K = len(obs), self.n_actions
-        index = torch.arange(K, device=obs.device).expand(batch, K)
         onehots = torch.eye(K, dtype=obs.dtype, device=obs.device).expand(batch, K, K)
         obs_k = obs.unsqueeze(-2).expand(batch, K, obs.shape[-1])
-        return obs_k, onehots, self.params(obs_k, index, onehots, eta_x.unsqueeze(-2))
+        first = self.pi_c[0]  # pi_c of every one-hot without building the B * K inputs (as params would)
+        means = self.pi_c[1:](every_action_linear(obs, first.weight, first.bias))
+        return obs_k, onehots, torch.tanh(means + self.std() * eta_x.unsqueeze(-2)) * self.mask
 
     def forward(
         self,
@@ -288,6 +289,18 @@ def expected_q(
     return logits, (logits.softmax(-1) * q_all).sum(-1)
 
 
+def every_action_q(*critics: Critic) -> Callable:
+    """:func:`expected_q`'s ``critic`` for :class:`Critic` networks: ``Q(s, k, x_k)`` of every ``k`` by
+    :meth:`Critic.every_action` (the states' first copy, the one-hots implied), the smallest of several critics'
+    values (twin critics)."""
+
+    def q_all(obs_k: torch.Tensor, onehots: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
+        values = [critic.every_action(obs_k[:, 0], x) for critic in critics]
+        return values[0] if len(values) == 1 else torch.minimum(*values)
+
+    return q_all
+
+
 class EntropyWeight(nn.Module):
     """The weight ``alpha = exp(log_alpha)`` of ``pi_d``'s entropy, tuned towards a target entropy (SAC's rule).
 
@@ -313,6 +326,13 @@ class Critic(nn.Module):
 
     def forward(self, obs: torch.Tensor, a: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
         return self.net(torch.cat([obs, a, x], dim=-1)).squeeze(-1)
+
+    def every_action(self, obs: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
+        """``Q(s, k, x_k)`` ``(B, K)`` for every action ``k``, its parameters ``x`` ``(B, K, m)``: the first layer's
+        one-hot part by :func:`~pamdp.policies.every_action_linear`, the parameters' by one product."""
+        first, split = self.net[0], obs.shape[-1] + x.shape[-2]
+        pre = every_action_linear(obs, first.weight[:, :split], first.bias) + F.linear(x, first.weight[:, split:])
+        return self.net[1:](pre).squeeze(-1)
 
 
 class PASVG0(Algorithm):
@@ -448,7 +468,8 @@ class PASVG0(Algorithm):
         next_obs, mask = b["next_obs"], b.get("next_mask")
         eta_a, eta_x = self._noise(len(next_obs))
         if cfg.discrete_gradient == "expected":
-            _, q_next = expected_q(self.policy_target, self._target_q, next_obs, eta_x, mask)
+            critics = (self.critic_target,) if self.critic2 is None else (self.critic_target, self.critic2_target)
+            _, q_next = expected_q(self.policy_target, every_action_q(*critics), next_obs, eta_x, mask)
         else:
             _, a_next, x_next = self.policy_target(next_obs, eta_a, eta_x, cfg.temperature, cfg.straight_through, mask)
             q_next = self._target_q(next_obs, a_next, x_next)
@@ -482,7 +503,7 @@ class PASVG0(Algorithm):
         # The recorded noise, pushed through the current policy: a = f(s, eta_a), x = g(s, a, eta_x).
         mask = b.get("mask")
         if cfg.discrete_gradient == "expected":
-            logits, q_pi = expected_q(self.policy, self.critic, obs, b["eta_x"], mask)
+            logits, q_pi = expected_q(self.policy, every_action_q(self.critic), obs, b["eta_x"], mask)
         else:
             logits, _, a, x = self.policy.sample(
                 obs, b["eta_a"], b["eta_x"], cfg.temperature, cfg.straight_through, mask

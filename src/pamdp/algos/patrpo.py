@@ -186,8 +186,7 @@ class PATRPO(Algorithm):
             self.linear_baseline.coef = state["linear_baseline"].numpy()
 
     def _act(self, obs, deterministic, mask=None):
-        dist = self.policy(obs, mask)
-        return dist.mode() if deterministic else dist.sample(self.torch_gen)
+        return self.policy.act(obs, mask, deterministic, self.torch_gen)
 
     # -- one epoch -------------------------------------------------------------------------------
     def _run_epoch(self) -> dict[str, float]:
