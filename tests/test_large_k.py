@@ -8,6 +8,7 @@ import pytest
 import torch
 import torch.nn.functional as F
 
+from pamdp import policies
 from pamdp.algos.pasvg import Critic, GumbelHybridPolicy, every_action_q
 from pamdp.algos.pdqn import QNetwork, param_blocks
 from pamdp.policies import HybridPolicy, every_action_linear
@@ -118,3 +119,15 @@ def test_pasvg_critic_and_parameters_of_every_action_are_the_explicit_ones():
         rtol=1e-12,
         atol=1e-12,
     )
+
+
+def test_passes_without_gradients_in_chunks_of_states_give_the_whole_batchs_values(monkeypatch):
+    policy = randomised(HybridPolicy(D, HYBRID, (8, 8)))
+    q_net = randomised(QNetwork(D, HYBRID, (7, 5), "relu", multi_pass=True))
+    obs, params = (t.detach() for t in inputs((B, D), (B, sum(SIZES))))
+    whole = policy.every_param_mean(obs), q_net(obs, params)  # with gradients: one pass over the batch
+    monkeypatch.setattr(policies, "EVERY_ACTION_ROWS", 2 * K)  # two states a chunk
+    with torch.no_grad():
+        chunked = policy.every_param_mean(obs), q_net(obs, params)
+    for w, c in zip(whole, chunked):
+        torch.testing.assert_close(c, w.detach(), rtol=1e-12, atol=1e-12)

@@ -17,9 +17,21 @@ from torch import nn
 from pamdp.distributions import HybridDistribution, masked_logits
 from pamdp.spaces import HybridActionSpace
 
-__all__ = ["ACTIVATIONS", "mlp", "every_action_linear", "LinearizedMLP", "HybridPolicy", "ValueNetwork"]
+__all__ = [
+    "ACTIVATIONS",
+    "EVERY_ACTION_ROWS",
+    "mlp",
+    "every_action_linear",
+    "in_chunks",
+    "LinearizedMLP",
+    "HybridPolicy",
+    "ValueNetwork",
+]
 
 ACTIVATIONS = {"relu": nn.ReLU, "tanh": nn.Tanh, "leaky_relu": nn.LeakyReLU, "elu": nn.ELU}
+EVERY_ACTION_ROWS = 2**14
+"""(state, action) rows of one chunk of an every-action pass without gradients (:func:`in_chunks`): small enough
+that the allocator reuses its hidden activations' memory instead of mapping (and zeroing) it afresh."""
 
 
 def mlp(
@@ -55,8 +67,18 @@ def every_action_linear(
     """
     d = obs.shape[-1]
     state = F.linear(obs, weight[:, :d], bias)
-    columns = weight[:, d:].T
+    columns = weight[:, d:].T.contiguous()  # else the sum takes the transpose's layout and the next layer copies it
     return state.unsqueeze(-2) + columns if a is None else state + columns[a]
+
+
+def in_chunks(fn: Callable[..., torch.Tensor], n_actions: int, *batches: torch.Tensor) -> torch.Tensor:
+    """``fn(*batches)``, an every-action pass over ``n_actions`` actions per state; without gradients, on chunks
+    of at most :data:`EVERY_ACTION_ROWS` (state, action) rows concatenated (each state's rows are computed alone,
+    so the result is the same)."""
+    step = max(1, EVERY_ACTION_ROWS // n_actions)
+    if torch.is_grad_enabled() or len(batches[0]) <= step:
+        return fn(*batches)
+    return torch.cat([fn(*parts) for parts in zip(*(b.split(step) for b in batches))])
 
 
 def _activation_slope(module: nn.Module, pre: torch.Tensor, out: torch.Tensor) -> torch.Tensor:
@@ -161,7 +183,7 @@ class HybridPolicy(nn.Module):
         """``pi_c``'s means for every action at ``obs`` ``(B, obs_dim)``: ``(B, K, m)``, ``param_means`` of every
         one-hot in one pass (its first layer by :func:`every_action_linear`)."""
         first = self.pi_c[0]
-        return self.pi_c[1:](every_action_linear(obs, first.weight, first.bias))
+        return in_chunks(lambda o: self.pi_c[1:](every_action_linear(o, first.weight, first.bias)), self.n_actions, obs)
 
     def forward(self, obs: torch.Tensor, action_mask: torch.Tensor | None = None) -> HybridDistribution:
         """The distribution at ``obs`` ``(B, obs_dim)``, with ``pi_c`` evaluated for every action in one pass;

@@ -66,7 +66,7 @@ from pamdp.algos.settings import (
     setting,
 )
 from pamdp.distributions import masked_logits
-from pamdp.policies import ACTIVATIONS, mlp
+from pamdp.policies import ACTIVATIONS, in_chunks, mlp
 from pamdp.spaces import HybridActionSpace
 
 if TYPE_CHECKING:
@@ -268,6 +268,9 @@ class QNetwork(nn.Module):
     def forward(self, obs: torch.Tensor, params: torch.Tensor) -> torch.Tensor:
         if not self.multi_pass:
             return self.net(torch.cat([obs, params], dim=-1))
+        return in_chunks(self._passes, self.n_actions, obs, params)
+
+    def _passes(self, obs: torch.Tensor, params: torch.Tensor) -> torch.Tensor:
         first, last, d = self.net[0], self.net[-1], obs.shape[-1]
         w_blocks = first.weight[:, d:][:, self.param_index] * self.param_mask  # (h, K, m): W_k
         pre = F.linear(obs, first.weight[:, :d], first.bias).unsqueeze(1)  # (B, 1, h): W_s s + b
