@@ -131,7 +131,7 @@ class Actor(nn.Module):
         mask = hybrid.param_mask
         index = np.where(mask, hybrid.n_actions + offsets[:, None] + np.arange(hybrid.max_param_size), 0)
         self.register_buffer("param_index", torch.as_tensor(index, dtype=torch.long))
-        self.register_buffer("param_mask", torch.as_tensor(mask, dtype=torch.float32))
+        self.register_buffer("param_mask", torch.tensor(mask, dtype=torch.float32))
 
     def forward(self, obs: torch.Tensor) -> torch.Tensor:
         return self.net(obs)
