@@ -144,8 +144,12 @@ DOMAIN_PRESETS: dict[tuple[str, str], DomainPreset] = {
     ("paddpg", HFO): DomainPreset(
         "hausknecht_stone", "hausknecht_stone", note="Hausknecht & Stone's own HFO agent: their networks and settings."
     ),
-    ("patrpo", HFO): DomainPreset(
-        "tuned", "tuned", note="The best PATRPO measured on HFO (docs/results.md, Soccer); the paper's is 'paper'."
+    ("patrpo", HFO): _derived(
+        "hfo",
+        "tuned",
+        "The tuned preset acting only among the actions that have an effect: KICK is masked while the ball is not "
+        "kickable (benchmarks/hfo_learning.md); the paper's soccer settings are 'paper'.",
+        ("action_mask", True, "measured: benchmarks/hfo_learning.md (issue 27)"),
     ),
     ("pappo", HFO): DomainPreset(
         "default",
