@@ -78,6 +78,8 @@ def measure(algo: str, n: int, repeats: int, src: str | None) -> dict:
         raise SystemExit(f"{algo} n={n} failed:\n{out.stderr[-3000:]}")
     result = json.loads(out.stdout.strip().splitlines()[-1])
     result["wall_s"] = time.time() - t
+    if src is None:  # the current code: which commit, and whether the package had uncommitted changes
+        result["commit"] = git("rev-parse", "--short", "HEAD") + ("+" if git("status", "--porcelain", "src") else "")
     return result
 
 
@@ -97,6 +99,7 @@ def main(argv=None) -> int:
     p.add_argument("--only-baseline", action="store_true", help="measure (and cache) the baseline only")
     p.add_argument("--only-now", action="store_true", help="measure (and cache) the current code only")
     p.add_argument("--reuse", action="store_true", help="take the current code's figures from the cache too")
+    p.add_argument("--record-only", action="store_true", help="measure nothing: write the record from the cache")
     p.add_argument("--worker", nargs=2, metavar=("ALGO", "N"), help=argparse.SUPPRESS)
     a = p.parse_args(argv)
     if a.worker:
@@ -123,6 +126,10 @@ def main(argv=None) -> int:
         src = export_source(ref, tmp) if ref else None
         for algo, n in cases:
             key = f"{algo}:{n}"
+            if a.record_only:
+                if key in cached_now:
+                    after[key] = cached_now[key]
+                continue
             if ref and key not in before and not a.only_now:
                 before[key] = measure(algo, n, a.repeats, src)
                 save()
@@ -142,10 +149,10 @@ def main(argv=None) -> int:
         "# Training cost of a sample on Hard Move at large K, every algorithm",
         "",
         f"- command: `{' '.join(['python', *sys.argv])}`",
-        f"- date: {dt.datetime.now(dt.timezone.utc).isoformat(timespec='minutes')}; "
-        f"code: HEAD {git('rev-parse', '--short', 'HEAD')}"
-        + (" (with any uncommitted changes)" if git("status", "--porcelain", "src") else "")
-        + (f" against {ref}" if ref else ""),
+        f"- date: {dt.datetime.now(dt.timezone.utc).isoformat(timespec='minutes')}; current code measured at "
+        + ", ".join(sorted({v.get("commit", "?") for v in after.values()}))
+        + " (+: with uncommitted changes to src)"
+        + (f", against {ref}" if ref else ""),
         f"- machine: {machine()}",
         f"- CPU ms per training sample, median of {a.repeats} epochs after a warm-up epoch, one worker process per "
         "case and version, torch threads 1; the env's preset with a short schedule (see the script's docstring); "
@@ -156,14 +163,17 @@ def main(argv=None) -> int:
     cols = ["algorithm (preset)"] + [f"n = {n} (K = {2**n})" for n in ns]
     lines += ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
     for algo in algos:
-        row = [f"{algo} ({next((v['preset'] for k, v in after.items() if k.startswith(algo + ':')), '?')})"]
+        measured = [v for k, v in (*before.items(), *after.items()) if k.startswith(algo + ":")]
+        row = [f"{algo} ({measured[0]['preset'] if measured else '?'})"]
         for n in ns:
             key = f"{algo}:{n}"
             if key not in med:
                 row.append("not run")
             elif ref and key in before:
-                b = statistics.median(before[key]["ms_per_sample"])
-                row.append(f"{b:.2f} -> {med[key]:.2f} (x{b / med[key]:.1f})")
+                runs = before[key]["ms_per_sample"]
+                few = f" ({len(runs)} epoch{'s' if len(runs) > 1 else ''})" if len(runs) < a.repeats else ""
+                b = statistics.median(runs)
+                row.append(f"{b:.2f}{few} -> {med[key]:.2f} (x{b / med[key]:.1f})")
             else:
                 row.append(f"{med[key]:.2f}")
         lines.append("| " + " | ".join(row) + " |")
