@@ -42,7 +42,7 @@ def _value(v) -> str:
 
 def _type(hint) -> str:
     if typing.get_origin(hint) is tuple:
-        return "tuple[int, ...]"
+        return "tuple[" + ", ".join(getattr(a, "__name__", "...") for a in typing.get_args(hint)) + "]"
     return getattr(hint, "__name__", str(hint))
 
 
