@@ -80,7 +80,7 @@ def test_a_wrong_shape_or_value_is_refused_clearly():
     for bad in ((0.0, math.nan), (1.0,)):  # a row has at least a weight and a bias
         with pytest.raises(ValueError, match=rf"param_passthrough = \({bad[0]},.*; expected none, or finite numbers"):
             PDQNConfig(param_passthrough=bad)
-    with pytest.raises(ValueError, match=r"setting 'param_passthrough' = \[0.0\]; expected float"):
+    with pytest.raises(ValueError, match=r"setting 'param_passthrough' = \[\[0.0\]\]; expected a list of float"):
         PDQNConfig.from_dict({"param_passthrough": [[0.0]]})
     with pytest.raises(ValueError, match="bound = 'squash'; expected bound 'invert' or 'zero'"):
         goal_config(bound="squash")

@@ -390,7 +390,7 @@ def test_a_log_resumed_from_a_checkpoint_keeps_the_checkpoints_epoch_in_tensorbo
     "text, expected",
     [
         ('delta = "abc"', "setting 'delta' = 'abc'; expected float"),
-        ("hidden_sizes = [64, 32.5]", "setting 'hidden_sizes' = 32.5; expected int"),
+        ("hidden_sizes = [64, 32.5]", "setting 'hidden_sizes' = [64, 32.5]; expected a list of int"),
         ('flush_denormal = "no"', "setting 'flush_denormal' = 'no'; expected bool"),
         ('seed = "abc"', "setting 'seed' = 'abc'; expected int"),
     ],

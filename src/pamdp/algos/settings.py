@@ -188,7 +188,10 @@ def _coerce(name: str, value: Any, hint: Any) -> Any:
         if not isinstance(value, (list, tuple)):
             raise ValueError(f"setting {name!r} = {value!r}; expected a list")
         (item,) = {a for a in typing.get_args(hint) if a is not Ellipsis}
-        return tuple(_coerce(name, v, item) for v in value)
+        try:
+            return tuple(_coerce(name, v, item) for v in value)
+        except ValueError:  # name the whole value, not the one bad element
+            raise ValueError(f"setting {name!r} = {value!r}; expected {type_name(hint)}") from None
     if hint is float and isinstance(value, (int, float)) and not isinstance(value, bool):
         return float(value)
     if not type_ok(value, hint):
