@@ -86,6 +86,23 @@ def write_record(lines: list[str], record: str | os.PathLike | None) -> str:
     return text
 
 
+def seed_by_seed(
+    exp, labels: list[str], seeds: list[int], out_root: str, write, workers: int = 1, train: bool = True
+) -> dict:
+    """Train the arms ``labels`` of experiment ``exp`` seed by seed across the arms, so that a cut-short invocation
+    still compares them, each run resuming from its checkpoint or skipped once finished; ``write(arms)`` rewrites
+    the record before and after each seed's runs (``train=False``: only before). ``arms``: ``{label: [(RunSpec,
+    run dir), ...]}`` in seed order."""
+    arms = {label: [(s, exp.run_dir(out_root, s)) for s in exp.specs(seeds, labels=[label])] for label in labels}
+    write(arms)
+    for i in range(len(seeds) if train else 0):
+        todo = [arms[label][i] for label in labels if not is_finished(arms[label][i][1], arms[label][i][0])]
+        if todo:
+            run_all([(spec, str(out)) for spec, out in todo], workers=workers)
+            write(arms)
+    return arms
+
+
 def run_and_record(
     experiment: str,
     out_root: str,

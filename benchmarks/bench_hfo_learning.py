@@ -22,12 +22,12 @@ import sys
 from pathlib import Path
 
 import numpy as np
-from _record import HERE, machine, write_record
+from _record import HERE, machine, seed_by_seed, write_record
 
 from pamdp.algos.logger import success_of
 from pamdp.experiments import load_experiment
 from pamdp.experiments.report import write_report
-from pamdp.experiments.runner import is_finished, run_all
+from pamdp.experiments.runner import is_finished
 from pamdp.experiments.status import epoch_seconds
 
 RECORD = HERE / "hfo_learning.md"
@@ -114,18 +114,10 @@ def main() -> None:
     a = p.parse_args()
     exp = load_experiment(HERE / "hfo_learning.toml")
     seeds = [int(s) for s in a.seeds.split(",")] if a.seeds else list(exp.seeds)
-    labels = a.runs.split(",") if a.runs else [r.label for r in exp.runs]
-    arms = {label: [(s, exp.run_dir(a.out, s)) for s in exp.specs(seeds, labels=[label])] for label in labels}
+    labels = a.runs.split(",") if a.runs else [r["label"] for r in exp.runs]
     command = "python " + " ".join(sys.argv)
-    write(exp, arms, a.out, command)
-    if a.record_only:
-        return
-    for i in range(len(seeds)):  # seed by seed across the arms, so that a cut-short invocation compares them
-        todo = [arms[label][i] for label in labels if not is_finished(arms[label][i][1], arms[label][i][0])]
-        if todo:
-            run_all([(spec, str(out)) for spec, out in todo], workers=a.workers)
-            write(exp, arms, a.out, command)
-
+    record = lambda arms: write(exp, arms, a.out, command)  # noqa: E731
+    seed_by_seed(exp, labels, seeds, a.out, record, a.workers, train=not a.record_only)
 
 if __name__ == "__main__":
     main()

@@ -3,7 +3,7 @@
     taskset -c 0 python benchmarks/bench_hsac.py [--seeds 0,1,2,3,4] [--forms flat,hierarchical] [--out DIR]
 
 Runs one at a time, seed by seed, the two forms alternating (so that a cut-short invocation still compares the
-forms), and rewrites benchmarks/hsac_platform.md after every run: the greedy return of each finished seed (1000
+forms), and rewrites benchmarks/hsac_platform.md after each seed's runs: the greedy return of each finished seed (1000
 episodes) with the median and mean per form, and the cost per sample (CPU seconds from each run's progress.csv).
 The runs go to DIR/hsac_platform/FORM/seedN (default results/bench) and resume where they stopped, so a rerun
 continues the benchmark; the record keeps its hand-written notes.
@@ -20,10 +20,10 @@ import sys
 from pathlib import Path
 
 import numpy as np
-from _record import HERE, machine, write_record
+from _record import HERE, machine, seed_by_seed, write_record
 
 from pamdp.experiments import load_experiment
-from pamdp.experiments.runner import is_finished, run_all
+from pamdp.experiments.runner import is_finished
 from pamdp.experiments.status import epoch_seconds
 
 RECORD = HERE / "hsac_platform.md"
@@ -90,16 +90,8 @@ def main() -> None:
     exp = load_experiment(HERE / "hsac_platform.toml")
     seeds = [int(s) for s in a.seeds.split(",")] if a.seeds else list(exp.seeds)
     forms = a.forms.split(",")
-    arms = {form: [(s, exp.run_dir(a.out, s)) for s in exp.specs(seeds, labels=[form])] for form in forms}
     command = "python " + " ".join(sys.argv)
-    write(exp, arms, command)
-    for i in range(len(seeds)):  # seed by seed, the forms alternating
-        for form in forms:
-            spec, out = arms[form][i]
-            if not is_finished(out, spec):
-                run_all([(spec, str(out))], workers=1)
-                write(exp, arms, command)
-
+    seed_by_seed(exp, forms, seeds, a.out, lambda arms: write(exp, arms, command))
 
 if __name__ == "__main__":
     main()
