@@ -157,7 +157,7 @@ def test_parameters_stay_in_bounds_and_unused_ones_are_zero():
         torch.randn(500, 4, generator=gen), gumbel_noise((500, 3), gen), torch.randn(500, 2) * 5, 1.0, True
     )
     assert x.abs().max() <= 1.0
-    mask = torch.as_tensor(HYBRID.param_mask)[index]
+    mask = torch.tensor(HYBRID.param_mask)[index]
     assert torch.all(x[~mask] == 0)
 
 
