@@ -43,6 +43,7 @@ __all__ = [
 
 LOCK_FILE = ".lock"
 # What a run directory holds before its first checkpoint: starting it again from step 0 loses nothing.
+_CUT_SHORT = ".cut-short"  # a first epoch's log kept aside when its checkpoint was cut short by a kill
 _BEFORE_FIRST_CHECKPOINT = {"run.json", "progress.csv", "tb", "stdout.log", LOCK_FILE}
 
 
@@ -171,13 +172,24 @@ def _check_fresh_directory(out: Path) -> None:
     if progress.exists():
         with open(progress, newline="") as f:
             epochs = sum(1 for _ in csv.DictReader(f))
-        if epochs:
+        if epochs == 1 and not (out / "evaluation.json").exists():
+            # A kill between the first epoch's log row and its checkpoint: nothing to resume, nothing lost by
+            # starting again; the cut-short log (and its TensorBoard events) are kept beside, renamed.
+            for name in ("progress.csv", "tb"):
+                if (out / name).exists():
+                    os.replace(out / name, out / f"{name}{_CUT_SHORT}")
+            present = sorted(os.listdir(out))
+        elif epochs:
             raise ValueError(
                 f"{out} holds a progress.csv of {epochs} epochs but no checkpoint to resume from; starting again "
                 "would replace that log: move the directory away to start again, or use another directory"
             )
     # (temporary files are an atomic write's, cut short by a kill)
-    foreign = [name for name in present if name not in _BEFORE_FIRST_CHECKPOINT and not name.endswith(".tmp")]
+    foreign = [
+        name
+        for name in present
+        if name not in _BEFORE_FIRST_CHECKPOINT and not name.endswith((".tmp", _CUT_SHORT))
+    ]
     if foreign:
         raise ValueError(
             f"{out} holds {', '.join(foreign)} and no pamdp checkpoint; expected a new or empty directory, "
