@@ -102,6 +102,12 @@ class HybridActionSpace:
         return _frozen(mask)
 
     @cached_property
+    def param_index(self) -> np.ndarray:
+        """Integer ``(K, m)``: entry ``[a, i]`` is where action ``a``'s padded parameter ``i`` sits in the
+        all-parameters vector, ``o_a + i`` (0 where :attr:`param_mask` is false)."""
+        return _frozen(np.where(self.param_mask, self.param_offsets[:, None] + np.arange(self.max_param_size), 0))
+
+    @cached_property
     def padded_low(self) -> np.ndarray:
         """``(K, m)`` lower bounds, padded with -1 (unused entries map identically)."""
         return self._padded(self.lows, -1.0)

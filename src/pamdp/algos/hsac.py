@@ -210,9 +210,7 @@ class HybridSACActor(nn.Module):
         self.form, self.n_actions, self.m = form, hybrid.n_actions, hybrid.max_param_size
         mask = hybrid.param_mask
         self.register_buffer("param_mask", torch.tensor(mask, dtype=torch.float32))
-        # where action a's padded parameter i sits in the all-actions vector (0 where unused)
-        index = np.where(mask, hybrid.param_offsets[:, None] + np.arange(self.m), 0)
-        self.register_buffer("param_index", torch.as_tensor(index, dtype=torch.long).view(-1))
+        self.register_buffer("param_index", torch.tensor(hybrid.param_index, dtype=torch.long).view(-1))
         self.total = total = hybrid.total_param_size
         # the all-actions vector's entries in the flattened padded (K * m) layout
         self.register_buffer("flat_index", torch.tensor(np.flatnonzero(mask), dtype=torch.long))

@@ -127,9 +127,8 @@ class Actor(nn.Module):
         out = hybrid.n_actions + hybrid.total_param_size
         self.net = mlp(obs_dim, hidden_sizes, out, activation, nn.Tanh if squash else None)
         # Where action a's padded parameter i sits in the output: K + offset_a + i (0 where unused).
-        offsets = hybrid.param_offsets
         mask = hybrid.param_mask
-        index = np.where(mask, hybrid.n_actions + offsets[:, None] + np.arange(hybrid.max_param_size), 0)
+        index = np.where(mask, hybrid.n_actions + hybrid.param_index, 0)
         self.register_buffer("param_index", torch.as_tensor(index, dtype=torch.long))
         self.register_buffer("param_mask", torch.tensor(mask, dtype=torch.float32))
 

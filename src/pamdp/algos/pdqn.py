@@ -226,12 +226,8 @@ class ParamActor(nn.Module):
             nn.init.zeros_(self.net[-1].bias)
         self.register_buffer("passthrough_weight", weight)
         self.register_buffer("passthrough_bias", bias)
-        # Where action a's padded parameter i sits in the flat vector: offset_a + i (0 where unused).
-        offsets = hybrid.param_offsets
-        mask = hybrid.param_mask
-        index = np.where(mask, offsets[:, None] + np.arange(hybrid.max_param_size), 0)
-        self.register_buffer("param_index", torch.as_tensor(index, dtype=torch.long))
-        self.register_buffer("param_mask", torch.tensor(mask, dtype=torch.float32))
+        self.register_buffer("param_index", torch.tensor(hybrid.param_index, dtype=torch.long))
+        self.register_buffer("param_mask", torch.tensor(hybrid.param_mask, dtype=torch.float32))
 
     def forward(self, obs: torch.Tensor) -> torch.Tensor:
         if self.passthrough_weight is None:
@@ -259,11 +255,8 @@ class QNetwork(nn.Module):
         self.n_actions = hybrid.n_actions
         self.multi_pass = multi_pass
         self.net = mlp(obs_dim + hybrid.total_param_size, hidden_sizes, hybrid.n_actions, activation)
-        # Action k's parameter i is entry offset_k + i of the all-actions vector (index 0, masked, where unused).
-        mask = hybrid.param_mask
-        index = np.where(mask, hybrid.param_offsets[:, None] + np.arange(hybrid.max_param_size), 0)
-        self.register_buffer("param_index", torch.as_tensor(index, dtype=torch.long), persistent=False)
-        self.register_buffer("param_mask", torch.tensor(mask, dtype=torch.float32), persistent=False)
+        self.register_buffer("param_index", torch.tensor(hybrid.param_index, dtype=torch.long), persistent=False)
+        self.register_buffer("param_mask", torch.tensor(hybrid.param_mask, dtype=torch.float32), persistent=False)
 
     def forward(self, obs: torch.Tensor, params: torch.Tensor) -> torch.Tensor:
         if not self.multi_pass:

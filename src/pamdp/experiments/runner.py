@@ -42,8 +42,8 @@ __all__ = [
 ]
 
 LOCK_FILE = ".lock"
-# What a run directory holds before its first checkpoint: starting it again from step 0 loses nothing.
 _CUT_SHORT = ".cut-short"  # a first epoch's log kept aside when its checkpoint was cut short by a kill
+# What a run directory holds before its first checkpoint: starting it again from step 0 loses nothing.
 _BEFORE_FIRST_CHECKPOINT = {"run.json", "progress.csv", "tb", "stdout.log", LOCK_FILE}
 
 
