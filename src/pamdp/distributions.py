@@ -21,7 +21,15 @@ from dataclasses import dataclass
 import torch
 import torch.nn.functional as F
 
-__all__ = ["HybridDistribution", "KL_ESTIMATORS", "MASKED", "kl_divergence", "masked_logits"]
+__all__ = [
+    "HybridDistribution",
+    "KL_ESTIMATORS",
+    "MASKED",
+    "draw_action",
+    "draw_params",
+    "kl_divergence",
+    "masked_logits",
+]
 
 KL_ESTIMATORS = ("joint_sample", "chain_sample", "chain_analytic")
 _LOG_2PI = math.log(2.0 * math.pi)
@@ -43,6 +51,27 @@ def masked_logits(logits: torch.Tensor, mask: torch.Tensor | None) -> torch.Tens
     mask = mask.to(torch.bool)
     mask = mask | ~mask.any(dim=-1, keepdim=True)
     return torch.where(mask, logits, torch.full_like(logits, MASKED))
+
+
+def draw_action(logits: torch.Tensor, deterministic: bool, generator: torch.Generator | None = None) -> torch.Tensor:
+    """``a ~ softmax(logits)`` ``(B,)``, or its argmax when ``deterministic``: the first draw of an action."""
+    if deterministic:
+        return logits.argmax(dim=-1)
+    return torch.multinomial(F.softmax(logits, dim=-1), 1, generator=generator).squeeze(-1)
+
+
+def draw_params(
+    mu: torch.Tensor,
+    log_std: torch.Tensor | None,
+    mask: torch.Tensor,
+    deterministic: bool,
+    generator: torch.Generator | None = None,
+) -> torch.Tensor:
+    """``x ~ N(mu, exp(log_std)^2)`` for the chosen actions (``mu`` ``(B, m)``), or ``mu`` when ``deterministic``;
+    entries outside ``mask`` zero: the second draw of an action, after :func:`draw_action`."""
+    if not deterministic:
+        mu = mu + log_std.exp() * torch.randn(mu.shape, generator=generator, dtype=mu.dtype, device=mu.device)
+    return mu * mask
 
 
 @dataclass
@@ -82,15 +111,13 @@ class HybridDistribution:
     # -- sampling ----------------------------------------------------------------------------
     def sample(self, generator: torch.Generator | None = None) -> tuple[torch.Tensor, torch.Tensor]:
         """Draw ``a ~ pi_d`` then ``x ~ pi_c(. | s, a)``; unused parameter entries are zero."""
-        a = torch.multinomial(self.probs_d, 1, generator=generator).squeeze(-1)
-        mu, log_std = self._at(self.means, a), self._at(self.log_std, a)
-        noise = torch.randn(mu.shape, generator=generator, dtype=mu.dtype, device=mu.device)
-        return a, (mu + log_std.exp() * noise) * self.mask[a]
+        a = draw_action(self.logits, False, generator)
+        return a, draw_params(self._at(self.means, a), self._at(self.log_std, a), self.mask[a], False, generator)
 
     def mode(self) -> tuple[torch.Tensor, torch.Tensor]:
         """The greedy action: ``argmax_a pi_d(a | s)`` with its mean parameters."""
-        a = self.logits.argmax(dim=-1)
-        return a, self._at(self.means, a) * self.mask[a]
+        a = draw_action(self.logits, True)
+        return a, draw_params(self._at(self.means, a), None, self.mask[a], True)
 
     # -- densities ---------------------------------------------------------------------------
     def log_prob(self, a: torch.Tensor, x: torch.Tensor) -> torch.Tensor:

@@ -14,7 +14,7 @@ import torch
 import torch.nn.functional as F
 from torch import nn
 
-from pamdp.distributions import HybridDistribution, masked_logits
+from pamdp.distributions import HybridDistribution, draw_action, draw_params, masked_logits
 from pamdp.spaces import HybridActionSpace
 
 __all__ = [
@@ -200,17 +200,10 @@ class HybridPolicy(nn.Module):
     ) -> tuple[torch.Tensor, torch.Tensor]:
         """``forward(obs, action_mask)``'s ``mode()`` or ``sample(generator)`` (the same draws), with ``pi_c`` run for
         the chosen action only: acting needs no other action's mean."""
-        logits = masked_logits(self.pi_d(obs), action_mask)
-        if deterministic:
-            a = logits.argmax(dim=-1)
-        else:
-            a = torch.multinomial(F.softmax(logits, dim=-1), 1, generator=generator).squeeze(-1)
+        a = draw_action(masked_logits(self.pi_d(obs), action_mask), deterministic, generator)
         first = self.pi_c[0]
         mu = self.pi_c[1:](every_action_linear(obs, first.weight, first.bias, a))
-        if not deterministic:
-            noise = torch.randn(mu.shape, generator=generator, dtype=mu.dtype, device=mu.device)
-            mu = mu + self.log_std[a].exp() * noise
-        return a, mu * self.mask[a]
+        return a, draw_params(mu, self.log_std[a], self.mask[a], deterministic, generator)
 
     def linearize(
         self, obs: torch.Tensor
