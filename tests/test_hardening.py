@@ -261,14 +261,18 @@ def test_a_log_without_a_checkpoint_is_not_replaced_by_a_new_run(trained, tmp_pa
 
 def test_a_kill_before_the_first_checkpoint_starts_again_keeping_its_log(trained, tmp_path):
     run = copy_of(trained, tmp_path)
-    for name in ("checkpoint.pt", "final_model.pt", "evaluation.json"):
-        (run / name).unlink()
-    lines = (run / "progress.csv").read_text().splitlines(keepends=True)
-    (run / "progress.csv").write_text("".join(lines[:2]))  # the header and epoch 1: killed before its checkpoint
-    cut_short = (run / "progress.csv").read_bytes()
     argv = ["train", "patrpo", "--total-steps", "1000", "--out", str(run), "--eval-episodes", "3", *TINY]
-    assert main(argv) == 0
-    assert (run / "progress.csv.cut-short").read_bytes() == cut_short
+    cut_short = []
+    for _ in range(2):  # killed twice in the same window: both logs are kept
+        for name in ("checkpoint.pt", "final_model.pt", "evaluation.json"):
+            (run / name).unlink()
+        lines = (run / "progress.csv").read_text().splitlines(keepends=True)
+        (run / "progress.csv").write_text("".join(lines[:2]))  # the header and epoch 1, killed before its checkpoint
+        cut_short.append((run / "progress.csv").read_bytes())
+        assert main(argv) == 0
+    assert (run / "progress.csv.cut-short").read_bytes() == cut_short[0]
+    assert (run / "progress.csv.cut-short.2").read_bytes() == cut_short[1]
+    assert (run / "tb.cut-short").is_dir() == (run / "tb.cut-short.2").is_dir() == (run / "tb").is_dir()
     with open(run / "progress.csv", newline="") as f:
         assert [int(float(r["time/epoch"])) for r in csv.DictReader(f)] == [1, 2]
     assert (run / "evaluation.json").exists()

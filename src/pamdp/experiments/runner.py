@@ -165,6 +165,16 @@ def _differences(recorded: dict, asked: dict) -> list[str]:
     return differ
 
 
+def _set_aside_name(out: Path, name: str) -> Path:
+    """The first free name for a cut-short ``name``: ``NAME.cut-short``, then ``NAME.cut-short.2``, ... (a run
+    cut short twice keeps both logs)."""
+    path, n = out / f"{name}{_CUT_SHORT}", 1
+    while path.exists():
+        n += 1
+        path = out / f"{name}{_CUT_SHORT}.{n}"
+    return path
+
+
 def _check_fresh_directory(out: Path) -> None:
     """Refuse to start a run from step 0 in a directory whose contents that would replace or mix with."""
     present = sorted(os.listdir(out)) if out.is_dir() else []
@@ -177,7 +187,7 @@ def _check_fresh_directory(out: Path) -> None:
             # starting again; the cut-short log (and its TensorBoard events) are kept beside, renamed.
             for name in ("progress.csv", "tb"):
                 if (out / name).exists():
-                    os.replace(out / name, out / f"{name}{_CUT_SHORT}")
+                    os.replace(out / name, _set_aside_name(out, name))
             present = sorted(os.listdir(out))
         elif epochs:
             raise ValueError(
@@ -188,7 +198,7 @@ def _check_fresh_directory(out: Path) -> None:
     foreign = [
         name
         for name in present
-        if name not in _BEFORE_FIRST_CHECKPOINT and not name.endswith((".tmp", _CUT_SHORT))
+        if name not in _BEFORE_FIRST_CHECKPOINT and not name.endswith(".tmp") and _CUT_SHORT not in name
     ]
     if foreign:
         raise ValueError(
