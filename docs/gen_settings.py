@@ -6,7 +6,7 @@ replaced. A row per ``dataclasses.fields(Config)``: the name, the type, the defa
 preset that differs from the default (blank where it does not), the field's ``metadata["help"]`` and the values
 its check accepts (``Config.check_of(name)``). Between ``<!-- domain-presets start -->`` and
 ``<!-- domain-presets end -->``: the presets chosen by the env (``pamdp.algos.domain_presets.DOMAIN_PRESETS``),
-each override with its source.
+each with the env arguments it asks for and each override with its source.
 
     python docs/gen_settings.py            # rewrite docs/algorithms.md in place
     python docs/gen_settings.py --check    # exit 1 if the tables are out of date (for CI)
@@ -79,11 +79,12 @@ def domain_table() -> str:
         "| algorithm | env | preset | over | settings (source) | note |",
         "|---|---|---|---|---|---|",
     ]
-    for (algo, env_id), p in DOMAIN_PRESETS.items():
+    for (algo, env_id, match), p in DOMAIN_PRESETS.items():
         over = "" if p.base == p.name else f"`{p.base}`"
         settings = "; ".join(f"`{n} = {_value(v)}` ({src})" for n, v, src in p.overrides) or "the preset as it is"
         note = p.note.replace("|", "\\|")
-        lines.append(f"| `{algo}` | `{env_id}` | `{p.name}` | {over} | {settings} | {note} |")
+        env = f"`{env_id}`" + "".join(f", {n} in {{{', '.join(map(str, vs))}}}" for n, vs in match)
+        lines.append(f"| `{algo}` | {env} | `{p.name}` | {over} | {settings} | {note} |")
     return "\n".join(lines) + "\n"
 
 

@@ -6,11 +6,13 @@ import dataclasses
 import pytest
 
 from pamdp.algos import algorithm_class, default_preset, preset_config, preset_names
-from pamdp.algos.domain_presets import DOMAIN_PRESETS
+from pamdp.algos.domain_presets import DOMAIN_PRESETS, domain_presets_of, when
 from pamdp.cli import _train_spec, build_parser
+from pamdp.experiments import load_experiment
 from pamdp.experiments.runner import RunSpec
 
 HFO = "pamdp/HalfFieldOffense-v0"
+HARD_MOVE = "pamdp/HardMove-v0"
 
 # Bester et al.'s Half Field Offense settings as issue 27 writes them (and their run_soccer_pdqn.py has them).
 MPDQN_HFO = {
@@ -73,12 +75,21 @@ def test_an_env_without_a_preset_falls_back_to_the_algorithms_default(env):
         assert RunSpec("pdqn", env, 10).config()[1] == "tuned"
 
 
-@pytest.mark.parametrize("key", list(DOMAIN_PRESETS), ids=lambda k: f"{k[0]}-{k[1].split('/')[-1]}")
+def _key_id(key):
+    algo, env, match = key
+    return "-".join([algo, env.split("/")[-1], *(f"{name}{'_'.join(map(str, vs))}" for name, vs in match)])
+
+
+@pytest.mark.parametrize("key", list(DOMAIN_PRESETS), ids=_key_id)
 def test_each_domain_preset_is_its_base_with_its_overrides(key):
-    algo, env = key
+    algo, env, match = key
     entry = DOMAIN_PRESETS[key]
     cls = algorithm_class(algo).config_class
-    assert default_preset(cls, env) == entry.name and entry.name in preset_names(cls)
+    for values in zip(*(vs for _, vs in match)) if match else [()]:  # every argument value the entry names
+        kwargs = dict(zip((name for name, _ in match), values))
+        assert default_preset(cls, env, kwargs) == entry.name and entry.name in preset_names(cls)
+    if entry.name != entry.base:  # a name of its own is one preset: no other entry's under the same name
+        assert domain_presets_of(algo)[entry.name] is entry
     config = preset_config(cls, entry.name)  # a config: every value passed its check
     base = cls.preset(entry.base)
     for f in dataclasses.fields(cls):
@@ -89,6 +100,56 @@ def test_each_domain_preset_is_its_base_with_its_overrides(key):
     # --preset takes the name, and a run given it gets the same config.
     build_parser().parse_args(["train", algo, "--env", env, "--preset", entry.name])
     assert RunSpec(algo, env, 10, preset=entry.name).config()[2] == config
+
+
+def test_hard_move_at_large_k_gets_the_cheaper_presets_through_the_command_line():
+    # n = 8, 10: P-DQN's single pass and PASVG(0)'s Gumbel-Softmax gradient, since MP-DQN's K passes a state and
+    # PASVG(0)'s K critic evaluations are out of a CPU's reach there (benchmarks/large_k_cost.md); n = 4, 6 and the
+    # env's default n (4) keep MP-DQN's hard_move preset and PASVG(0)'s tuned one.
+    for n in (8, 10):
+        _, preset, config = config_of(["pdqn", "--env", HARD_MOVE, "--env-kwargs", f'{{"n": {n}}}'])
+        assert preset == "hard_move_large" and not config.multi_pass and config.hidden_sizes == (256, 256)
+        _, preset, config = config_of(["pasvg0", "--env", HARD_MOVE, "--env-kwargs", f'{{"n": {n}}}'])
+        assert preset == "hard_move_large" and config.discrete_gradient == "gumbel"
+    for argv in (["--env-kwargs", '{"n": 4}'], ["--env-kwargs", '{"n": 6}'], []):
+        _, preset, config = config_of(["pdqn", "--env", HARD_MOVE, *argv])
+        assert preset == "hard_move" and config.multi_pass and config.hidden_sizes == (256, 256)
+        _, preset, config = config_of(["pasvg0", "--env", HARD_MOVE, *argv])
+        assert preset == "tuned" and config.discrete_gradient == "expected"
+    # A flag or --preset still wins over the entry for the env's arguments.
+    argv = ["pdqn", "--env", HARD_MOVE, "--env-kwargs", '{"n": 8}']
+    assert config_of([*argv, "--multi-pass", "true"])[2].multi_pass
+    assert config_of([*argv, "--preset", "hard_move"])[1] == "hard_move"
+
+
+def test_an_experiments_env_arguments_choose_the_preset(tmp_path):
+    path = tmp_path / "e.toml"
+    path.write_text(
+        'seeds = [0]\nenv = "pamdp/HardMove-v0"\ntotal_steps = 1000\nenv_kwargs = { n = 8 }\n'
+        '[[runs]]\nlabel = "big"\nalgo = "pdqn"\n'
+        '[[runs]]\nlabel = "small"\nalgo = "pdqn"\nenv_kwargs = { n = 4 }\n'
+    )
+    big, small = load_experiment(path).specs()
+    assert big.config()[1] == "hard_move_large" and small.config()[1] == "hard_move"
+    suite = {s.label: s for s in load_experiment("benchmark-suite").specs(seeds=[0])}
+    assert suite["P-DQN on Hard Move n=10"].config()[1] == "hard_move_large"
+    assert suite["MP-DQN on Hard Move n=6"].config()[1] == "hard_move"
+
+
+def test_an_entry_or_a_run_naming_an_argument_the_env_lacks_is_refused(monkeypatch):
+    cls = algorithm_class("pdqn").config_class
+    with pytest.raises(ValueError, match=r"env 'pamdp/HardMove-v0' takes no argument 'N'; expected some of n"):
+        config_of(["pdqn", "--env", HARD_MOVE, "--env-kwargs", '{"N": 8}'])
+    entry = DOMAIN_PRESETS["pdqn", HARD_MOVE, when(n=(8, 10))]
+    monkeypatch.setitem(DOMAIN_PRESETS, ("pdqn", HARD_MOVE, when(N=(8,))), entry)
+    with pytest.raises(ValueError, match=r"names env argument 'N' for 'pamdp/HardMove-v0', which takes no such"):
+        default_preset(cls, HARD_MOVE, {"n": 8})
+    # Two entries naming as many arguments that both fit: neither is the more specific.
+    monkeypatch.delitem(DOMAIN_PRESETS, ("pdqn", HARD_MOVE, when(N=(8,))))
+    monkeypatch.setitem(DOMAIN_PRESETS, ("pdqn", HARD_MOVE, when(n=(6, 8))), entry)
+    with pytest.raises(ValueError, match=r"two entries for \('pdqn', 'pamdp/HardMove-v0'\) that fit .*'n': 8"):
+        default_preset(cls, HARD_MOVE, {"n": 8})
+    assert default_preset(cls, HARD_MOVE, {"n": 10}) == entry.name
 
 
 def test_an_unknown_preset_is_refused_naming_the_valid_ones(capsys):

@@ -121,12 +121,12 @@ def preset_config(config_class, name: str):
     return config_class.from_dict(derived.settings, base=table[derived.base])
 
 
-def default_preset(config_class, env_id: str | None = None) -> str:
-    """The preset a run gets when none is named: the env's (``domain_presets.py``) where it has one, else
-    ``tuned`` where the algorithm has it, else its first."""
+def default_preset(config_class, env_id: str | None = None, env_kwargs: dict | None = None) -> str:
+    """The preset a run gets when none is named: the env's (``domain_presets.py``, for the env's arguments
+    ``env_kwargs``) where it has one, else ``tuned`` where the algorithm has it, else its first."""
     from pamdp.algos.domain_presets import domain_preset
 
-    chosen = domain_preset(_algo_of(config_class), env_id)
+    chosen = domain_preset(_algo_of(config_class), env_id, env_kwargs)
     if chosen is not None:
         return chosen.name
     presets = config_class.presets()

@@ -1,11 +1,15 @@
-"""Presets chosen by the env: for each algorithm and env id, the preset a run gets when none is named.
+"""Presets chosen by the env: for each algorithm, env id and env arguments, the preset a run gets when none is named.
 
 ``pamdp train pdqn --env pamdp/HalfFieldOffense-v0`` trains with :data:`DOMAIN_PRESETS`' ``("pdqn",
-"pamdp/HalfFieldOffense-v0")`` entry; an explicit ``--preset`` (or a config file's ``preset``) still wins, and an
-env without an entry gets the algorithm's default preset. An entry names a preset: either one the algorithm's
-config already has (``overrides`` empty: the env's choice among them), or a new one, ``base`` with ``overrides``,
-each override with the place its value comes from. Values the sources do not give are marked ``assumed``;
-a source's settings that pamdp has no setting for are listed in the entry's ``note``.
+"pamdp/HalfFieldOffense-v0", ANY)`` entry; an explicit ``--preset`` (or a config file's ``preset``) still wins, and an
+env without an entry gets the algorithm's default preset. An entry may ask for some of the env's arguments
+(:func:`when`): ``pamdp train pdqn --env pamdp/HardMove-v0 --env-kwargs '{"n": 8}'`` gets the ``when(n=(8, 10))``
+entry, the env's default ``n`` the ``ANY`` one; of the entries that fit, the one naming the most arguments wins.
+
+An entry names a preset: either one the algorithm's config already has (``overrides`` empty: the env's choice
+among them), or a new one, ``base`` with ``overrides``, each override with the place its value comes from. Values
+the sources do not give are marked ``assumed``; a source's settings that pamdp has no setting for are listed in
+the entry's ``note``.
 
 Sources:
 
@@ -21,9 +25,19 @@ from __future__ import annotations
 import dataclasses
 from typing import Any
 
-__all__ = ["DomainPreset", "DOMAIN_PRESETS", "MASSON_GOAL_START", "domain_preset", "domain_presets_of"]
+__all__ = [
+    "ANY",
+    "DomainPreset",
+    "DOMAIN_PRESETS",
+    "LARGE_K",
+    "MASSON_GOAL_START",
+    "domain_preset",
+    "domain_presets_of",
+    "when",
+]
 
 HFO = "pamdp/HalfFieldOffense-v0"
+HARD_MOVE = "pamdp/HardMove-v0"
 MPDQN_HFO = "MP-DQN's HFO script"
 MPDQN_GOAL = "MP-DQN's Goal script"
 
@@ -44,6 +58,15 @@ class DomainPreset:
     @property
     def settings(self) -> dict[str, Any]:
         return {name: value for name, value, _ in self.overrides}
+
+
+def when(**values) -> tuple[tuple[str, tuple[Any, ...]], ...]:
+    """The env arguments an entry applies to, each with the values it takes: ``when(n=(8, 10))``, n is 8 or 10."""
+    return tuple(sorted((name, tuple(allowed)) for name, allowed in values.items()))
+
+
+ANY = when()
+"""An entry for the env whatever its arguments."""
 
 
 def _derived(name: str, base: str, note: str, *overrides: tuple[str, Any, str]) -> DomainPreset:
@@ -139,25 +162,33 @@ GOAL_NOTE = (
     "and the std 1e-5 of its output layers (the Q-network's is pamdp's default, the actor's starts at zero)."
 )
 
-DOMAIN_PRESETS: dict[tuple[str, str], DomainPreset] = {
-    ("pdqn", HFO): _MPDQN_HFO,
-    ("paddpg", HFO): DomainPreset(
+# Hard Move's networks for its 2^n actions.
+_HARD_MOVE_Q = (
+    ("hidden_sizes", (256, 256), "assumed: up to 1024 Q outputs at n = 10"),
+    ("buffer_size", 200_000, "assumed: a fifth of the 1M budget"),
+)
+LARGE_K = when(n=(8, 10))
+"""Hard Move's two largest sizes, 256 and 1024 actions."""
+
+DOMAIN_PRESETS: dict[tuple[str, str, tuple], DomainPreset] = {
+    ("pdqn", HFO, ANY): _MPDQN_HFO,
+    ("paddpg", HFO, ANY): DomainPreset(
         "hausknecht_stone", "hausknecht_stone", note="Hausknecht & Stone's own HFO agent: their networks and settings."
     ),
-    ("patrpo", HFO): _derived(
+    ("patrpo", HFO, ANY): _derived(
         "hfo",
         "tuned",
         "The tuned preset acting only among the actions that have an effect: KICK is masked while the ball is not "
         "kickable (benchmarks/hfo_learning.md); the paper's soccer settings are 'paper'.",
         ("action_mask", True, "measured: benchmarks/hfo_learning.md (issue 27)"),
     ),
-    ("pappo", HFO): DomainPreset(
+    ("pappo", HFO, ANY): DomainPreset(
         "default",
         "default",
         note="PPO's common settings: the tuned entropy weight was found on Platform's three actions.",
     ),
-    ("hyar", HFO): _HYAR_HFO,
-    ("pdqn", "pamdp/Goal-v0"): _derived(
+    ("hyar", HFO, ANY): _HYAR_HFO,
+    ("pdqn", "pamdp/Goal-v0", ANY): _derived(
         "goal",
         "paper",
         "MP-DQN's own Goal settings. " + GOAL_NOTE,
@@ -176,31 +207,80 @@ DOMAIN_PRESETS: dict[tuple[str, str], DomainPreset] = {
         ("grad_clip", 1.0, MPDQN_GOAL),
         ("param_passthrough", MASSON_GOAL_START, f"{MPDQN_GOAL}: Masson's initial weights"),
     ),
-    ("pdqn", "pamdp/HardGoal-v0"): _mpdqn_hybrid(
+    ("pdqn", "pamdp/HardGoal-v0", ANY): _mpdqn_hybrid(
         "hard_goal", "MP-DQN's Goal settings do not apply (ten actions); the tuned preset with multi-pass."
     ),
-    ("pdqn", "pamdp/CatchPoint-v0"): _mpdqn_hybrid("catch_point", "HyAR's P-DQN settings were not read here."),
-    ("pdqn", "pamdp/HardMove-v0"): _mpdqn_hybrid(
-        "hard_move",
-        "HyAR's P-DQN settings were not read here; 2^n actions, so a wider Q-network.",
-        ("hidden_sizes", (256, 256), "assumed: up to 1024 Q outputs at n = 10"),
-        ("buffer_size", 200_000, "assumed: a fifth of the 1M budget"),
+    ("pdqn", "pamdp/CatchPoint-v0", ANY): _mpdqn_hybrid("catch_point", "HyAR's P-DQN settings were not read here."),
+    ("pdqn", HARD_MOVE, ANY): _mpdqn_hybrid(
+        "hard_move", "HyAR's P-DQN settings were not read here; 2^n actions, so a wider Q-network.", *_HARD_MOVE_Q
     ),
-    ("pdqn", "pamdp/Moving-v0"): _mpdqn_hybrid("moving", "No published settings; the tuned preset with multi-pass."),
-    ("pdqn", "pamdp/Sliding-v0"): _mpdqn_hybrid("sliding", "No published settings; the tuned preset with multi-pass."),
-    ("hyar", "pamdp/Goal-v0"): _hyar_hybrid("goal", 5_000, "HyAR's Goal budget is 300k samples."),
-    ("hyar", "pamdp/HardGoal-v0"): _hyar_hybrid("hard_goal", 5_000, "HyAR's Hard Goal budget is 300k samples."),
-    ("hyar", "pamdp/CatchPoint-v0"): _hyar_hybrid("catch_point", 20_000, "HyAR's Catch Point budget is 1M samples."),
-    ("hyar", "pamdp/HardMove-v0"): _hyar_hybrid("hard_move", 20_000, "HyAR's Hard Move budget is 1M samples."),
+    ("pdqn", HARD_MOVE, LARGE_K): _derived(
+        "hard_move_large",
+        "tuned",
+        "P-DQN's single pass of the Q-network over all actions' parameters: MP-DQN's K passes a state are out of "
+        "a CPU's reach at this K (benchmarks/large_k_cost.md). Otherwise the hard_move preset.",
+        ("multi_pass", False, "HyAR's Table 2 compares P-DQN (Xiong et al.): one pass"),
+        ("gamma", 0.99, "assumed: TD3's discount, as HyAR's baselines"),
+        *_HARD_MOVE_Q,
+    ),
+    ("pdqn", "pamdp/Moving-v0", ANY): _mpdqn_hybrid(
+        "moving", "No published settings; the tuned preset with multi-pass."
+    ),
+    ("pdqn", "pamdp/Sliding-v0", ANY): _mpdqn_hybrid(
+        "sliding", "No published settings; the tuned preset with multi-pass."
+    ),
+    ("hyar", "pamdp/Goal-v0", ANY): _hyar_hybrid("goal", 5_000, "HyAR's Goal budget is 300k samples."),
+    ("hyar", "pamdp/HardGoal-v0", ANY): _hyar_hybrid("hard_goal", 5_000, "HyAR's Hard Goal budget is 300k samples."),
+    ("hyar", "pamdp/CatchPoint-v0", ANY): _hyar_hybrid(
+        "catch_point", 20_000, "HyAR's Catch Point budget is 1M samples."
+    ),
+    ("hyar", HARD_MOVE, ANY): _hyar_hybrid("hard_move", 20_000, "HyAR's Hard Move budget is 1M samples."),
+    ("pasvg0", HARD_MOVE, LARGE_K): _derived(
+        "hard_move_large",
+        "tuned",
+        "The tuned preset with the paper's Gumbel-Softmax gradient of pi_d: the exact expectation over the K "
+        "actions costs K critic evaluations a state, out of a CPU's reach at this K (benchmarks/large_k_cost.md).",
+        ("discrete_gradient", "gumbel", "PASVG(0)'s paper"),
+    ),
 }
-"""``(algorithm's command-line name, env id) -> DomainPreset``."""
+"""``(algorithm's command-line name, env id, env arguments (:func:`when`)) -> DomainPreset``."""
 
 
-def domain_preset(algo: str, env_id: str | None) -> DomainPreset | None:
-    """The env's preset for algorithm ``algo`` (its command-line name), or ``None`` where it has none."""
-    return DOMAIN_PRESETS.get((algo, env_id)) if env_id else None
+def domain_preset(algo: str, env_id: str | None, env_kwargs: dict | None = None) -> DomainPreset | None:
+    """The env's preset for algorithm ``algo`` (its command-line name), or ``None`` where it has none: of the
+    entries for ``env_id`` whose arguments fit ``env_kwargs`` (the env's defaults where they leave one out), the
+    one naming the most."""
+    entries = {match: p for (a, e, match), p in DOMAIN_PRESETS.items() if (a, e) == (algo, env_id)}
+    args = _env_arguments(env_id, env_kwargs or {}, {name for match in entries for name, _ in match})
+    fitting = sorted((m for m in entries if all(args[name] in values for name, values in m)), key=len, reverse=True)
+    if len(fitting) > 1 and len(fitting[0]) == len(fitting[1]):
+        raise ValueError(
+            f"DOMAIN_PRESETS has two entries for ({algo!r}, {env_id!r}) that fit its arguments {args}: "
+            f"{fitting[0]} and {fitting[1]}; expected one naming more arguments than the other"
+        )
+    return entries[fitting[0]] if fitting else None
+
+
+def _env_arguments(env_id: str, env_kwargs: dict, names: set[str]) -> dict[str, Any]:
+    """The values of the env arguments ``names`` that ``gymnasium.make(env_id, **env_kwargs)`` would pass."""
+    if not names:
+        return {}
+    import inspect
+
+    from pamdp.algos.vector_env import check_env_kwargs, env_creator, env_spec
+
+    check_env_kwargs(env_id, env_kwargs)
+    params = inspect.signature(env_creator(env_id)).parameters
+    unknown = sorted(names - set(params))
+    if unknown:
+        raise ValueError(
+            f"DOMAIN_PRESETS names env argument {', '.join(map(repr, unknown))} for {env_id!r}, which takes no such "
+            f"argument; expected some of {', '.join(params)}"
+        )
+    given = {**{n: p.default for n, p in params.items()}, **(env_spec(env_id).kwargs or {}), **env_kwargs}
+    return {name: given[name] for name in sorted(names)}
 
 
 def domain_presets_of(algo: str) -> dict[str, DomainPreset]:
     """``{name: DomainPreset}`` of the new presets (those with a name of their own) of algorithm ``algo``."""
-    return {p.name: p for (a, _), p in DOMAIN_PRESETS.items() if a == algo and p.name != p.base}
+    return {p.name: p for (a, _, _), p in DOMAIN_PRESETS.items() if a == algo and p.name != p.base}

@@ -66,7 +66,7 @@ class RunSpec:
         cls = algorithm_class(self.algo)
         if cls is None:
             raise ValueError(f"algorithm {self.algo!r} is not available in this install")
-        preset = self.preset or default_preset(cls.config_class, self.env)
+        preset = self.preset or default_preset(cls.config_class, self.env, dict(self.env_kwargs))
         base = preset_config(cls.config_class, preset)
         return cls, preset, cls.config_class.from_dict({**dict(self.settings), "seed": self.seed}, base=base)
 
