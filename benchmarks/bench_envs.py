@@ -3,9 +3,11 @@
 Run ``python benchmarks/bench_envs.py --cpu 1`` (a few minutes); it rewrites ``benchmarks/env_speed.md``, keeping
 its section ``## Notes (written by hand)``. For each registered env (Hard Move at each n of the benchmark suite):
 the scalar env from ``gymnasium.make`` (resets included) and the batched env at ``--num-envs`` copies
-(autoresets included), each the median over ``--repeats`` timings of ``time.process_time`` (this process's CPU
-time, which another process on the core does not inflate). Actions are sampled before timing. An env whose
-module is missing or fails to build is skipped, and the record says which and why.
+(autoresets included), and again with the parameter boxes stacked in one array where they share one shape and
+the batched env takes that format (Hard Move), each the median over ``--repeats`` timings of
+``time.process_time`` (this process's CPU time, which another process on the core does not inflate). Actions are
+sampled before timing. An env whose module is missing or fails to build is skipped, and the record says which
+and why.
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ import time
 from pathlib import Path
 
 import gymnasium
+import numpy as np
 
 import pamdp  # noqa: F401  (registers the envs)
 from pamdp.envs import _REGISTRATIONS
@@ -52,8 +55,16 @@ def batched_rate(env, actions, steps: int) -> float:
     return steps * env.num_envs / (time.process_time() - start)
 
 
-def measure(env_id: str, kwargs: dict, num_envs: int, repeats: int, scalar_steps: int) -> tuple[float, float]:
-    """Median scalar and batched env-steps per CPU-second."""
+def stacked(action):
+    """A batched action with its parameter boxes stacked in one ``(K, N, m)`` array, or ``None`` where the boxes
+    differ in shape (the format Hard Move's batched env also takes)."""
+    a, params = action
+    return (a, np.stack(params)) if len({p.shape for p in params}) == 1 else None
+
+
+def measure(env_id: str, kwargs: dict, num_envs: int, repeats: int, scalar_steps: int) -> tuple[float, ...]:
+    """Median scalar, batched and batched-with-stacked-parameters env-steps per CPU-second (the last ``nan``
+    where the env takes no stacked parameters)."""
     scalar = gymnasium.make(env_id, **kwargs)
     scalar.reset(seed=0)
     scalar.action_space.seed(0)
@@ -66,13 +77,20 @@ def measure(env_id: str, kwargs: dict, num_envs: int, repeats: int, scalar_steps
     batched_steps = max(1, MIN_ENV_STEPS // num_envs)
     scalar_rate(scalar, actions, 200)  # Numba's compilation and the first resets, untimed
     batched_rate(batched, batched_actions, 5)
-    rates = {"scalar": [], "batched": []}
+    stacked_actions = [stacked(action) for action in batched_actions]
+    try:
+        batched_rate(batched, stacked_actions, 5) if stacked_actions[0] is not None else None
+    except ValueError:  # the env reads only a tuple of boxes
+        stacked_actions = [None]
+    rates = {"scalar": [], "batched": [], "stacked": []}
     for _ in range(repeats):
         rates["scalar"].append(scalar_rate(scalar, actions, scalar_steps))
         rates["batched"].append(batched_rate(batched, batched_actions, batched_steps))
+        if stacked_actions[0] is not None:
+            rates["stacked"].append(batched_rate(batched, stacked_actions, batched_steps))
     scalar.close()
     batched.close()
-    return statistics.median(rates["scalar"]), statistics.median(rates["batched"])
+    return tuple(statistics.median(r) if r else float("nan") for r in rates.values())
 
 
 def main() -> None:
@@ -89,11 +107,12 @@ def main() -> None:
     for env_id, kwargs in cases():
         name = env_id + (f" {kwargs}" if kwargs else "")
         try:
-            scalar, batched = measure(env_id, kwargs, a.num_envs, a.repeats, a.scalar_steps)
+            scalar, batched, stack = measure(env_id, kwargs, a.num_envs, a.repeats, a.scalar_steps)
         except Exception as exc:  # a domain whose module has not landed, or does not build
             skipped.append(f"- {name}: {type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}")
             continue
-        rows.append(f"| {name} | {scalar:,.0f} | {batched:,.0f} | {batched / scalar:,.0f}x |")
+        in_stack = "-" if np.isnan(stack) else f"{stack:,.0f} ({stack / scalar:,.0f}x)"
+        rows.append(f"| {name} | {scalar:,.0f} | {batched:,.0f} | {batched / scalar:,.0f}x | {in_stack} |")
         print(rows[-1], flush=True)
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, cwd=HERE)
     lines = [
@@ -107,8 +126,9 @@ def main() -> None:
         f"{a.num_envs:,} copies, at least {MIN_ENV_STEPS:,} env steps a timing, autoresets included"
         + (f"; pinned to core {a.cpu}" if a.cpu is not None else ""),
         "",
-        f"| env | scalar steps/s | batched steps/s ({a.num_envs:,} copies) | batched / scalar |",
-        "|---|---|---|---|",
+        f"| env | scalar steps/s | batched steps/s ({a.num_envs:,} copies) | batched / scalar "
+        "| batched, parameters stacked in one (K, N, m) array |",
+        "|---|---|---|---|---|",
         *rows,
     ]
     if skipped:
