@@ -188,6 +188,18 @@ DOMAIN_PRESETS: dict[tuple[str, str, tuple], DomainPreset] = {
         note="PPO's common settings: the tuned entropy weight was found on Platform's three actions.",
     ),
     ("hyar", HFO, ANY): _HYAR_HFO,
+    ("pasvg0", HFO, ANY): DomainPreset(
+        "tuned",
+        "tuned",
+        note="No published HFO settings (the paper runs PASVG(0) on Platform alone): the tuned preset, found on "
+        "Platform (benchmarks/pasvg_tuning.md); the paper's 'paper' preset is the other choice.",
+    ),
+    ("hsac", HFO, ANY): DomainPreset(
+        "tuned",
+        "tuned",
+        note="Delalleau et al.'s HFO settings (their 0.639 goals) were not read here: the "
+        "tuned preset, found on Platform (benchmarks/hsac_platform.md).",
+    ),
     ("pdqn", "pamdp/Goal-v0", ANY): _derived(
         "goal",
         "paper",
