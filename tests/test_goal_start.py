@@ -14,15 +14,17 @@ import torch
 import pamdp  # noqa: F401  (registers the envs)
 from pamdp.algos.domain_presets import MASSON_GOAL_START
 from pamdp.algos.pdqn import PDQN, PDQNConfig
+from pamdp.envs.goal.env import hard_goal_shot
 from pamdp.experiments.runner import RunSpec
 
 GOAL = "pamdp/Goal-v0"
+HARD_GOAL = "pamdp/HardGoal-v0"
 SMALL = {"num_envs": 1, "device": "cpu", "hidden_sizes": [16], "batch_size": 16, "learning_starts": 32}
 
 
-def goal_config(**settings) -> PDQNConfig:
-    """The config ``pamdp train pdqn --env pamdp/Goal-v0`` gets, with ``settings`` over it."""
-    return RunSpec("pdqn", GOAL, 10, settings=tuple(settings.items())).config()[2]
+def goal_config(env: str = GOAL, **settings) -> PDQNConfig:
+    """The config ``pamdp train pdqn --env ENV`` gets, with ``settings`` over it."""
+    return RunSpec("pdqn", env, 10, settings=tuple(settings.items())).config()[2]
 
 
 def masson_in_metres(state: dict) -> tuple[float, float, float]:
@@ -51,6 +53,22 @@ def test_the_goal_preset_starts_at_massons_kick_and_shots(seed):
     # The greedy action carries its own block of that start.
     a, params = model.predict(obs)
     assert params[a] == pytest.approx(h.to_env(a, model.actor.select(x[None], torch.tensor([a]))[0].numpy())[1][a])
+
+
+def test_the_hard_goal_preset_kicks_as_on_goal_and_shoots_inside_either_post():
+    model = PDQN(HARD_GOAL, goal_config(HARD_GOAL, **SMALL))
+    env = gym.make(HARD_GOAL)
+    obs, _ = env.reset(seed=3)
+    obs, *_ = env.step((0, (np.array([30.0, 0.0], np.float32), *(np.zeros(1, np.float32),) * 10)))
+    with torch.no_grad():
+        x = model.actor(torch.tensor(obs[None], dtype=torch.float32))[0].numpy()
+    kick_x, inside_upper, inside_lower = masson_in_metres(env.unwrapped.state)
+    h = model.hybrid
+    assert h.to_env(0, x[:2])[1][0][0] == pytest.approx(kick_x, abs=1e-4)
+    # Through the env's own shot mapping (spec 4.2), part j = (a - 1) % 5 of the mouth for a = 1..10.
+    aims = [hard_goal_shot((a - 1) % 5, h.to_env(a, x[1 + a : 2 + a])[1][a][0]) for a in range(1, 11)]
+    middles = [hard_goal_shot(j, 0.0) for j in (1, 2, 3)]
+    assert aims == pytest.approx([inside_lower, *middles, inside_upper] * 2, abs=1e-5)
 
 
 def test_the_passthrough_stays_fixed_while_the_actor_learns_and_round_trips(tmp_path):

@@ -31,6 +31,7 @@ __all__ = [
     "DOMAIN_PRESETS",
     "LARGE_K",
     "MASSON_GOAL_START",
+    "MASSON_HARD_GOAL_START",
     "domain_preset",
     "domain_presets_of",
     "when",
@@ -145,15 +146,16 @@ def _linear_map(n_obs: int, rows: tuple[tuple[float, dict[int, float]], ...]) ->
 # Goal script sets its passthrough layer (``initialise_params``, with ``scale_actions``). In metres it is Masson's
 # kick to x = Bx + 2.5 + 1.25 f14, y = (5/6) By + (5/3) f15 (the port reads only x: it kicks towards (x, x)),
 # and shots 1 m inside either post, y = +-6.01.
-MASSON_GOAL_START = _linear_map(
-    17,
-    (
-        (-0.375, {10: 0.5, 14: 0.0625}),
-        (0.0, {11: 5 / 6, 15: 1 / 9}),
-        (6.01 / 7.01, {}),
-        (-6.01 / 7.01, {}),
-    ),
-)
+_MASSON_KICK = ((-0.375, {10: 0.5, 14: 0.0625}), (0.0, {11: 5 / 6, 15: 1 / 9}))
+MASSON_GOAL_START = _linear_map(17, (*_MASSON_KICK, (6.01 / 7.01, {}), (-6.01 / 7.01, {})))
+
+# Masson's start carried over to Hard Goal (not published): kick-to as on Goal; the shots into the goal mouth's
+# outer parts (j = 0 and 4: actions 1, 6 and 5, 10) 1 m inside either post. Hard Goal maps a shot's p to
+# y = 7.010000228881836 q with q = p m_j + o_j, m_j = -0.2, o_0 = -0.8, o_4 = 0.8 (env spec 4.2), so p = (q - o_j) / m_j
+# for q = -+6.01 / 7.010000228881836; the three inner parts start at their middles (p = 0).
+_POST = 6.01 / 7.010000228881836
+_HARD_GOAL_SHOTS = ((-_POST + 0.8) / -0.2, 0.0, 0.0, 0.0, (_POST - 0.8) / -0.2)
+MASSON_HARD_GOAL_START = _linear_map(17, (*_MASSON_KICK, *((p, {}) for p in _HARD_GOAL_SHOTS * 2)))
 
 GOAL_NOTE = (
     "The parameter network starts from Masson's hand-set linear weights, as MP-DQN's Goal runs did "
@@ -161,6 +163,23 @@ GOAL_NOTE = (
     "random, the start later work reports MP-DQN failing from). Not reproduced: the script's reward scale 1/50 "
     "and the std 1e-5 of its output layers (the Q-network's is pamdp's default, the actor's starts at zero)."
 )
+
+_MPDQN_GOAL_SETTINGS = (
+    ("multi_pass", True, MPDQN_GOAL),
+    ("hidden_sizes", (256,), MPDQN_GOAL),
+    ("gamma", 0.95, MPDQN_GOAL),
+    ("batch_size", 128, MPDQN_GOAL),
+    ("q_lr", 1e-3, MPDQN_GOAL),
+    ("actor_lr", 1e-5, MPDQN_GOAL),
+    ("tau_q", 0.1, MPDQN_GOAL),
+    ("tau_actor", 0.001, MPDQN_GOAL),
+    ("epsilon_end", 0.01, MPDQN_GOAL),
+    ("epsilon_steps", 10_000, f"{MPDQN_GOAL}: 1000 episodes (assumed ~10 samples each)"),
+    ("buffer_size", 20_000, MPDQN_GOAL),
+    ("learning_starts", 128, MPDQN_GOAL),
+    ("grad_clip", 1.0, MPDQN_GOAL),
+)
+"""MP-DQN's Goal script's settings over P-DQN's ``paper`` preset (Goal's and Hard Goal's presets)."""
 
 # Hard Move's networks for its 2^n actions.
 _HARD_MOVE_Q = (
@@ -204,23 +223,20 @@ DOMAIN_PRESETS: dict[tuple[str, str, tuple], DomainPreset] = {
         "goal",
         "paper",
         "MP-DQN's own Goal settings. " + GOAL_NOTE,
-        ("multi_pass", True, MPDQN_GOAL),
-        ("hidden_sizes", (256,), MPDQN_GOAL),
-        ("gamma", 0.95, MPDQN_GOAL),
-        ("batch_size", 128, MPDQN_GOAL),
-        ("q_lr", 1e-3, MPDQN_GOAL),
-        ("actor_lr", 1e-5, MPDQN_GOAL),
-        ("tau_q", 0.1, MPDQN_GOAL),
-        ("tau_actor", 0.001, MPDQN_GOAL),
-        ("epsilon_end", 0.01, MPDQN_GOAL),
-        ("epsilon_steps", 10_000, f"{MPDQN_GOAL}: 1000 episodes (assumed ~10 samples each)"),
-        ("buffer_size", 20_000, MPDQN_GOAL),
-        ("learning_starts", 128, MPDQN_GOAL),
-        ("grad_clip", 1.0, MPDQN_GOAL),
+        *_MPDQN_GOAL_SETTINGS,
         ("param_passthrough", MASSON_GOAL_START, f"{MPDQN_GOAL}: Masson's initial weights"),
     ),
-    ("pdqn", "pamdp/HardGoal-v0", ANY): _mpdqn_hybrid(
-        "hard_goal", "MP-DQN's Goal settings do not apply (ten actions); the tuned preset with multi-pass."
+    ("pdqn", "pamdp/HardGoal-v0", ANY): _derived(
+        "hard_goal",
+        "paper",
+        "MP-DQN's Goal settings with Masson's start carried over to Hard Goal's shots (MASSON_HARD_GOAL_START; "
+        "not published: HyAR's P-DQN on Hard Goal started at random and scored 0.0). " + GOAL_NOTE,
+        *_MPDQN_GOAL_SETTINGS,
+        (
+            "param_passthrough",
+            MASSON_HARD_GOAL_START,
+            "Masson's Goal weights, shots aimed as his (measured: benchmarks/hard_goal_start.md)",
+        ),
     ),
     ("pdqn", "pamdp/CatchPoint-v0", ANY): _mpdqn_hybrid("catch_point", "HyAR's P-DQN settings were not read here."),
     ("pdqn", HARD_MOVE, ANY): _mpdqn_hybrid(
