@@ -144,6 +144,18 @@ def test_gauss_newton_and_double_backprop_take_the_same_step(estimator):
     torch.testing.assert_close(steps[0], steps[1], atol=1e-5 * float(steps[1].abs().max()), rtol=0)
 
 
+def test_an_update_without_a_direction_is_logged_as_skipped_not_as_a_failed_line_search():
+    """Zero advantages and no entropy bonus: the surrogate's gradient is exactly zero, conjugate gradients return
+    the zero direction, and the policy stays as it is without a line search (catch_point.md: a collapsed pi_d)."""
+    model = PATRPO("pamdp/Platform-v0", PATRPOConfig.from_dict({"entropy_coef": 0.0}, base=SMALL))
+    obs, a, x, adv = float64_batch(model, 200)[:4]
+    before = flat_params(list(model.policy.parameters()))
+    stats = model._update_policy(obs, a, x, torch.zeros_like(adv))
+    assert stats["train/update_skipped"] == 1.0 and stats["train/backtracks"] == 0.0 and stats["train/kl"] == 0.0
+    assert torch.equal(flat_params(list(model.policy.parameters())), before)
+    assert model._update_policy(obs, a, x, adv)["train/update_skipped"] == 0.0
+
+
 def test_save_load_predict_round_trip(tmp_path):
     model = PATRPO("pamdp/Platform-v0", SMALL)
     model.learn(1000, progress_bar=False)

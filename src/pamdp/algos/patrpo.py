@@ -225,12 +225,17 @@ class PATRPO(Algorithm):
         fvp = self._fisher_vector_product(obs, a, x, old, mask)
         direction = conjugate_gradient(fvp, g, cfg.cg_iters)
         shs = float(direction @ fvp(direction))
-        stats = {"train/entropy": float(old.entropy().mean()), "train/grad_norm": float(g.norm())}
-        if not (np.isfinite(shs) and shs > 0):
+        stats = {
+            "train/entropy": float(old.entropy().mean()),
+            "train/grad_norm": float(g.norm()),
+            "train/param_std": float(self.policy.log_std.detach().exp()[self.policy.mask].mean()),
+        }
+        if not (np.isfinite(shs) and shs > 0):  # no direction (a vanishing gradient): no step, no line search
             stats.update(
                 {
+                    "train/update_skipped": 1.0,
                     "train/line_search_success": 0.0,
-                    "train/backtracks": float(cfg.max_backtracks),
+                    "train/backtracks": 0.0,
                     "losses/surrogate_improvement": 0.0,
                     "train/kl": 0.0,
                 }
@@ -245,12 +250,12 @@ class PATRPO(Algorithm):
             kl_after = float(kl_divergence(old, after, "chain_analytic").mean())
         stats.update(
             {
+                "train/update_skipped": 0.0,
                 "train/line_search_success": float(result.success),
                 "train/backtracks": float(result.backtracks),
                 "losses/surrogate_improvement": result.improvement,
                 "train/kl": kl_after,
                 "train/kl_estimate": result.kl,
-                "train/param_std": float(self.policy.log_std.detach().exp()[self.policy.mask].mean()),
             }
         )
         return stats
