@@ -73,7 +73,7 @@ def write(exp, arms: dict, out_root: str, command: str) -> None:
         f"- date: {dt.datetime.now().isoformat(timespec='minutes')} (rewritten after every finished run)",
         f"- machine: {machine()}",
         "- each arm with the preset its `--env` picks unless named, `action_mask = true` unless the label says "
-        "\"no mask\" ([hfo_learning.toml](hfo_learning.toml)); goal rate and steps to goal: 1000 greedy episodes "
+        '"no mask" ([hfo_learning.toml](hfo_learning.toml)); goal rate and steps to goal: 1000 greedy episodes '
         "of each seed's final model",
         "",
         "| arm | samples | seeds done | goal rate in steps, per seed | median goal rate | median steps to goal "
@@ -118,6 +118,7 @@ def main() -> None:
     command = "python " + " ".join(sys.argv)
     record = lambda arms: write(exp, arms, a.out, command)  # noqa: E731
     seed_by_seed(exp, labels, seeds, a.out, record, a.workers, train=not a.record_only)
+
 
 if __name__ == "__main__":
     main()

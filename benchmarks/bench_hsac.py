@@ -93,5 +93,6 @@ def main() -> None:
     command = "python " + " ".join(sys.argv)
     seed_by_seed(exp, forms, seeds, a.out, lambda arms: write(exp, arms, command))
 
+
 if __name__ == "__main__":
     main()

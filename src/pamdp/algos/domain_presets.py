@@ -238,6 +238,15 @@ DOMAIN_PRESETS: dict[tuple[str, str, tuple], DomainPreset] = {
             "Masson's Goal weights, shots aimed as his (measured: benchmarks/hard_goal_start.md)",
         ),
     ),
+    ("patrpo", "pamdp/CatchPoint-v0", ANY): _derived(
+        "catch_point",
+        "tuned",
+        "The tuned preset with less parameter noise and a larger entropy weight: at the tuned noise even the best "
+        "heading returns less than ending the episode with 11 failed catches, so pi_d collapses onto catch "
+        "(benchmarks/catch_point.md).",
+        ("init_log_std", -1.5, "measured: benchmarks/catch_point.md (issue 26)"),
+        ("entropy_coef", 0.05, "measured: benchmarks/catch_point.md (issue 26)"),
+    ),
     ("pdqn", "pamdp/CatchPoint-v0", ANY): _mpdqn_hybrid("catch_point", "HyAR's P-DQN settings were not read here."),
     ("pdqn", HARD_MOVE, ANY): _mpdqn_hybrid(
         "hard_move", "HyAR's P-DQN settings were not read here; 2^n actions, so a wider Q-network.", *_HARD_MOVE_Q
