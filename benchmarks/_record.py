@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 import csv
 import datetime as dt
 import json
@@ -101,6 +102,25 @@ def seed_by_seed(
             run_all([(spec, str(out)) for spec, out in todo], workers=workers)
             write(arms)
     return arms
+
+
+def seed_by_seed_main(doc: str, exp, write) -> None:
+    """The command line of a benchmark made with :func:`seed_by_seed`: ``--runs`` (comma-separated arm labels,
+    default every arm of ``exp``), ``--seeds`` (default ``exp``'s), ``--workers``, ``--out`` (the runs' root,
+    default ``results/bench``) and ``--record-only`` (train nothing: write the record from the runs under
+    ``--out``); ``write(arms, out_root, command)`` rewrites the record."""
+    p = argparse.ArgumentParser(description=doc, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--runs", default=None, help="comma-separated arm labels (default: all)")
+    p.add_argument("--seeds", default=None, help="comma-separated seeds (default: the experiment's)")
+    p.add_argument("--workers", type=int, default=1, help="runs side by side in processes")
+    p.add_argument("--out", default="results/bench", help="root of the runs")
+    p.add_argument("--record-only", action="store_true", help="train nothing, write the record")
+    a = p.parse_args()
+    seeds = [int(s) for s in a.seeds.split(",")] if a.seeds else list(exp.seeds)
+    labels = a.runs.split(",") if a.runs else [run["label"] for run in exp.runs]
+    command = "python " + " ".join(sys.argv)
+    record = lambda arms: write(arms, a.out, command)  # noqa: E731
+    seed_by_seed(exp, labels, seeds, a.out, record, a.workers, train=not a.record_only)
 
 
 def run_and_record(

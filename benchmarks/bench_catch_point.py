@@ -13,16 +13,14 @@ keeps its hand-written notes.
 
 from __future__ import annotations
 
-import argparse
 import csv
 import datetime as dt
 import json
 import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
-from _record import HERE, machine, seed_by_seed, write_record
+from _record import HERE, machine, seed_by_seed_main, write_record
 
 from pamdp.algos.logger import success_of
 from pamdp.experiments import Experiment
@@ -111,18 +109,5 @@ def write(arms: dict, command: str) -> None:
     write_record(lines, RECORD)
 
 
-def main() -> None:
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--runs", default=None, help="comma-separated arm labels (default: all)")
-    p.add_argument("--seeds", default=None)
-    p.add_argument("--out", default="results/bench")
-    p.add_argument("--record-only", action="store_true", help="train nothing, write the record")
-    a = p.parse_args()
-    seeds = [int(s) for s in a.seeds.split(",")] if a.seeds else list(EXPERIMENT.seeds)
-    labels = a.runs.split(",") if a.runs else list(ARMS)
-    command = "python " + " ".join(sys.argv)
-    seed_by_seed(EXPERIMENT, labels, seeds, a.out, lambda arms: write(arms, command), train=not a.record_only)
-
-
 if __name__ == "__main__":
-    main()
+    seed_by_seed_main(__doc__, EXPERIMENT, lambda arms, out, command: write(arms, command))

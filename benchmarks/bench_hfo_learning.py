@@ -12,17 +12,15 @@ runs already under DIR (``pamdp reproduce benchmarks/hfo_learning.toml --out DIR
 
 from __future__ import annotations
 
-import argparse
 import csv
 import datetime as dt
 import json
 import shutil
 import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
-from _record import HERE, machine, seed_by_seed, write_record
+from _record import HERE, machine, seed_by_seed_main, write_record
 
 from pamdp.algos.logger import success_of
 from pamdp.experiments import load_experiment
@@ -104,21 +102,6 @@ def write(exp, arms: dict, out_root: str, command: str) -> None:
     write_record(lines, RECORD)
 
 
-def main() -> None:
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--runs", default=None, help="comma-separated arm labels (default: all)")
-    p.add_argument("--seeds", default=None)
-    p.add_argument("--workers", type=int, default=1)
-    p.add_argument("--out", default="results/bench")
-    p.add_argument("--record-only", action="store_true", help="train nothing, write the record")
-    a = p.parse_args()
-    exp = load_experiment(HERE / "hfo_learning.toml")
-    seeds = [int(s) for s in a.seeds.split(",")] if a.seeds else list(exp.seeds)
-    labels = a.runs.split(",") if a.runs else [r["label"] for r in exp.runs]
-    command = "python " + " ".join(sys.argv)
-    record = lambda arms: write(exp, arms, a.out, command)  # noqa: E731
-    seed_by_seed(exp, labels, seeds, a.out, record, a.workers, train=not a.record_only)
-
-
 if __name__ == "__main__":
-    main()
+    exp = load_experiment(HERE / "hfo_learning.toml")
+    seed_by_seed_main(__doc__, exp, lambda arms, out, command: write(exp, arms, out, command))

@@ -1,6 +1,7 @@
 """Hybrid SAC on Platform, flat and hierarchical forms (hsac_platform.toml): 5 seeds x 300k samples each.
 
-    taskset -c 0 python benchmarks/bench_hsac.py [--seeds 0,1,2,3,4] [--forms flat,hierarchical] [--out DIR]
+    taskset -c 0 python benchmarks/bench_hsac.py [--seeds 0,1,2,3,4] [--runs flat,hierarchical] [--out DIR]
+        [--record-only]
 
 Runs one at a time, seed by seed, the two forms alternating (so that a cut-short invocation still compares the
 forms), and rewrites benchmarks/hsac_platform.md after each seed's runs: the greedy return of each finished seed (1000
@@ -11,16 +12,14 @@ continues the benchmark; the record keeps its hand-written notes.
 
 from __future__ import annotations
 
-import argparse
 import csv
 import datetime as dt
 import json
 import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
-from _record import HERE, machine, seed_by_seed, write_record
+from _record import HERE, machine, seed_by_seed_main, write_record
 
 from pamdp.experiments import load_experiment
 from pamdp.experiments.runner import is_finished
@@ -81,18 +80,6 @@ def write(exp, arms: dict, command: str) -> None:
     write_record(lines, RECORD)
 
 
-def main() -> None:
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--seeds", default=None)
-    p.add_argument("--forms", default="flat,hierarchical")
-    p.add_argument("--out", default="results/bench")
-    a = p.parse_args()
-    exp = load_experiment(HERE / "hsac_platform.toml")
-    seeds = [int(s) for s in a.seeds.split(",")] if a.seeds else list(exp.seeds)
-    forms = a.forms.split(",")
-    command = "python " + " ".join(sys.argv)
-    seed_by_seed(exp, forms, seeds, a.out, lambda arms: write(exp, arms, command))
-
-
 if __name__ == "__main__":
-    main()
+    exp = load_experiment(HERE / "hsac_platform.toml")
+    seed_by_seed_main(__doc__, exp, lambda arms, out, command: write(exp, arms, command))
