@@ -44,6 +44,20 @@ def machine() -> str:
 NOTES_HEADING = "## Notes (written by hand"
 
 
+def record_head(title: str, command: str, rewritten: bool = False) -> list[str]:
+    """A record's first lines: its title, the command with the commit it ran at, the date and the machine
+    (``rewritten``: the date says the record is rewritten after every finished run)."""
+    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, cwd=HERE)
+    date = dt.datetime.now().isoformat(timespec="minutes") + (" (rewritten after every finished run)" * rewritten)
+    return [
+        f"# {title}",
+        "",
+        f"- command: `{command}` (commit {commit.stdout.strip()})",
+        f"- date: {date}",
+        f"- machine: {machine()}",
+    ]
+
+
 def run_together(commands: list[list[str]]) -> list[dict]:
     """Start the worker processes ``commands`` and let them time together: each prints ``ready`` once built and
     warmed up, starts on a line ``go`` on its stdin, and ends by printing its result as one JSON line."""
@@ -168,15 +182,7 @@ def run_and_record(
         with open(Path(o.out) / "progress.csv", newline="") as f:
             seconds = sum(epoch_seconds(r) for r in csv.DictReader(f))
         per_run.setdefault(o.spec.label, []).append(seconds)
-    commit = subprocess.run(
-        ["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, cwd=HERE
-    ).stdout.strip()
-    lines = [
-        f"# {title}",
-        "",
-        f"- command: `python {' '.join(sys.argv)}` (commit {commit})",
-        f"- date: {dt.datetime.now().isoformat(timespec='minutes')}",
-        f"- machine: {machine()}",
+    lines = record_head(title, f"python {' '.join(sys.argv)}") + [
         f"- {len(jobs)} runs of {jobs[0][0].total_steps:,} steps, {workers} processes at a time"
         + "; this invocation took "
         f"{wall / 60:.1f} min (runs finished by an earlier, interrupted invocation are skipped, partial ones resumed)",

@@ -14,13 +14,11 @@ keeps its hand-written notes.
 from __future__ import annotations
 
 import csv
-import datetime as dt
 import json
-import subprocess
 from pathlib import Path
 
 import numpy as np
-from _record import HERE, machine, seed_by_seed_main, write_record
+from _record import HERE, record_head, seed_by_seed_main, write_record
 
 from pamdp.algos.logger import success_of
 from pamdp.experiments import Experiment
@@ -85,13 +83,7 @@ def _arm_row(label: str, jobs) -> str:
 
 
 def write(arms: dict, command: str) -> None:
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, cwd=HERE)
-    lines = [
-        f"# {EXPERIMENT.description}",
-        "",
-        f"- command: `{command}` (commit {commit.stdout.strip()})",
-        f"- date: {dt.datetime.now().isoformat(timespec='minutes')} (rewritten after every finished run)",
-        f"- machine: {machine()}",
+    lines = record_head(EXPERIMENT.description, command, rewritten=True) + [
         f"- `pamdp train patrpo --env {ENV} --preset tuned --seed N --total-steps S [--SETTING VALUE]`, one run at a "
         "time beside other long runs; success rate and return: 1000 greedy episodes of each seed's final model "
         "(`pamdp evaluate RUN --episodes 1000 --json` gives the same figures)",

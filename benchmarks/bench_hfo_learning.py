@@ -13,14 +13,12 @@ runs already under DIR (``pamdp reproduce benchmarks/hfo_learning.toml --out DIR
 from __future__ import annotations
 
 import csv
-import datetime as dt
 import json
 import shutil
-import subprocess
 from pathlib import Path
 
 import numpy as np
-from _record import HERE, machine, seed_by_seed_main, write_record
+from _record import HERE, record_head, seed_by_seed_main, write_record
 
 from pamdp.algos.logger import success_of
 from pamdp.experiments import load_experiment
@@ -63,13 +61,7 @@ def _arm_row(label: str, jobs) -> str:
 
 
 def write(exp, arms: dict, out_root: str, command: str) -> None:
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, cwd=HERE)
-    lines = [
-        f"# {exp.description}",
-        "",
-        f"- command: `{command}` (commit {commit.stdout.strip()})",
-        f"- date: {dt.datetime.now().isoformat(timespec='minutes')} (rewritten after every finished run)",
-        f"- machine: {machine()}",
+    lines = record_head(exp.description, command, rewritten=True) + [
         "- each arm with the preset its `--env` picks unless named, `action_mask = true` unless the label says "
         '"no mask" ([hfo_learning.toml](hfo_learning.toml)); goal rate and steps to goal: 1000 greedy episodes '
         "of each seed's final model",

@@ -13,13 +13,11 @@ continues the benchmark; the record keeps its hand-written notes.
 from __future__ import annotations
 
 import csv
-import datetime as dt
 import json
-import subprocess
 from pathlib import Path
 
 import numpy as np
-from _record import HERE, machine, seed_by_seed_main, write_record
+from _record import HERE, record_head, seed_by_seed_main, write_record
 
 from pamdp.experiments import load_experiment
 from pamdp.experiments.runner import is_finished
@@ -58,13 +56,7 @@ def _arm_lines(label: str, jobs) -> list[str]:
 
 
 def write(exp, arms: dict, command: str) -> None:
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, cwd=HERE)
-    lines = [
-        f"# {exp.description}",
-        "",
-        f"- command: `{command}` (commit {commit.stdout.strip()})",
-        f"- date: {dt.datetime.now().isoformat(timespec='minutes')} (rewritten after every finished run)",
-        f"- machine: {machine()}",
+    lines = record_head(exp.description, command, rewritten=True) + [
         f"- {exp.total_steps:,} samples per run, one run at a time; greedy return: 1000 episodes of the final model",
         "",
         "| form | seeds done | greedy return per seed | median | mean +- std | CPU ms per sample |",
