@@ -1,37 +1,49 @@
 #!/usr/bin/env bash
-# The long learning runs still owed to issue 7, in the order of what each CPU-hour buys.
+# The long learning runs still owed to issues 26 and 27, as two resumable queues, one core each.
 #
 #   nohup benchmarks/backlog.sh > backlog.log 2>&1 &      # at the start of a session, from the repo root
 #
 # Every step resumes where an earlier, interrupted invocation stopped (finished runs are skipped, partial
 # ones continue from their last checkpoint; the off-policy runs keep their replay buffer in it), so a
-# session simply starts this again. Outputs go to $PAMDP_RUNS (default /root/pamdp-runs), outside the work
-# tree; records and figures land in benchmarks/ and the experiments' directories, to be committed by hand.
-# A session that starts on a new machine has no $PAMDP_RUNS: everything starts from scratch.
+# session simply starts this again. Outputs go outside the work tree: the soccer figure's runs under
+# $SOCCER_OUT, the benchmark suite's under $SUITE_OUT, HFO's other algorithms under $HFO_OUT (defaults under
+# $PAMDP_RUNS, itself /root/pamdp-runs by default). On 2026-12-02 they were /work/runs/soccer/results,
+# /work/runs/suite/results and /work/runs/hfo/results: set the three variables to go on with those runs.
+# A session that starts on a new machine has none of them: everything starts from scratch.
 #
-# Costs on the 2-core Intel Xeon, measured 2026-11-29/30 (offpolicy_speed.md, denormals.md, denormals_hfo.md),
-# per run with another run beside it:
-#   done: the whole platform figure (all three arms, 2026-11-30), step-size, kl-estimators, PADDPG with Hausknecht &
-#         Stone's preset, soccer's PATRPO seed 2 (records and figures committed; docs/results.md has the commands)
-#   1. the platform figure again (minutes; skips every finished run)
-#   2. soccer's PATRPO seeds 0 and 1 again, side by side: ~50 s of CPU an epoch, ~1.4 h a run (2026-11-30)
-#   3. soccer's PADDPG arm (3.3 ms a sample on an idle core, ~4.6 h of CPU a run, two runs at a time)
-#                                                                                  ~14 core-hours
-# One queue, in that order, on both cores.
+# Costs on this 2-core machine (CPU time a sample; docs/results.md, benchmarks/hfo_learning.md):
+#   soccer: PADDPG 3.3 ms (~4.6 h a run, 3 seeds), PATRPO ~1.4 h a run (3 seeds: their directories were lost
+#           with earlier machines, their results are recorded)                          ~18 core-hours
+#   suite:  HyAR-TD3 ~2.5 ms (~0.7 h per 1M), MP-DQN on Goal and Hard Goal 9-15 ms (45-77 min per 300k),
+#           P-DQN hard_move_large 3.5-6 ms (1-1.7 h per 1M)                             ~12 core-hours
+#   HFO:    PAPPO 0.46 ms (~40 min a run)
 set -euo pipefail
 cd "$(dirname "$0")"
 RUNS=${PAMDP_RUNS:-/root/pamdp-runs}
+SOCCER_OUT=${SOCCER_OUT:-$RUNS/repro}
+SUITE_OUT=${SUITE_OUT:-$RUNS/suite}
+HFO_OUT=${HFO_OUT:-$RUNS/hfo}
 
-# All in one function, which bash reads whole before running any of it: editing this file while it runs
+# All in functions, which bash reads whole before running any of them: editing this file while it runs
 # changes nothing in the running copy.
-main() {
-    pamdp reproduce platform --workers 2 --out "$RUNS/repro"  # every run is done: draws the figure again (issue 7)
-    # Soccer's PATRPO seeds 0 and 1 again: their run directories went with an earlier machine (their results are in
-    # docs/results.md), and the figure needs their curves beside seed 2's (done 2026-11-30). ~1.4 h a run.
-    pamdp reproduce soccer --runs PATRPO --workers 2 --out "$RUNS/repro"
-    # PADDPG's three seeds, two at a time (~4.6 h of CPU a run; seed stacking was removed with issue 28).
-    pamdp reproduce soccer --runs PADDPG --workers 2 --out "$RUNS/repro"
+soccer() {  # issue 27: the paper's soccer figure, one run at a time
+    for seed in 0 1 2; do pamdp reproduce soccer --runs PADDPG --seeds "$seed" --out "$SOCCER_OUT"; done
+    for seed in 0 1 2; do pamdp reproduce soccer --runs PATRPO --seeds "$seed" --out "$SOCCER_OUT"; done
 }
 
-main "$@"
+suite() {  # issue 26: the suite's missing cells, the cheapest first, then the other seeds; then HFO's PAPPO
+    local s="pamdp reproduce benchmark-suite --out $SUITE_OUT"
+    for run in Catch_Point Hard_Move_n=10 Hard_Move_n=6 Hard_Move_n=4 Hard_Goal Goal; do
+        $s --seeds 0 --runs "HyAR-TD3_on_$run"
+    done
+    for seed in 1 2 0; do $s --seeds "$seed" --runs MP-DQN_on_Goal; done
+    for seed in 1 2; do $s --seeds "$seed" --runs MP-DQN_on_Hard_Goal; done
+    $s --seeds 0 --runs P-DQN_on_Hard_Move_n=8,P-DQN_on_Hard_Move_n=10
+    $s --seeds 1,2 --runs HyAR-TD3_on_Catch_Point,HyAR-TD3_on_Hard_Move_n=8
+    for seed in 1 2; do pamdp reproduce hfo_learning.toml --runs PAPPO --seeds "$seed" --out "$HFO_OUT"; done
+}
+
+soccer &
+suite &
+wait
 exit
