@@ -58,6 +58,27 @@ def record_head(title: str, command: str, rewritten: bool = False) -> list[str]:
     ]
 
 
+def progress_rows(run: Path) -> list[dict]:
+    """A run directory's ``progress.csv`` rows (none before its first epoch)."""
+    if not (run / "progress.csv").exists():
+        return []
+    with open(run / "progress.csv", newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def cpu_ms_per_sample(rows: list[dict]) -> float:
+    """A run's CPU time in training (its greedy evaluations left out) per sample, in ms, from its rows."""
+    return sum(epoch_seconds(r) for r in rows) / float(rows[-1]["time/total_timesteps"]) * 1e3
+
+
+def where_unfinished(spec, rows: list[dict], metric: str | None = None, digits: int = 2, unit: str = "") -> str:
+    """``seed N at S[unit][, greedy V (100 episodes)]``: how far an unfinished run is, with its last greedy
+    evaluation of ``metric`` (a progress.csv column) if it has one."""
+    evals = [r for r in rows if metric and r.get(metric)]
+    last = f", greedy {float(evals[-1][metric]):.{digits}f} (100 episodes)" if evals else ""
+    return f"seed {spec.seed} at {int(float(rows[-1]['time/total_timesteps'])):,}{unit}{last}"
+
+
 def run_together(commands: list[list[str]]) -> list[dict]:
     """Start the worker processes ``commands`` and let them time together: each prints ``ready`` once built and
     warmed up, starts on a line ``go`` on its stdin, and ends by printing its result as one JSON line."""

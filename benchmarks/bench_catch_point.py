@@ -13,12 +13,10 @@ keeps its hand-written notes.
 
 from __future__ import annotations
 
-import csv
 import json
-from pathlib import Path
 
 import numpy as np
-from _record import HERE, record_head, seed_by_seed_main, write_record
+from _record import HERE, progress_rows, record_head, seed_by_seed_main, where_unfinished, write_record
 
 from pamdp.algos.logger import success_of
 from pamdp.experiments import Experiment
@@ -54,24 +52,17 @@ EXPERIMENT = Experiment(
 )
 
 
-def _rows(run: Path) -> list[dict]:
-    if not (run / "progress.csv").exists():
-        return []
-    with open(run / "progress.csv", newline="") as f:
-        return list(csv.DictReader(f))
-
-
 def _arm_row(label: str, jobs) -> str:
     """One line of the table: the finished seeds' success rates, their median, the median greedy return and CPU
     minutes of a run, and how far the unfinished seeds are."""
     done, partial = [], []
     for spec, out in jobs:
-        rows = _rows(out)
+        rows = progress_rows(out)
         if is_finished(out, spec):
             result = json.loads((out / "evaluation.json").read_text())
             done.append((spec.seed, success_of(result)[0], result["mean_return"], sum(map(epoch_seconds, rows))))
         elif rows:
-            partial.append(f"seed {spec.seed} at {int(float(rows[-1]['time/total_timesteps'])):,}")
+            partial.append(where_unfinished(spec, rows))
     settings = ", ".join(f"{k} = {v}" for k, v in ARMS[label][0].items()) or "(the preset's)"
     per_seed = ", ".join(f"{s}: {r:.3f}" for s, r, _, _ in done) or "-"
     rate, ret, cpu = (np.median([d[i] for d in done]) if done else None for i in (1, 2, 3))

@@ -12,28 +12,27 @@ runs already under DIR (``pamdp reproduce benchmarks/hfo_learning.toml --out DIR
 
 from __future__ import annotations
 
-import csv
 import json
 import shutil
 from pathlib import Path
 
 import numpy as np
-from _record import HERE, record_head, seed_by_seed_main, write_record
+from _record import (
+    HERE,
+    cpu_ms_per_sample,
+    progress_rows,
+    record_head,
+    seed_by_seed_main,
+    where_unfinished,
+    write_record,
+)
 
 from pamdp.algos.logger import success_of
 from pamdp.experiments import load_experiment
 from pamdp.experiments.report import write_report
 from pamdp.experiments.runner import is_finished
-from pamdp.experiments.status import epoch_seconds
 
 RECORD = HERE / "hfo_learning.md"
-
-
-def _rows(run: Path) -> list[dict]:
-    if not (run / "progress.csv").exists():
-        return []
-    with open(run / "progress.csv", newline="") as f:
-        return list(csv.DictReader(f))
 
 
 def _arm_row(label: str, jobs) -> str:
@@ -41,15 +40,13 @@ def _arm_row(label: str, jobs) -> str:
     where the unfinished seeds stand."""
     done, costs, partial = [], [], []
     for spec, out in jobs:
-        rows = _rows(out)
+        rows = progress_rows(out)
         if is_finished(out, spec):
             rate, steps = success_of(json.loads((out / "evaluation.json").read_text()))
             done.append((spec.seed, rate, steps))
-            costs.append(sum(epoch_seconds(r) for r in rows) / float(rows[-1]["time/total_timesteps"]) * 1e3)
+            costs.append(cpu_ms_per_sample(rows))
         elif rows:
-            evals = [r for r in rows if r.get("eval/success_rate")]
-            last = f", greedy {float(evals[-1]['eval/success_rate']):.2f} (100 episodes)" if evals else ""
-            partial.append(f"seed {spec.seed} at {int(float(rows[-1]['time/total_timesteps'])):,}{last}")
+            partial.append(where_unfinished(spec, rows, "eval/success_rate"))
     per_seed = ", ".join(f"{s}: {r:.3f} in {n:.1f}" if n else f"{s}: {r:.3f}" for s, r, n in done)
     rates = [r for _, r, _ in done]
     steps = [n for _, _, n in done if n]
@@ -77,7 +74,7 @@ def write(exp, arms: dict, out_root: str, command: str) -> None:
         "median over the finished seeds. Unfinished: each started seed's samples so far and its last greedy "
         "evaluation.",
     ]
-    started = [out.parent for jobs in arms.values() for _, out in jobs if _rows(out)]
+    started = [out.parent for jobs in arms.values() for _, out in jobs if progress_rows(out)]
     if started:
         report = write_report(list(dict.fromkeys(started)), Path(out_root) / exp.name / "report-hfo_learning")
         for key, name in (("greedy_success_png", "greedy goal rate"), ("success_png", "training goal rate")):

@@ -12,40 +12,35 @@ continues the benchmark; the record keeps its hand-written notes.
 
 from __future__ import annotations
 
-import csv
 import json
-from pathlib import Path
 
 import numpy as np
-from _record import HERE, record_head, seed_by_seed_main, write_record
+from _record import (
+    HERE,
+    cpu_ms_per_sample,
+    progress_rows,
+    record_head,
+    seed_by_seed_main,
+    where_unfinished,
+    write_record,
+)
 
 from pamdp.experiments import load_experiment
 from pamdp.experiments.runner import is_finished
-from pamdp.experiments.status import epoch_seconds
 
 RECORD = HERE / "hsac_platform.md"
-
-
-def _progress(run: Path) -> list[dict]:
-    if not (run / "progress.csv").exists():
-        return []
-    with open(run / "progress.csv", newline="") as f:
-        return list(csv.DictReader(f))
 
 
 def _arm_lines(label: str, jobs) -> list[str]:
     """One row of the table: the finished seeds' greedy returns, their median and mean, the cost per sample."""
     returns, costs, partial = [], [], []
     for spec, out in jobs:
-        rows = _progress(out)
+        rows = progress_rows(out)
         if is_finished(out, spec):
             returns.append((spec.seed, json.loads((out / "evaluation.json").read_text())["mean_return"]))
-            steps = float(rows[-1]["time/total_timesteps"])
-            costs.append(sum(epoch_seconds(r) for r in rows) / steps * 1e3)
+            costs.append(cpu_ms_per_sample(rows))
         elif rows:
-            evals = [r for r in rows if r.get("eval/mean_return")]
-            last = f", greedy {float(evals[-1]['eval/mean_return']):.3f} (100 episodes)" if evals else ""
-            partial.append(f"seed {spec.seed} at {int(float(rows[-1]['time/total_timesteps'])):,} samples{last}")
+            partial.append(where_unfinished(spec, rows, "eval/mean_return", 3, " samples"))
     values = np.array([r for _, r in returns])
     per_seed = ", ".join(f"{s}: {r:.3f}" for s, r in returns) or "-"
     median = f"{np.median(values):.3f}" if len(values) else "-"
