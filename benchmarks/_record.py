@@ -200,9 +200,7 @@ def run_and_record(
         shutil.copy(report["greedy_png"], greedy_figure)
     per_run = {}  # training time of each run from its own log, so that resumed and skipped runs count too
     for o in outcomes:
-        with open(Path(o.out) / "progress.csv", newline="") as f:
-            seconds = sum(epoch_seconds(r) for r in csv.DictReader(f))
-        per_run.setdefault(o.spec.label, []).append(seconds)
+        per_run.setdefault(o.spec.label, []).append(sum(map(epoch_seconds, progress_rows(Path(o.out)))))
     lines = record_head(title, f"python {' '.join(sys.argv)}") + [
         f"- {len(jobs)} runs of {jobs[0][0].total_steps:,} steps, {workers} processes at a time"
         + "; this invocation took "

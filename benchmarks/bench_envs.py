@@ -13,10 +13,8 @@ and why.
 from __future__ import annotations
 
 import argparse
-import datetime as dt
 import os
 import statistics
-import subprocess
 import sys
 import time
 from pathlib import Path
@@ -28,7 +26,7 @@ import pamdp  # noqa: F401  (registers the envs)
 from pamdp.envs import _REGISTRATIONS
 
 sys.path.insert(0, str(Path(__file__).parent))
-from _record import machine, write_record  # noqa: E402
+from _record import record_head, write_record  # noqa: E402
 
 HERE = Path(__file__).parent
 SUITE_KWARGS = {"pamdp/HardMove-v0": [{"n": n} for n in (4, 6, 8, 10)]}
@@ -78,10 +76,11 @@ def measure(env_id: str, kwargs: dict, num_envs: int, repeats: int, scalar_steps
     scalar_rate(scalar, actions, 200)  # Numba's compilation and the first resets, untimed
     batched_rate(batched, batched_actions, 5)
     stacked_actions = [stacked(action) for action in batched_actions]
-    try:
-        batched_rate(batched, stacked_actions, 5) if stacked_actions[0] is not None else None
-    except ValueError:  # the env reads only a tuple of boxes
-        stacked_actions = [None]
+    if stacked_actions[0] is not None:
+        try:
+            batched_rate(batched, stacked_actions, 5)
+        except ValueError:  # the env reads only a tuple of boxes
+            stacked_actions = [None]
     rates = {"scalar": [], "batched": [], "stacked": []}
     for _ in range(repeats):
         rates["scalar"].append(scalar_rate(scalar, actions, scalar_steps))
@@ -114,13 +113,8 @@ def main() -> None:
         in_stack = "-" if np.isnan(stack) else f"{stack:,.0f} ({stack / scalar:,.0f}x)"
         rows.append(f"| {name} | {scalar:,.0f} | {batched:,.0f} | {batched / scalar:,.0f}x | {in_stack} |")
         print(rows[-1], flush=True)
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, cwd=HERE)
-    lines = [
-        "# Environment speed: steps per CPU-second, scalar and batched",
-        "",
-        f"- command: `python {' '.join(sys.argv)}` (commit {commit.stdout.strip()})",
-        f"- date: {dt.datetime.now().isoformat(timespec='minutes')}",
-        f"- machine: {machine()}",
+    title = "Environment speed: steps per CPU-second, scalar and batched"
+    lines = record_head(title, f"python {' '.join(sys.argv)}") + [
         f"- uniformly random actions sampled before timing; median of {a.repeats} timings of this process's CPU "
         f"time; scalar: {a.scalar_steps:,} steps of `gymnasium.make`'s env a timing, resets included; batched: "
         f"{a.num_envs:,} copies, at least {MIN_ENV_STEPS:,} env steps a timing, autoresets included"
