@@ -81,9 +81,10 @@ def test_every_action_linear_is_the_layer_on_one_hot_inputs():
     torch.testing.assert_close(chosen, layer(torch.cat([obs, F.one_hot(a, K).double()], -1)), rtol=1e-12, atol=1e-12)
 
 
+@pytest.mark.parametrize("pi_c_input", ["onehot", "state"])
 @pytest.mark.parametrize("deterministic", [False, True])
-def test_policy_acts_as_its_distribution_does_from_the_chosen_action_alone(deterministic):
-    policy = randomised(HybridPolicy(D, HYBRID, (8, 8)))
+def test_policy_acts_as_its_distribution_does_from_the_chosen_action_alone(deterministic, pi_c_input):
+    policy = randomised(HybridPolicy(D, HYBRID, (8, 8), pi_c_input=pi_c_input))
     obs = inputs((300, D))[0].detach()
     a, x = policy.act(obs, None, deterministic, torch.Generator().manual_seed(2))
     dist = policy(obs)

@@ -68,6 +68,7 @@ def test_linear_baseline_recovers_a_linear_function():
         ({"gamma": float("nan")}, "gamma = nan"),
         ({"baseline": "zero"}, "baseline = 'zero'"),
         ({"fvp": "exact"}, "fvp = 'exact'"),
+        ({"pi_c_input": "one_hot"}, "pi_c_input = 'one_hot'; expected one of 'onehot', 'state'"),
         ({"fvp": "gauss_newton", "kl_estimator": "joint_sample"}, "fvp = 'gauss_newton'.*joint_sample"),
     ],
 )

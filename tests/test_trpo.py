@@ -19,10 +19,10 @@ from pamdp.policies import HybridPolicy, LinearizedMLP, mlp
 from pamdp.spaces import HybridActionSpace
 
 
-def tiny_policy(seed=0, activation="tanh", hidden_sizes=(4,)):
+def tiny_policy(seed=0, activation="tanh", hidden_sizes=(4,), pi_c_input="onehot"):
     hs = HybridActionSpace((np.zeros(2), np.zeros(1)), (np.ones(2), np.ones(1)))
     torch.manual_seed(seed)
-    pol = HybridPolicy(3, hs, hidden_sizes=hidden_sizes, activation=activation).double()
+    pol = HybridPolicy(3, hs, hidden_sizes=hidden_sizes, activation=activation, pi_c_input=pi_c_input).double()
     # Larger final layers than the default near-zero init, so the Hessian is not trivially tiny.
     for p in pol.parameters():
         p.data.normal_(0, 0.5)
@@ -65,10 +65,20 @@ def test_fisher_vector_product_matches_explicit_hessian():
     assert torch.linalg.eigvalsh(H).min() > -1e-10
 
 
-@pytest.mark.parametrize("activation", ["tanh", "relu", "leaky_relu", "elu"])
+@pytest.mark.parametrize(
+    "activation, pi_c_input",
+    [
+        ("tanh", "onehot"),
+        ("relu", "onehot"),
+        ("leaky_relu", "onehot"),
+        ("elu", "onehot"),
+        ("tanh", "state"),
+        ("relu", "state"),
+    ],
+)
 @pytest.mark.parametrize("estimator", ["chain_analytic", "chain_sample"])
-def test_gauss_newton_product_matches_explicit_hessian(estimator, activation):
-    pol = tiny_policy(3, activation, hidden_sizes=(5, 4))
+def test_gauss_newton_product_matches_explicit_hessian(estimator, activation, pi_c_input):
+    pol = tiny_policy(3, activation, hidden_sizes=(5, 4), pi_c_input=pi_c_input)
     named = list(pol.named_parameters())
     names, params = [n for n, _ in named], [p for _, p in named]
     g = torch.Generator().manual_seed(0)

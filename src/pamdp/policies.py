@@ -4,6 +4,12 @@ The paper's architecture (Wei, Wicke & Luke 2018, section "Hierarchical Approach
 is an MLP on the state with a softmax output; ``pi_c`` is an MLP on ``[s, onehot(a)]`` with a Tanh output
 of the constant size ``m = max_a m_a``, whatever the number of actions. Exploration around ``pi_c``'s mean
 is Gaussian with a learned, state-independent log-std per action and parameter.
+
+``pi_c`` can instead read the state alone and output every action's mean at once, ``K * m`` Tanh outputs of
+which action ``a``'s ``m`` are its mean (``pi_c_input="state"``, P-DQN's parameter network and H-PPO's
+parameter actor): still a policy conditioned on the action, through its output block instead of its input.
+Every action's mean is then one pass of the network on the state, where the one-hot input takes ``K`` passes
+of its hidden layers; at the thousand actions of Hard Move n = 10 that is what an update costs.
 """
 
 from __future__ import annotations
@@ -19,6 +25,7 @@ from pamdp.spaces import HybridActionSpace
 
 __all__ = [
     "ACTIVATIONS",
+    "PI_C_INPUTS",
     "EVERY_ACTION_ROWS",
     "mlp",
     "every_action_linear",
@@ -29,6 +36,8 @@ __all__ = [
 ]
 
 ACTIVATIONS = {"relu": nn.ReLU, "tanh": nn.Tanh, "leaky_relu": nn.LeakyReLU, "elu": nn.ELU}
+PI_C_INPUTS = ("onehot", "state")
+"""What ``pi_c`` reads: ``[s, onehot(a)]`` (the paper's) or ``s`` alone with a block of outputs per action."""
 EVERY_ACTION_ROWS = 2**14
 """(state, action) rows of one chunk of an every-action pass without gradients (:func:`in_chunks`): small enough
 that the allocator reuses its hidden activations' memory instead of mapping (and zeroing) it afresh."""
@@ -152,6 +161,8 @@ class HybridPolicy(nn.Module):
         hidden_sizes: hidden layers of both networks; the paper's PATRPO preset is ``(200, 100, 50)``.
         activation: hidden activation (``relu`` in the paper).
         init_log_std: initial log standard deviation of the parameter noise (in ``[-1, 1]`` units).
+        pi_c_input: ``"onehot"`` (the paper's ``pi_c([s, onehot(a)])``) or ``"state"`` (``pi_c(s)``'s output block
+            ``a``); see the module docstring.
     """
 
     def __init__(
@@ -161,13 +172,20 @@ class HybridPolicy(nn.Module):
         hidden_sizes: Sequence[int] = (200, 100, 50),
         activation: str = "relu",
         init_log_std: float = 0.0,
+        pi_c_input: str = "onehot",
     ):
         super().__init__()
+        if pi_c_input not in PI_C_INPUTS:
+            raise ValueError(f"unknown pi_c_input {pi_c_input!r}; expected one of {', '.join(PI_C_INPUTS)}")
         self.obs_dim = int(obs_dim)
         self.n_actions = action_space.n_actions
         self.param_size = action_space.max_param_size
+        self.onehot_input = pi_c_input == "onehot"
         self.pi_d = mlp(self.obs_dim, hidden_sizes, self.n_actions, activation)
-        self.pi_c = mlp(self.obs_dim + self.n_actions, hidden_sizes, self.param_size, activation, nn.Tanh)
+        if self.onehot_input:
+            self.pi_c = mlp(self.obs_dim + self.n_actions, hidden_sizes, self.param_size, activation, nn.Tanh)
+        else:
+            self.pi_c = mlp(self.obs_dim, hidden_sizes, self.n_actions * self.param_size, activation, nn.Tanh)
         self.log_std = nn.Parameter(torch.full((self.n_actions, self.param_size), float(init_log_std)))
         self.register_buffer("mask", torch.tensor(action_space.param_mask))
         # Small final layers start both policies near uniform / centred, as rllab and Spinning Up do.
@@ -175,13 +193,15 @@ class HybridPolicy(nn.Module):
             nn.init.uniform_(head.weight, -3e-3, 3e-3)
             nn.init.zeros_(head.bias)
 
-    def param_means(self, obs: torch.Tensor, onehot: torch.Tensor) -> torch.Tensor:
-        """``pi_c``'s mean for the (batched) one-hot actions ``onehot`` (any leading shape)."""
-        return self.pi_c(torch.cat([obs, onehot], dim=-1))
+    def _blocks(self, out: torch.Tensor) -> torch.Tensor:
+        """A state-input ``pi_c``'s outputs ``(..., K * m)`` as every action's mean ``(..., K, m)``."""
+        return out.unflatten(-1, (self.n_actions, self.param_size))
 
     def every_param_mean(self, obs: torch.Tensor) -> torch.Tensor:
-        """``pi_c``'s means for every action at ``obs`` ``(B, obs_dim)``: ``(B, K, m)``, ``param_means`` of every
-        one-hot in one pass (its first layer by :func:`every_action_linear`)."""
+        """``pi_c``'s means for every action at ``obs`` ``(B, obs_dim)``: ``(B, K, m)``; with the one-hot input,
+        ``pi_c`` of every one-hot in one pass (its first layer by :func:`every_action_linear`)."""
+        if not self.onehot_input:
+            return self._blocks(self.pi_c(obs))
         first = self.pi_c[0]
         return in_chunks(lambda o: self.pi_c[1:](every_action_linear(o, first.weight, first.bias)), self.n_actions, obs)
 
@@ -201,8 +221,11 @@ class HybridPolicy(nn.Module):
         """``forward(obs, action_mask)``'s ``mode()`` or ``sample(generator)`` (the same draws), with ``pi_c`` run for
         the chosen action only: acting needs no other action's mean."""
         a = draw_action(masked_logits(self.pi_d(obs), action_mask), deterministic, generator)
-        first = self.pi_c[0]
-        mu = self.pi_c[1:](every_action_linear(obs, first.weight, first.bias, a))
+        if self.onehot_input:
+            first = self.pi_c[0]
+            mu = self.pi_c[1:](every_action_linear(obs, first.weight, first.bias, a))
+        else:
+            mu = self._blocks(self.pi_c(obs))[torch.arange(len(a)), a]
         return a, draw_params(mu, self.log_std[a], self.mask[a], deterministic, generator)
 
     def linearize(
@@ -216,16 +239,21 @@ class HybridPolicy(nn.Module):
         Fisher-vector product needs no mask beyond the old distribution's.
         """
         lin_d = LinearizedMLP(self.pi_d, obs)
-        lin_c = LinearizedMLP(self.pi_c, None, lambda weight, bias: every_action_linear(obs, weight, bias))
+        if self.onehot_input:
+            lin_c = LinearizedMLP(self.pi_c, None, lambda weight, bias: every_action_linear(obs, weight, bias))
+            means, blocks = lin_c.outputs, (lambda d: d)
+        else:
+            lin_c = LinearizedMLP(self.pi_c, obs)
+            means, blocks = self._blocks(lin_c.outputs), self._blocks
         names_d = [f"pi_d.{n}" for n, _ in self.pi_d.named_parameters()]
         names_c = [f"pi_c.{n}" for n, _ in self.pi_c.named_parameters()]
 
         def jvp(tangents: dict[str, torch.Tensor]) -> tuple[torch.Tensor, ...]:
             d_logits = lin_d.jvp([tangents[n] for n in names_d])
-            d_means = lin_c.jvp([tangents[n] for n in names_c])
+            d_means = blocks(lin_c.jvp([tangents[n] for n in names_c]))
             return d_logits, d_means, tangents["log_std"]
 
-        return HybridDistribution(lin_d.outputs, lin_c.outputs, self.log_std, self.mask), jvp
+        return HybridDistribution(lin_d.outputs, means, self.log_std, self.mask), jvp
 
 
 class ValueNetwork(nn.Module):

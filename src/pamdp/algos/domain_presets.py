@@ -247,6 +247,14 @@ DOMAIN_PRESETS: dict[tuple[str, str, tuple], DomainPreset] = {
         ("init_log_std", -1.5, "measured: benchmarks/catch_point.md (issue 26)"),
         ("entropy_coef", 0.05, "measured: benchmarks/catch_point.md (issue 26)"),
     ),
+    ("patrpo", HARD_MOVE, ANY): _derived(
+        "hard_move",
+        "tuned",
+        "The tuned preset with pi_c on the state alone, a block of outputs per action: the 2^n actions' means in "
+        "one pass instead of 2^n passes of pi_c's hidden layers, which made a sample cost grow with 2^n "
+        "(benchmarks/large_k_cost.md).",
+        ("pi_c_input", "state", "measured: docs/results.md, benchmark suite (issue 26)"),
+    ),
     ("pdqn", "pamdp/CatchPoint-v0", ANY): _mpdqn_hybrid("catch_point", "HyAR's P-DQN settings were not read here."),
     ("pdqn", HARD_MOVE, ANY): _mpdqn_hybrid(
         "hard_move", "HyAR's P-DQN settings were not read here; 2^n actions, so a wider Q-network.", *_HARD_MOVE_Q

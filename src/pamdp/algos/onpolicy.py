@@ -14,11 +14,13 @@ import numpy as np
 import torch
 
 from pamdp.algos.logger import EpisodeTracker
+from pamdp.algos.settings import one_of, setting
 from pamdp.algos.vector_env import info_action_masks
-from pamdp.policies import HybridPolicy
+from pamdp.policies import PI_C_INPUTS, HybridPolicy
 from pamdp.spaces import HybridActionSpace
 
 __all__ = [
+    "pi_c_input_setting",
     "Rollout",
     "gae",
     "advantage_batch",
@@ -27,6 +29,16 @@ __all__ = [
     "network_values",
     "LinearFeatureBaseline",
 ]
+
+
+def pi_c_input_setting() -> str:
+    """The ``pi_c_input`` setting of the hierarchical policy's algorithms (:class:`~pamdp.policies.HybridPolicy`)."""
+    return setting(
+        "onehot",
+        "What pi_c reads: onehot ([s, onehot(a)], the paper's) or state (s alone, a block of K * m outputs, one "
+        "per action: every action's mean in one pass, for large K such as Hard Move's).",
+        one_of(PI_C_INPUTS),
+    )
 
 
 def gae(

@@ -33,7 +33,14 @@ import numpy as np
 import torch
 
 from pamdp.algos.base import Algorithm
-from pamdp.algos.onpolicy import Rollout, advantage_batch, mask_tensor, network_values, update_tensors
+from pamdp.algos.onpolicy import (
+    Rollout,
+    advantage_batch,
+    mask_tensor,
+    network_values,
+    pi_c_input_setting,
+    update_tensors,
+)
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
 from pamdp.algos.subnormals import subnormals_flushed
 from pamdp.distributions import HybridDistribution, kl_divergence
@@ -61,6 +68,7 @@ class PAPPOConfig(AlgoConfig):
         "tanh", "Hidden activation of the policies: tanh (PPO's usual), relu, leaky_relu or elu.", one_of(ACTIVATIONS)
     )
     init_log_std: float = setting(0.0, "Initial log-std of the parameter noise, in [-1, 1] units.")
+    pi_c_input: str = pi_c_input_setting()
     batch_size: int = setting(
         4096, "Samples per epoch, collected with the current policy before its update.", at_least(1)
     )
@@ -168,7 +176,9 @@ class PAPPO(Algorithm):
 
     def _build(self) -> None:
         cfg = self.config
-        self.policy = HybridPolicy(self.obs_dim, self.hybrid, cfg.hidden_sizes, cfg.activation, cfg.init_log_std)
+        self.policy = HybridPolicy(
+            self.obs_dim, self.hybrid, cfg.hidden_sizes, cfg.activation, cfg.init_log_std, cfg.pi_c_input
+        )
         self.value = ValueNetwork(self.obs_dim, cfg.vf_hidden_sizes)
         self.optimizer = torch.optim.Adam([*self.policy.parameters(), *self.value.parameters()], lr=cfg.lr)
         self.rollout = Rollout(cfg.action_mask)  # a loaded model starts new episodes

@@ -35,6 +35,7 @@ from pamdp.algos.onpolicy import (
     advantage_batch,
     mask_tensor,
     network_values,
+    pi_c_input_setting,
     update_tensors,
 )
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, at_least, interval, one_of, setting
@@ -75,6 +76,7 @@ class PATRPOConfig(AlgoConfig):
         "relu", "Hidden activation of the policies: relu (paper), tanh, leaky_relu or elu.", one_of(ACTIVATIONS)
     )
     init_log_std: float = setting(0.0, "Initial log-std of the parameter noise, in [-1, 1] units (rllab: std 1).")
+    pi_c_input: str = pi_c_input_setting()
     batch_size: int = setting(
         10_000, "Samples per epoch (one TRPO update per epoch); the paper uses 10 000.", at_least(1)
     )
@@ -162,7 +164,9 @@ class PATRPO(Algorithm):
 
     def _build(self) -> None:
         cfg = self.config
-        self.policy = HybridPolicy(self.obs_dim, self.hybrid, cfg.hidden_sizes, cfg.activation, cfg.init_log_std)
+        self.policy = HybridPolicy(
+            self.obs_dim, self.hybrid, cfg.hidden_sizes, cfg.activation, cfg.init_log_std, cfg.pi_c_input
+        )
         if cfg.baseline == "mlp":
             self.value = ValueNetwork(self.obs_dim, cfg.vf_hidden_sizes)
             self.vf_optimizer = torch.optim.Adam(self.value.parameters(), lr=cfg.vf_lr)
