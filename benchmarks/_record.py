@@ -122,6 +122,19 @@ def write_record(lines: list[str], record: str | os.PathLike | None) -> str:
     return text
 
 
+def kept_rows(record: str | os.PathLike, labels) -> dict[str, str]:
+    """The table rows of the existing ``record`` whose first cell is one of ``labels``, by label: a record
+    rewritten from the runs at hand keeps them for the arms whose runs are not there (lost with a machine, or
+    under another ``--out``), so that no figure measured earlier is dropped."""
+    path, labels = Path(record), set(labels)
+    rows = {}
+    for line in path.read_text().splitlines() if path.exists() else ():
+        cells = line.split("|")
+        if line.startswith("| ") and len(cells) > 2 and cells[1].strip() in labels:
+            rows[cells[1].strip()] = line
+    return rows
+
+
 def seed_by_seed(
     exp, labels: list[str], seeds: list[int], out_root: str, write, workers: int = 1, train: bool = True
 ) -> dict:

@@ -16,7 +16,7 @@ from __future__ import annotations
 import json
 
 import numpy as np
-from _record import HERE, progress_rows, record_head, seed_by_seed_main, where_unfinished, write_record
+from _record import HERE, kept_rows, progress_rows, record_head, seed_by_seed_main, where_unfinished, write_record
 
 from pamdp.algos.logger import success_of
 from pamdp.experiments import Experiment
@@ -25,6 +25,9 @@ from pamdp.experiments.status import epoch_seconds
 
 RECORD = HERE / "catch_point.md"
 ENV = "pamdp/CatchPoint-v0"
+
+CATCH_POINT = {"init_log_std": -1.5, "entropy_coef": 0.05}
+"""The ``catch_point`` preset of ``patrpo``: these settings over the tuned preset."""
 
 # label -> (settings over the tuned preset, samples); the tuned preset's own init_log_std is -0.5.
 ARMS = {
@@ -35,7 +38,14 @@ ARMS = {
     "init_log_std=-1.5 batch_size=10000": ({"init_log_std": -1.5, "batch_size": 10_000}, 300_000),
     "init_log_std=-1.5 entropy_coef=0.1": ({"init_log_std": -1.5, "entropy_coef": 0.1}, 300_000),
     "init_log_std=-1.5 entropy_coef=0.05": ({"init_log_std": -1.5, "entropy_coef": 0.05}, 300_000),
-    "init_log_std=-1.5 entropy_coef=0.05 1M": ({"init_log_std": -1.5, "entropy_coef": 0.05}, 1_000_000),
+    "init_log_std=-1.5 entropy_coef=0.05 1M": (CATCH_POINT, 1_000_000),
+    # 2026-12-02 (second session): one change at a time over the catch_point preset, at HyAR's 1M budget.
+    "catch_point pi_c_input=state": ({**CATCH_POINT, "pi_c_input": "state"}, 1_000_000),
+    "catch_point batch_size=2000": ({**CATCH_POINT, "batch_size": 2_000}, 1_000_000),
+    "catch_point init_log_std=-2.0": ({**CATCH_POINT, "init_log_std": -2.0}, 1_000_000),
+    "catch_point entropy_coef=0.02": ({**CATCH_POINT, "entropy_coef": 0.02}, 1_000_000),
+    "catch_point delta=0.01": ({**CATCH_POINT, "delta": 0.01}, 1_000_000),
+    "catch_point gae_lambda=0.9": ({**CATCH_POINT, "gae_lambda": 0.9}, 1_000_000),
 }
 
 EXPERIMENT = Experiment(
@@ -83,9 +93,18 @@ def write(arms: dict, command: str) -> None:
         "| CPU min per run (median) | unfinished |",
         "|---|---|---|---|---|---|---|---|",
     ]
-    lines += [_arm_row(label, jobs) for label, jobs in arms.items()]
+    kept = kept_rows(RECORD, ARMS)
+    for label in ARMS:  # an arm with no run at hand keeps the row the record had
+        jobs = arms.get(label)
+        has_runs = jobs is not None and any(progress_rows(out) for _, out in jobs)
+        if has_runs or (jobs is not None and label not in kept):
+            lines.append(_arm_row(label, jobs))
+        elif label in kept:
+            lines.append(kept[label])
     lines += [
         "",
+        "Rows of arms with no run under this invocation's `--out` are kept from the record as they were (their runs "
+        "were lost with an earlier machine, or ran under another `--out`). "
         "CPU min per run: the run's CPU time in training (its final evaluation left out), from its progress.csv. "
         "Published success rates at 1M samples (HyAR, Table 2): HyAR-TD3 0.90, P-DQN 0.77, HPPO 0.69.",
     ]
