@@ -169,3 +169,47 @@ def test_epoch_stats_average_each_figure_over_the_updates_that_computed_it():
     assert stats["train/updates"] == len(calls) >= 40
     assert stats["every"] == pytest.approx(np.mean(calls))
     assert stats["third"] == pytest.approx(np.mean([10 * i for i in calls if i % 3 == 0]))
+
+
+def test_reward_scale_scales_what_the_critics_learn_from_and_nothing_the_user_sees():
+    """Two loops with the same seeds and the same fixed actions, one at reward_scale 1/50: its stored rewards and
+    Monte-Carlo returns are the other's times 1/50, its logged episode returns the same."""
+    from pamdp.algos.offpolicy import OffPolicyLoop
+    from pamdp.algos.paddpg import PADDPGConfig
+    from pamdp.algos.vector_env import make_vector_env
+    from pamdp.spaces import HybridActionSpace
+
+    def run(scale):
+        env = make_vector_env("pamdp/Platform-v0", 4)
+        hybrid = HybridActionSpace.from_gym(env.single_action_space)
+        d = env.single_observation_space.shape[0]
+        fields = {
+            "obs": ((d,), np.float32),
+            "a": ((), np.int64),
+            "x": ((hybrid.max_param_size,), np.float32),
+            "reward": ((), np.float32),
+            "next_obs": ((d,), np.float32),
+            "terminated": ((), np.bool_),
+            "mc": ((), np.float32),
+        }
+        buffer = ReplayBuffer(1000, fields)
+        loop = OffPolicyLoop(
+            PADDPGConfig(epoch_steps=200, learning_starts=10**6, reward_scale=scale), hybrid, buffer, True
+        )
+
+        def act(obs, step, episode_start, mask):  # run right at speed 0.6: episodes of several steps, rewards > 0
+            n = len(obs)
+            return torch.zeros(n, dtype=torch.long), torch.full((n, hybrid.max_param_size), 0.2), {}
+
+        stats = loop.run_epoch(env, act, lambda: {}, 0, np.random.default_rng(0))
+        n = len(buffer)
+        return stats, {k: buffer.data[k][:n].numpy() for k in ("reward", "mc")}
+
+    stats1, data1 = run(1.0)
+    stats50, data50 = run(1 / 50)
+    assert data1["reward"].any() and np.isfinite(data1["mc"]).sum() > 50
+    np.testing.assert_allclose(data50["reward"], data1["reward"] / 50, rtol=1e-6)
+    finite = np.isfinite(data1["mc"])
+    np.testing.assert_array_equal(np.isfinite(data50["mc"]), finite)
+    np.testing.assert_allclose(data50["mc"][finite], data1["mc"][finite] / 50, rtol=1e-5)
+    assert stats50["charts/episodic_return"] == stats1["charts/episodic_return"] > 0

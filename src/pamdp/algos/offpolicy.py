@@ -14,7 +14,8 @@ bootstrap); a truncation by the time limit stores ``False``, so the target boots
 observation. Episodes carry across epochs; a resumed run starts new episodes (env states are not saved).
 
 With ``mc_returns`` the loop also writes each transition's discounted Monte-Carlo return-to-go into the
-buffer's ``"mc"`` field when its episode ends (``NaN`` until then), for PADDPG's mixed targets.
+buffer's ``"mc"`` field when its episode ends (``NaN`` until then), for PADDPG's mixed targets. Both the stored
+rewards and these returns are the env's rewards times ``reward_scale``, the scale the critics learn on.
 
 The actors of PADDPG, P-DQN and HyAR output bounded values trained along ``dQ/d output``; Hausknecht & Stone's
 three ways of keeping them in ``[-1, 1]`` (spec "PADDPG") are :data:`BOUNDS`, applied by :func:`backprop_actor`.
@@ -94,6 +95,12 @@ class OffPolicyConfig:
     )
     save_replay: bool = setting(
         False, "Store the replay contents in checkpoints (large); otherwise a resumed run refills the buffer."
+    )
+    reward_scale: float = setting(
+        1.0,
+        "Rewards are multiplied by this before they are stored, so the critics learn scaled values (MP-DQN's Goal "
+        "script: 1/50); logged returns and evaluations stay the env's.",
+        POSITIVE,
     )
 
 
@@ -390,7 +397,7 @@ class OffPolicyLoop:
                     "obs": obs[valid],
                     "a": a[valid],
                     "x": x[valid],
-                    "reward": np.asarray(reward, dtype=np.float32)[valid],
+                    "reward": (np.asarray(reward, dtype=np.float64) * cfg.reward_scale).astype(np.float32)[valid],
                     "next_obs": np.asarray(next_obs, dtype=np.float32)[valid],
                     "terminated": (terminated & valid)[valid],
                     **{k: v[valid] for k, v in extras.items()},
@@ -436,7 +443,7 @@ class OffPolicyLoop:
             )
         for c, i in zip(counters, np.flatnonzero(valid)):
             self._pending[i][0].append(int(c))
-            self._pending[i][1].append(float(reward[i]))
+            self._pending[i][1].append(float(reward[i]) * self.config.reward_scale)  # on the critics' scale
         for i in ended:
             stored, rewards = self._pending[i]
             returns = discounted_returns(np.asarray(rewards), self.config.gamma, float(tails[i]))
