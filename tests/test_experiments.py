@@ -4,10 +4,12 @@ import csv
 import dataclasses
 import json
 import os
+import re
 import signal
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -495,3 +497,47 @@ def test_the_suite_table_puts_each_domains_runs_beside_hyars_numbers(tmp_path):
     _suite_run(other, "MP-DQN on CartPole", "CartPole-v1", 0, evaluation={"success_rate": 1.0})
     _suite_run(other, "MP-DQN on Hard Move n=5", "pamdp/HardMove-v0", 0, {"n": 5}, evaluation={"success_rate": 1.0})
     assert "suite" not in write_report([other], tmp_path / "fig2")
+
+
+def test_an_archive_of_earlier_suite_runs_fills_the_table_where_no_run_at_hand_replaces_it(tmp_path):
+    """Runs lost with a machine come back from the suite-finals.json an earlier plot wrote: the table counts an
+    archived seed unless a run at hand has the same domain, method and seed, and the new file holds both."""
+    from pamdp.experiments.report import write_report
+
+    lost = tmp_path / "lost" / "benchmark-suite"
+    for seed, rate in enumerate((0.2, 0.4, 0.6)):
+        _suite_run(lost, "MP-DQN on Goal", "pamdp/Goal-v0", seed, evaluation={"success_rate": rate})
+    archive = write_report([lost], tmp_path / "fig0")["suite_finals"]
+    now = tmp_path / "now" / "benchmark-suite"
+    _suite_run(now, "MP-DQN on Goal", "pamdp/Goal-v0", 1, evaluation={"success_rate": 0.9})  # seed 1 again
+    _suite_run(now, "PATRPO on Catch Point", "pamdp/CatchPoint-v0", 0, evaluation={"success_rate": 0.8})
+    report = write_report([now], tmp_path / "fig", suite_archive=archive)
+    rows = {line.split(" | ")[0][2:]: line.split(" | ")[1:3] for line in report["suite"].read_text().splitlines()[2:10]}
+    assert rows["Goal"] == [f"{np.mean([0.2, 0.9, 0.6]):.2f} +- {np.std([0.2, 0.9, 0.6]):.2f} (3 seeds)", "-"]
+    assert rows["Catch Point"] == ["-", "0.80 +- 0.00 (1 seed)"]
+    merged = json.loads(report["suite_finals"].read_text())
+    goal = {e["seed"]: (e["value"], Path(e["source"]).parts[-4]) for e in merged if e["domain"] == "Goal"}
+    assert goal == {0: (0.2, "lost"), 1: (0.9, "now"), 2: (0.6, "lost")}
+    assert write_report([now], tmp_path / "fig2")["suite"].read_text().count("(1 seed)") == 2  # no archive
+
+
+@pytest.mark.parametrize(
+    "entries, message",
+    [
+        ({"domain": "Goal"}, "a dict; expected a list of entries"),
+        ([{"domain": "Goal", "method": "MP-DQN", "seed": 0, "value": 0.5}], r"entry 0: \['domain'.*expected an object"),
+        ([{"domain": "Gol", "method": "M", "seed": 0, "value": 0.5, "final": True, "source": ""}], "domain = 'Gol'"),
+        ([{"domain": "Goal", "method": "M", "seed": 0, "value": "0.5", "final": True, "source": ""}], "value = '0.5'"),
+        ([{"domain": "Goal", "method": "M", "seed": True, "value": 0.5, "final": True, "source": ""}], "seed = True"),
+    ],
+)
+def test_a_bad_suite_archive_is_refused_with_the_entry_and_what_was_expected(tmp_path, capsys, entries, message):
+    from pamdp.cli import main
+
+    runs = tmp_path / "runs" / "benchmark-suite"
+    _suite_run(runs, "MP-DQN on Goal", "pamdp/Goal-v0", 0, evaluation={"success_rate": 0.5})
+    archive = tmp_path / "finals.json"
+    archive.write_text(json.dumps(entries))
+    assert main(["plot", str(runs), "--out", str(tmp_path / "fig"), "--suite-archive", str(archive)]) == 2
+    assert re.search(f"suite archive {re.escape(str(archive))}.*{message}", capsys.readouterr().err)
+    assert not (tmp_path / "fig").exists()  # refused before anything was written

@@ -265,6 +265,12 @@ def build_parser() -> argparse.ArgumentParser:
         help="x axis: training epochs as the paper's figures, samples, or auto: epochs unless the settings' "
         "epochs differ in size (default: %(default)s)",
     )
+    pl.add_argument(
+        "--suite-archive",
+        default=None,
+        help="an earlier suite-finals.json (the benchmark suite's per-seed figures): its entries fill suite.md "
+        "where no run at hand has their domain, method and seed",
+    )
 
     rd = sub.add_parser("render", help="write one episode to a GIF (a trained model, or random actions in an env)")
     rd.add_argument("source", help="run directory, model file, or a registered env id (random actions)")
@@ -364,7 +370,7 @@ def cmd_reproduce(args) -> int:
 def cmd_plot(args) -> int:
     from pamdp.experiments.report import write_report
 
-    _print_report(write_report(args.dirs, args.out or args.dirs[0], args.title, args.x))
+    _print_report(write_report(args.dirs, args.out or args.dirs[0], args.title, args.x, args.suite_archive))
     return 0
 
 

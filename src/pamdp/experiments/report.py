@@ -4,19 +4,24 @@ and for runs on the benchmark suite's domains their table beside HyAR's (:mod:`p
 from __future__ import annotations
 
 import csv
+import json
 import os
 from pathlib import Path
 
 import numpy as np
 
 from pamdp.experiments.plots import EXTRA_FIGURES, aggregate, find_groups, plot_curves, results_table
-from pamdp.experiments.suite import plot_domains, suite_table
+from pamdp.experiments.suite import load_finals, merge_finals, plot_domains, suite_finals, suite_table
 
 __all__ = ["write_report"]
 
 
 def write_report(
-    roots: list[str | os.PathLike], out: str | os.PathLike, title: str = "", x: str = "auto"
+    roots: list[str | os.PathLike],
+    out: str | os.PathLike,
+    title: str = "",
+    x: str = "auto",
+    suite_archive: str | os.PathLike | None = None,
 ) -> dict[str, Path]:
     """Curves (PNG, SVG), the per-epoch aggregate (CSV) and the results table (markdown) into ``out``.
 
@@ -27,9 +32,11 @@ def write_report(
     an env that reports episode outcomes (``info["is_success"]``) get ``success_rate.png`` and ``.svg``: the
     training success rate per epoch (epochs logged before a run recorded it are left out), and with
     ``eval_every`` ``greedy_success_rate.png`` and ``.svg``, that of the greedy evaluations. Runs on the benchmark
-    suite's domains also get ``suite.md``, their table beside HyAR's published one, and a figure per domain
-    (:mod:`pamdp.experiments.suite`).
+    suite's domains also get ``suite.md``, their table beside HyAR's published one, ``suite-finals.json``, each
+    seed's figure, and a figure per domain (:mod:`pamdp.experiments.suite`). ``suite_archive``: an earlier
+    ``suite-finals.json``, whose entries fill the table where no run at hand has their domain, method and seed.
     """
+    archived = [] if suite_archive is None else load_finals(suite_archive)  # checked before anything is written
     groups = find_groups(roots)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -58,9 +65,10 @@ def write_report(
                 )
     table = out / "results.md"
     table.write_text(results_table(groups) + "\n")
-    suite = suite_table(groups)
-    if suite:  # runs on the benchmark suite's domains: their table beside HyAR's, and a figure per domain
-        (out / "suite.md").write_text(suite + "\n")
-        extra["suite"] = out / "suite.md"
+    finals = merge_finals(suite_finals(groups), archived)
+    if finals:  # runs on the benchmark suite's domains: their table beside HyAR's, and a figure per domain
+        (out / "suite.md").write_text(suite_table(finals) + "\n")
+        (out / "suite-finals.json").write_text(json.dumps(finals, indent=1) + "\n")
+        extra["suite"], extra["suite_finals"] = out / "suite.md", out / "suite-finals.json"
         extra.update({f"{p.stem}_{p.suffix[1:]}": p for p in plot_domains(groups, out)})
     return {"png": png, "svg": svg, "csv": csv_path, "table": table, **extra}

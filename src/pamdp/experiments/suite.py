@@ -5,6 +5,10 @@ domain from the env (and its arguments) its ``run.json`` records, and its method
 counts with its final evaluation (1000 greedy episodes); a run still training with its last greedy evaluation
 during training (100 episodes), marked as such. Platform's figure is the return, as in HyAR's table; the
 others' the success rate (``info["is_success"]``).
+
+Each seed's figure is an entry of ``suite-finals.json``, written beside the table. Runs are lost when a machine
+goes; handed back as an archive (``pamdp plot --suite-archive FILE``), the entries of earlier runs fill the table
+where no run at hand has the same domain, method and seed.
 """
 
 from __future__ import annotations
@@ -17,7 +21,17 @@ import numpy as np
 
 from pamdp.algos.logger import success_of
 
-__all__ = ["DOMAINS", "HYAR_TABLE", "domain_of", "suite_cells", "suite_table", "plot_domains"]
+__all__ = [
+    "DOMAINS",
+    "HYAR_TABLE",
+    "domain_of",
+    "suite_finals",
+    "load_finals",
+    "merge_finals",
+    "suite_cells",
+    "suite_table",
+    "plot_domains",
+]
 
 DOMAINS: tuple[tuple[str, str, dict], ...] = (
     ("Platform", "pamdp/Platform-v0", {}),
@@ -72,21 +86,83 @@ def _figure(run: Path, domain: str) -> tuple[float, bool] | None:
     return None
 
 
-def suite_cells(groups: dict[str, list[Path]]) -> dict[tuple[str, str], str]:
-    """``{(domain, method): "0.93 +- 0.02 (3 seeds)"}`` from the groups of :func:`plots.find_groups`."""
+def _seed_of(run: Path, recorded: dict) -> int | None:
+    """A run's seed: its recorded settings', else its directory's name (``seedN``)."""
+    seed = (recorded.get("config") or {}).get("seed")
+    if seed is None and run.name.startswith("seed") and run.name[4:].isdigit():
+        seed = int(run.name[4:])
+    return None if seed is None else int(seed)
+
+
+def suite_finals(groups: dict[str, list[Path]]) -> list[dict]:
+    """One entry per run of the groups (:func:`plots.find_groups`) on a suite domain with a figure:
+    ``{"domain", "method", "seed", "value", "final", "source"}`` (``final``: its evaluation of 1000 episodes, else
+    its last greedy evaluation during training; ``source``: the run's directory)."""
     from pamdp.experiments.plots import _recorded
 
-    found: dict[tuple[str, str], list[tuple[float, bool]]] = {}
+    finals = []
     for label, runs in groups.items():
         for run in runs:
             recorded = _recorded(run)
             domain = domain_of(recorded)
-            if domain is None:
-                continue
-            method = str(recorded.get("label") or label).split(" on ")[0]
-            figure = _figure(run, domain)
+            figure = None if domain is None else _figure(run, domain)
             if figure is not None:
-                found.setdefault((domain, method), []).append(figure)
+                method = str(recorded.get("label") or label).split(" on ")[0]
+                seed = _seed_of(run, recorded)
+                finals.append(dict(domain=domain, method=method, seed=seed, value=figure[0], final=figure[1]))
+                finals[-1]["source"] = str(run)
+    return finals
+
+
+FINALS_KEYS = {"domain": str, "method": str, "seed": int, "value": float, "final": bool, "source": str}
+"""The keys of a suite-finals entry and their types."""
+
+
+def load_finals(path: str | os.PathLike) -> list[dict]:
+    """The entries of a ``suite-finals.json`` (as :func:`write_report` writes it), each checked: a ``ValueError``
+    names the file, the entry and what was expected."""
+    try:
+        entries = json.loads(Path(path).read_text())
+    except (OSError, json.JSONDecodeError) as e:
+        raise ValueError(f"suite archive {path}: cannot read it as JSON ({e})") from None
+    if not isinstance(entries, list):
+        raise ValueError(f"suite archive {path}: a {type(entries).__name__}; expected a list of entries")
+    names = [d[0] for d in DOMAINS]
+    for i, entry in enumerate(entries):
+        where = f"suite archive {path}, entry {i}"
+        if not isinstance(entry, dict) or set(entry) != set(FINALS_KEYS):
+            got = sorted(entry) if isinstance(entry, dict) else entry
+            raise ValueError(f"{where}: {got!r}; expected an object with the keys {sorted(FINALS_KEYS)}")
+        for key, kind in FINALS_KEYS.items():
+            value = entry[key]
+            ok = isinstance(value, kind) and not (kind is int and isinstance(value, bool))
+            ok = ok or (key == "seed" and value is None)  # a run whose seed was not recorded
+            if kind is float:
+                ok = isinstance(value, (int, float)) and not isinstance(value, bool) and np.isfinite(value)
+            if not ok:
+                raise ValueError(
+                    f"{where}: {key} = {value!r}; expected a {'finite number' if kind is float else kind.__name__}"
+                )
+        if entry["domain"] not in names:
+            raise ValueError(f"{where}: domain = {entry['domain']!r}; expected one of {names}")
+    return entries
+
+
+def merge_finals(at_hand: list[dict], archived: list[dict]) -> list[dict]:
+    """``archived`` entries with those of ``at_hand`` over them (a run at hand replaces the archived entry of its
+    domain, method and seed), in the table's domain order, then by method and seed."""
+    merged = {(e["domain"], e["method"], e["seed"]): e for e in [*archived, *at_hand]}
+    order = {d[0]: i for i, d in enumerate(DOMAINS)}
+    return sorted(
+        merged.values(), key=lambda e: (order[e["domain"]], e["method"], -1 if e["seed"] is None else e["seed"])
+    )
+
+
+def suite_cells(finals: list[dict]) -> dict[tuple[str, str], str]:
+    """``{(domain, method): "0.93 +- 0.02 (3 seeds)"}`` from entries of :func:`suite_finals`."""
+    found: dict[tuple[str, str], list[tuple[float, bool]]] = {}
+    for e in finals:
+        found.setdefault((e["domain"], e["method"]), []).append((float(e["value"]), bool(e["final"])))
     cells = {}
     for key, figures in found.items():
         values = np.array([v for v, _ in figures])
@@ -96,10 +172,10 @@ def suite_cells(groups: dict[str, list[Path]]) -> dict[tuple[str, str], str]:
     return cells
 
 
-def suite_table(groups: dict[str, list[Path]]) -> str:
-    """A markdown table: each domain's measured figure per method, then HyAR's published ones ("" where no run
-    of the groups is on a suite domain)."""
-    cells = suite_cells(groups)
+def suite_table(finals: list[dict]) -> str:
+    """A markdown table: each domain's measured figure per method (entries of :func:`suite_finals`), then HyAR's
+    published ones ("" without entries)."""
+    cells = suite_cells(finals)
     if not cells:
         return ""
     methods = list(dict.fromkeys(method for _, method in cells))
@@ -112,7 +188,8 @@ def suite_table(groups: dict[str, list[Path]]) -> str:
         "",
         "Success rate (Platform: return), mean +- std over seeds, each seed's final greedy evaluation over 1000 "
         "episodes; * a run still training, counted with its last greedy evaluation (100 episodes). HyAR's columns: "
-        "its Table 2 (5 runs, 100 evaluation episodes).",
+        "its Table 2 (5 runs, 100 evaluation episodes). Per seed, with where each figure comes from: "
+        "`suite-finals.json` beside this table.",
     ]
     return "\n".join(lines)
 
