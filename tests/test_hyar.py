@@ -177,6 +177,19 @@ def test_epsilon_draws_embeddings_uniformly_and_anneals():
     assert float(replaced) == pytest.approx(0.2, abs=0.03)
 
 
+def test_exploration_noise_falls_from_its_start_after_the_warm_up():
+    """The spread of explored actor outputs around a greedy one at 0, in the actor's [-1, 1] units: the start's std
+    at the end of the warm-up, the schedule's midpoint halfway, exploration_noise after it (HyAR's schedule)."""
+    m = model(warmup_steps=100, exploration_noise=0.05, exploration_noise_start=0.35, exploration_noise_steps=1000)
+    u = torch.zeros(20_000, m.latent_size)  # the clamp at +-1 is 2.9 start stds away: it trims nothing measurable
+    for step, std in ((0, 0.35), (100, 0.35), (600, 0.2), (1100, 0.05), (10**6, 0.05)):
+        explored = m._noisy(u, step)
+        assert explored.std().item() == pytest.approx(std, rel=0.03), step
+        assert abs(explored.mean().item()) < 0.01
+    constant = model(exploration_noise=0.05, exploration_noise_start=0.35)  # no schedule: exploration_noise always
+    assert constant._noisy(u, 0).std().item() == pytest.approx(0.05, rel=0.03)
+
+
 def test_relabelling_replaces_exactly_the_stale_latents():
     m = model()
     gen = torch.Generator().manual_seed(0)
@@ -288,6 +301,8 @@ def test_actor_gradient_through_the_latent_box_matches_finite_differences(bound)
         ({"vae_hidden_sizes": ()}, "vae_hidden_sizes = \\(\\)"),
         ({"kl_weight": -1.0}, "kl_weight = -1.0"),
         ({"epsilon_start": 1.5}, "epsilon_start = 1.5"),
+        ({"exploration_noise_steps": -1}, "exploration_noise_steps = -1"),
+        ({"exploration_noise_start": -0.1}, "exploration_noise_start = -0.1"),
         ({"bound": "zero"}, "bound = 'zero'"),
         ({"lsc_remap": True}, "lsc_remap = True.*squash"),
     ],

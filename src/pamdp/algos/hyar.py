@@ -137,7 +137,22 @@ class HyARConfig(OffPolicyConfig, AlgoConfig):
     batch_size: int = shared_setting("batch_size", 128, "assumed: 128")
     tau: float = setting(0.005, "Soft target-update rate (TD3: 0.005).", interval(0, 1, low_open=True))
     exploration_noise: float = setting(
-        0.1, "Std of the Gaussian noise on the actor's [-1, 1] output (TD3: 0.1).", NON_NEGATIVE
+        0.1,
+        "Std of the Gaussian noise on the actor's [-1, 1] output (TD3: 0.1); with exploration_noise_steps, the std "
+        "the schedule ends at.",
+        NON_NEGATIVE,
+    )
+    exploration_noise_start: float = setting(
+        1.0,
+        "Std of that noise when TD3 starts, falling linearly to exploration_noise over exploration_noise_steps "
+        "(HyAR's scripts: 1.0 to 0.1 over 1000 episodes, on the embedding and the parameters' latent alike).",
+        NON_NEGATIVE,
+    )
+    exploration_noise_steps: int = setting(
+        0,
+        "Samples after the warm-up over which the noise's std falls from exploration_noise_start to "
+        "exploration_noise; 0: no schedule, the std is exploration_noise throughout.",
+        at_least(0),
     )
     epsilon_start: float = setting(
         0.0,
@@ -373,11 +388,20 @@ class HyAR(Algorithm):
     def _act(self, obs, deterministic, mask=None):
         u = self.actor(obs).clamp(-1.0, 1.0)
         if not deterministic:
-            u = self._noisy(u)
+            u = self._noisy(u, self.num_timesteps)
         return self.rep.decode(obs, self.actor.to_latent(u), mask)
 
-    def _noisy(self, u: torch.Tensor) -> torch.Tensor:
-        noise = self.np_rng.normal(0.0, self.config.exploration_noise, size=u.shape).astype(np.float32)
+    def noise_std(self, step: int) -> float:
+        """The std of the actor's exploration noise after ``step`` samples (warm-up included): exploration_noise,
+        or with a schedule, linear from exploration_noise_start at the end of the warm-up to exploration_noise."""
+        cfg = self.config
+        if cfg.exploration_noise_steps == 0:
+            return cfg.exploration_noise
+        rl_steps = max(step - cfg.warmup_steps, 0)
+        return linear_epsilon(rl_steps, cfg.exploration_noise_start, cfg.exploration_noise, cfg.exploration_noise_steps)
+
+    def _noisy(self, u: torch.Tensor, step: int) -> torch.Tensor:
+        noise = self.np_rng.normal(0.0, self.noise_std(step), size=u.shape).astype(np.float32)
         return (u + self._from_numpy(noise)).clamp(-1.0, 1.0)
 
     def _explore(self, obs: torch.Tensor, step: int, episode_start: np.ndarray, mask: torch.Tensor | None):
@@ -387,7 +411,7 @@ class HyAR(Algorithm):
             x = self.np_rng.uniform(-1.0, 1.0, size=(n, h.max_param_size)).astype(np.float32)
             x = self._from_numpy(x) * self.rep.mask[a]
             return a, x, {"latent": np.zeros((n, self.latent_size), dtype=np.float32)}
-        latent = self.actor.to_latent(self._noisy(self.actor(obs).clamp(-1.0, 1.0)))
+        latent = self.actor.to_latent(self._noisy(self.actor(obs).clamp(-1.0, 1.0), step))
         eps = self.epsilon(step)
         if eps > 0:  # a uniformly drawn action's embedding in place of the actor's, the parameters' latent kept
             drawn = self._from_numpy(self.np_rng.random(len(obs)) < eps)
@@ -408,6 +432,7 @@ class HyAR(Algorithm):
         stats = self.loop.run_epoch(self.vec_env, self._explore, self._update, self.num_timesteps, self.np_rng)
         stats["train/latent_box_width"] = float((self.actor.high - self.actor.low).mean())
         stats["train/epsilon"] = self.epsilon(self.num_timesteps + stats["steps"])
+        stats["train/noise_std"] = self.noise_std(self.num_timesteps + stats["steps"])
         return stats
 
     def train_representation(self, updates: int) -> dict[str, float]:
