@@ -160,8 +160,8 @@ MASSON_HARD_GOAL_START = _linear_map(17, (*_MASSON_KICK, *((p, {}) for p in _HAR
 GOAL_NOTE = (
     "The parameter network starts from Masson's hand-set linear weights, as MP-DQN's Goal runs did "
     "(param_passthrough: their fixed passthrough layer; a config file's param_passthrough = [] starts it at "
-    "random, the start later work reports MP-DQN failing from). Not reproduced: the script's reward scale 1/50 "
-    "and the std 1e-5 of its output layers (the Q-network's is pamdp's default, the actor's starts at zero)."
+    "random, the start later work reports MP-DQN failing from). Not reproduced: the std 1e-5 of the script's "
+    "output layers (the Q-network's is pamdp's default, the actor's starts at zero)."
 )
 
 _MPDQN_GOAL_SETTINGS = (
@@ -178,6 +178,7 @@ _MPDQN_GOAL_SETTINGS = (
     ("buffer_size", 20_000, MPDQN_GOAL),
     ("learning_starts", 128, MPDQN_GOAL),
     ("grad_clip", 1.0, MPDQN_GOAL),
+    ("reward_scale", 1 / 50, f"{MPDQN_GOAL}: a goal's 50 learnt as 1"),
 )
 """MP-DQN's Goal script's settings over P-DQN's ``paper`` preset (Goal's and Hard Goal's presets)."""
 
