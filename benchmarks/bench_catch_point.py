@@ -46,6 +46,11 @@ ARMS = {
     "catch_point entropy_coef=0.02": ({**CATCH_POINT, "entropy_coef": 0.02}, 1_000_000),
     "catch_point delta=0.01": ({**CATCH_POINT, "delta": 0.01}, 1_000_000),
     "catch_point gae_lambda=0.9": ({**CATCH_POINT, "gae_lambda": 0.9}, 1_000_000),
+    # 2026-12-03: delta 0.01 scored on all three seeds; one more change over it.
+    "catch_point delta=0.01 init_log_std=-2.0": ({**CATCH_POINT, "delta": 0.01, "init_log_std": -2.0}, 1_000_000),
+    "catch_point delta=0.01 gae_lambda=0.9": ({**CATCH_POINT, "delta": 0.01, "gae_lambda": 0.9}, 1_000_000),
+    "catch_point delta=0.01 gamma=0.95": ({**CATCH_POINT, "delta": 0.01, "gamma": 0.95}, 1_000_000),
+    "catch_point delta=0.005": ({**CATCH_POINT, "delta": 0.005}, 1_000_000),
 }
 
 EXPERIMENT = Experiment(
