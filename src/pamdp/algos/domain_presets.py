@@ -16,8 +16,10 @@ Sources:
 - MP-DQN's HFO script: Bester et al.'s code, ``run_soccer_pdqn.py`` (cycraig/MP-DQN), the settings of their
   Half Field Offense results, as issue 27 lists them.
 - MP-DQN's Goal script: the same repository's ``run_goal_pdqn.py``.
-- HyAR: Li et al. (ICLR 2022), its budgets (``../shared/specs/benchmarks.md``); its other settings were not read
-  here, so what these presets take from TD3 or assume says so.
+- HyAR: Li et al. (ICLR 2022), its budgets (``../shared/specs/benchmarks.md``). HyAR's Catch Point script:
+  ``main_embedding_direction_catch_td3.py`` of HyAR's code (TJU-DRL-LAB/AI-Optimizer's copy), read for ``hyar``'s
+  ``catch_point`` preset (``benchmarks/hyar_scripts.md``); the other ``hyar`` presets take TD3's settings or say
+  what they assume.
 """
 
 from __future__ import annotations
