@@ -144,7 +144,7 @@ def _hyar_catch_point() -> DomainPreset:
         ("latent_dim", 4, HYAR_CATCH),
         ("kl_weight", 0.0625, f"{HYAR_CATCH}: its KL weight 0.5 over a mean, in pamdp's units"),
         ("dynamics_weight", 0.5, f"{HYAR_CATCH}: its state-change weight against a reconstruction weight of 2"),
-        ("warmup_steps", 100_000, f"{HYAR_CATCH}: 5000 random episodes, ~115 000 samples it does not count; counted here"),
+        ("warmup_steps", 100_000, f"{HYAR_CATCH}: 5000 random episodes (~115 000 samples, not in its budget; in ours)"),
         ("warmup_updates", 5_000, HYAR_CATCH),
         ("buffer_size", 1_200_000, f"{HYAR_CATCH}: its representation's replay keeps every sample of the run"),
         ("exploration_noise_start", 1.0, f"{HYAR_CATCH}: noise std 1.0 to 0.1 over 1000 episodes"),
