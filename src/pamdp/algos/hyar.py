@@ -25,7 +25,8 @@ ordinary continuous-control algorithm can act in, and decodes the box back to a 
 Schedule: ``warmup_steps`` samples of uniformly random hybrid actions (the paper: 5000 random episodes; 11 000
 samples are about that many on Platform, whose random episodes last 2.2 steps), then ``warmup_updates`` steps of
 representation training alone, then TD3 with a round of ``vae_updates`` representation steps every
-``vae_interval`` samples.
+``vae_interval`` samples. TD3's exploration noise may start high and fall linearly over ``exploration_noise_steps``
+samples (``exploration_noise_start`` to ``exploration_noise``), as HyAR's own training scripts do.
 
 The paper's appendix (network sizes, learning rates, latent sizes, the percentile, the validity test) was not
 available when this was written: those settings are marked as assumptions in their help. The paper reports
