@@ -113,13 +113,16 @@ _HYAR_HFO = _derived(
 )
 
 
+_TD3_GAMMA = ("gamma", 0.99, "TD3's discount (HyAR's code builds on TD3's)")
+
+
 def _hyar_hybrid(name: str, warmup: int, note: str) -> DomainPreset:
     """HyAR-TD3 on one of HyAR's own domains: the cpu preset, TD3's discount, a warm-up of random samples."""
     return _derived(
         name,
         "cpu",
         note,
-        ("gamma", 0.99, "TD3's discount (HyAR's code builds on TD3's)"),
+        _TD3_GAMMA,
         ("warmup_steps", warmup, "assumed: HyAR warms up on 5000 random episodes that its budget does not count"),
         ("epsilon_steps", 100_000, "assumed: a tenth of the 1M budget"),
     )
@@ -127,32 +130,30 @@ def _hyar_hybrid(name: str, warmup: int, note: str) -> DomainPreset:
 
 HYAR_CATCH = "HyAR's Catch Point script"
 
-
-def _hyar_catch_point() -> DomainPreset:
-    """HyAR-TD3 on Catch Point with the settings of HyAR's own script where pamdp has them (its update rate and
-    network widths stay the cpu preset's)."""
-    return _derived(
-        "catch_point",
-        "cpu",
-        "HyAR's Catch Point script's representation, exploration and replay, over the cpu preset (a quarter of a "
-        "TD3 update a sample, 128-wide networks: HyAR's ~1 update a sample at 256 wide would cost several times "
-        "more). Not expressible here: HyAR's separate TD3 replay of 1e5 samples without the warm-up, its latent box "
-        "on the parameters' latent only, its VAE's multiplicative input fusion and its relabelling tests "
-        "(benchmarks/hyar_scripts.md).",
-        ("gamma", 0.99, "TD3's discount (HyAR's code builds on TD3's)"),
-        ("embed_dim", 4, HYAR_CATCH),
-        ("latent_dim", 4, HYAR_CATCH),
-        ("kl_weight", 0.0625, f"{HYAR_CATCH}: its KL weight 0.5 over a mean, in pamdp's units"),
-        ("dynamics_weight", 0.5, f"{HYAR_CATCH}: its state-change weight against a reconstruction weight of 2"),
-        ("warmup_steps", 100_000, f"{HYAR_CATCH}: 5000 random episodes (~115 000 samples, not in its budget; in ours)"),
-        ("warmup_updates", 5_000, HYAR_CATCH),
-        ("buffer_size", 1_200_000, f"{HYAR_CATCH}: its representation's replay keeps every sample of the run"),
-        ("exploration_noise_start", 1.0, f"{HYAR_CATCH}: noise std 1.0 to 0.1 over 1000 episodes"),
-        ("exploration_noise_steps", 25_000, f"{HYAR_CATCH}: 1000 episodes of at most 25 samples"),
-        ("epsilon_start", 0.0, f"{HYAR_CATCH}: no epsilon-greedy"),
-        ("epsilon_end", 0.0, f"{HYAR_CATCH}: no epsilon-greedy"),
-        ("target_noise", 0.1, "HyAR's TD3 (P_TD3_relable.py)"),
-    )
+_HYAR_CATCH_POINT = _derived(
+    "catch_point",
+    "cpu",
+    "HyAR's Catch Point script's representation, exploration and replay, over the cpu preset (a quarter of a "
+    "TD3 update a sample, 128-wide networks: HyAR's ~1 update a sample at 256 wide would cost several times "
+    "more). Not expressible here: HyAR's separate TD3 replay of 1e5 samples without the warm-up, its latent box "
+    "on the parameters' latent only, its VAE's multiplicative input fusion and its relabelling tests "
+    "(benchmarks/hyar_scripts.md).",
+    _TD3_GAMMA,
+    ("embed_dim", 4, HYAR_CATCH),
+    ("latent_dim", 4, HYAR_CATCH),
+    ("kl_weight", 0.0625, f"{HYAR_CATCH}: its KL weight 0.5 over a mean, in pamdp's units"),
+    ("dynamics_weight", 0.5, f"{HYAR_CATCH}: its state-change weight against a reconstruction weight of 2"),
+    ("warmup_steps", 100_000, f"{HYAR_CATCH}: 5000 random episodes (~115 000 samples, not in its budget; in ours)"),
+    ("warmup_updates", 5_000, HYAR_CATCH),
+    ("buffer_size", 1_200_000, f"{HYAR_CATCH}: its representation's replay keeps every sample of the run"),
+    ("exploration_noise_start", 1.0, f"{HYAR_CATCH}: noise std 1.0 to 0.1 over 1000 episodes"),
+    ("exploration_noise_steps", 25_000, f"{HYAR_CATCH}: 1000 episodes of at most 25 samples"),
+    ("epsilon_start", 0.0, f"{HYAR_CATCH}: no epsilon-greedy"),
+    ("epsilon_end", 0.0, f"{HYAR_CATCH}: no epsilon-greedy"),
+    ("target_noise", 0.1, "HyAR's TD3 (P_TD3_relable.py)"),
+)
+"""HyAR-TD3 on Catch Point with the settings of HyAR's own script where pamdp has them (its update rate and network
+widths stay the cpu preset's)."""
 
 
 def _mpdqn_hybrid(name: str, note: str, *more: tuple[str, Any, str]) -> DomainPreset:
@@ -309,7 +310,7 @@ DOMAIN_PRESETS: dict[tuple[str, str, tuple], DomainPreset] = {
     ),
     ("hyar", "pamdp/Goal-v0", ANY): _hyar_hybrid("goal", 5_000, "HyAR's Goal budget is 300k samples."),
     ("hyar", "pamdp/HardGoal-v0", ANY): _hyar_hybrid("hard_goal", 5_000, "HyAR's Hard Goal budget is 300k samples."),
-    ("hyar", "pamdp/CatchPoint-v0", ANY): _hyar_catch_point(),
+    ("hyar", "pamdp/CatchPoint-v0", ANY): _HYAR_CATCH_POINT,
     ("hyar", HARD_MOVE, ANY): _hyar_hybrid("hard_move", 20_000, "HyAR's Hard Move budget is 1M samples."),
     ("pasvg0", HARD_MOVE, LARGE_K): _derived(
         "hard_move_large",

@@ -432,8 +432,9 @@ class HyAR(Algorithm):
     def _run_epoch(self) -> dict[str, float]:
         stats = self.loop.run_epoch(self.vec_env, self._explore, self._update, self.num_timesteps, self.np_rng)
         stats["train/latent_box_width"] = float((self.actor.high - self.actor.low).mean())
-        stats["train/epsilon"] = self.epsilon(self.num_timesteps + stats["steps"])
-        stats["train/noise_std"] = self.noise_std(self.num_timesteps + stats["steps"])
+        step = self.num_timesteps + stats["steps"]
+        stats["train/epsilon"] = self.epsilon(step)
+        stats["train/noise_std"] = self.noise_std(step)
         return stats
 
     def train_representation(self, updates: int) -> dict[str, float]:
