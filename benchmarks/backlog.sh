@@ -36,9 +36,7 @@ suite() {  # issue 26: the suite's missing cells, the cheapest first, then the o
     # HyAR-TD3's catch_point preset (HyAR's script's settings, 2026-12-03): seed 0 ran as a screen
     # (benchmarks/hyar_scripts.md); ~20 CPU minutes a run
     $s --seeds 1,2 --runs HyAR-TD3_on_Catch_Point
-    # MP-DQN on Goal and Hard Goal with the reward scale 1/50 ran on 2026-12-03 (docs/results.md); a seed that
-    # did not finish then resumes here
-    $s --seeds 0,1,2 --runs MP-DQN_on_Hard_Goal
+    # MP-DQN on Goal and Hard Goal with the reward scale 1/50 ran on 2026-12-03, 3 seeds each (docs/results.md)
     for run in Hard_Move_n=10 Hard_Move_n=6 Hard_Move_n=4 Hard_Goal Goal; do
         $s --seeds 0 --runs "HyAR-TD3_on_$run"
     done
