@@ -192,6 +192,28 @@ def test_plot_averages_only_runs_of_one_algorithm_and_env(tmp_path):
     ]
 
 
+def test_plot_follows_symbolic_links_and_counts_each_run_once(tmp_path):
+    """Runs gathered from several places by links (a directory of runs, or one run) are read, a run reached twice
+    is one seed, and a link back up the tree does not loop."""
+    from pamdp.experiments.plots import find_groups
+
+    write_run(tmp_path / "elsewhere" / "A" / "seed0", "patrpo", "pamdp/Platform-v0", [0.1])
+    write_run(tmp_path / "elsewhere" / "A" / "seed1", "patrpo", "pamdp/Platform-v0", [0.3])
+    write_run(tmp_path / "other" / "seed2", "patrpo", "pamdp/Platform-v0", [0.5])
+    tree = tmp_path / "tree"
+    (tree / "A").mkdir(parents=True)
+    (tree / "A" / "seed0").symlink_to(tmp_path / "elsewhere" / "A" / "seed0")
+    (tree / "A" / "seed1").symlink_to(tmp_path / "elsewhere" / "A" / "seed1")
+    (tree / "A" / "seed2").symlink_to(tmp_path / "other" / "seed2")
+    (tree / "A" / "again").symlink_to(tmp_path / "elsewhere" / "A" / "seed0")
+    (tree / "A" / "loop").symlink_to(tree)
+    groups = find_groups([tree])
+    assert list(groups) == ["A"]
+    assert sorted(os.path.realpath(p) for p in groups["A"]) == sorted(
+        os.path.realpath(tmp_path / d) for d in ("elsewhere/A/seed0", "elsewhere/A/seed1", "other/seed2")
+    )
+
+
 @pytest.mark.parametrize("x", ["epochs", "samples"])
 def test_a_curve_of_one_epoch_shows_as_a_point_on_ticks_that_do_not_overlap(x, tmp_path):
     """A reproduce at ``--scale 0.01`` trains one epoch per run: one point per curve."""

@@ -59,7 +59,7 @@ def find_groups(roots: list[str | os.PathLike]) -> dict[str, list[Path]]:
     for root in map(Path, roots):
         if not root.exists():
             raise FileNotFoundError(f"no such directory: {root}")
-        runs = [root] if (root / "progress.csv").exists() else sorted(p.parent for p in root.rglob("progress.csv"))
+        runs = [root] if (root / "progress.csv").exists() else _run_dirs(root)
         for run in runs:
             recorded = _recorded(run)
             label = str(recorded.get("label") or "") or (run.parent.name if run != root else run.name)
@@ -73,6 +73,22 @@ def find_groups(roots: list[str | os.PathLike]) -> dict[str, list[Path]]:
         (label if kinds[label] == 1 else f"{label} ({' on '.join(kind)})"): runs
         for (label, kind), runs in found.items()
     }
+
+
+def _run_dirs(root: Path) -> list[Path]:
+    """The directories below ``root`` that hold a ``progress.csv``, sorted. Symbolic links are followed (a tree
+    gathered from several places by links is read whole), each real directory once, so that two links to one
+    run count it once and a link back up the tree ends the walk there."""
+    seen, runs = set(), []
+    for path, subdirs, files in os.walk(root, followlinks=True):
+        real = os.path.realpath(path)
+        if real in seen:
+            subdirs.clear()
+            continue
+        seen.add(real)
+        if "progress.csv" in files:
+            runs.append(Path(path))
+    return sorted(runs)
 
 
 def _recorded(run: Path) -> dict:
