@@ -51,6 +51,17 @@ ARMS = {
     "catch_point delta=0.01 gae_lambda=0.9": ({**CATCH_POINT, "delta": 0.01, "gae_lambda": 0.9}, 1_000_000),
     "catch_point delta=0.01 gamma=0.95": ({**CATCH_POINT, "delta": 0.01, "gamma": 0.95}, 1_000_000),
     "catch_point delta=0.005": ({**CATCH_POINT, "delta": 0.005}, 1_000_000),
+    # 2026-12-03 (second session), against the failures of catch_point_failures.md: early catches (a better critic),
+    # a sector given up and an imprecise heading near +-pi (a wider policy), noisy steps (a larger batch).
+    "catch_point vf 256x256 10 epochs": ({**CATCH_POINT, "vf_hidden_sizes": (256, 256), "vf_epochs": 10}, 1_000_000),
+    "catch_point hidden_sizes=256x256": ({**CATCH_POINT, "hidden_sizes": (256, 256)}, 1_000_000),
+    "catch_point batch_size=10000": ({**CATCH_POINT, "batch_size": 10_000}, 1_000_000),
+    # the critic's arm scored 0.791, 0.934, 0.940 on seeds 0-2: more of it
+    "catch_point vf 256x256 20 epochs": ({**CATCH_POINT, "vf_hidden_sizes": (256, 256), "vf_epochs": 20}, 1_000_000),
+    "catch_point vf 256x256 10 epochs batch_size=10000": (
+        {**CATCH_POINT, "vf_hidden_sizes": (256, 256), "vf_epochs": 10, "batch_size": 10_000},
+        1_000_000,
+    ),
 }
 
 EXPERIMENT = Experiment(
