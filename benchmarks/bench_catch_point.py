@@ -27,7 +27,8 @@ RECORD = HERE / "catch_point.md"
 ENV = "pamdp/CatchPoint-v0"
 
 CATCH_POINT = {"init_log_std": -1.5, "entropy_coef": 0.05}
-"""The ``catch_point`` preset of ``patrpo``: these settings over the tuned preset."""
+"""The ``catch_point`` preset of ``patrpo`` until 2026-12-03 (second session): these settings over the tuned preset;
+since then also the arm ``catch_point vf 256x256 10 epochs``'s."""
 
 # label -> (settings over the tuned preset, samples); the tuned preset's own init_log_std is -0.5.
 ARMS = {

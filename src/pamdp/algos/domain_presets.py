@@ -276,10 +276,13 @@ DOMAIN_PRESETS: dict[tuple[str, str, tuple], DomainPreset] = {
         "catch_point",
         "tuned",
         "The tuned preset with less parameter noise and a larger entropy weight: at the tuned noise even the best "
-        "heading returns less than ending the episode with 11 failed catches, so pi_d collapses onto catch "
-        "(benchmarks/catch_point.md).",
+        "heading returns less than ending the episode with 11 failed catches, so pi_d collapses onto catch; and a "
+        "larger critic fitted longer, against catches tried too early (benchmarks/catch_point.md, "
+        "benchmarks/catch_point_failures.md).",
         ("init_log_std", -1.5, "measured: benchmarks/catch_point.md (issue 26)"),
         ("entropy_coef", 0.05, "measured: benchmarks/catch_point.md (issue 26)"),
+        ("vf_hidden_sizes", (256, 256), "measured: benchmarks/catch_point.md (issue 26)"),
+        ("vf_epochs", 10, "measured: benchmarks/catch_point.md (issue 26)"),
     ),
     ("patrpo", HARD_MOVE, ANY): _derived(
         "hard_move",
