@@ -33,11 +33,10 @@ soccer() {  # issue 27: the paper's soccer figure, one run at a time
 
 suite() {  # issue 26: the suite's missing cells, the cheapest first, then the other seeds; then HFO's PAPPO
     local s="pamdp reproduce benchmark-suite --out $SUITE_OUT"
-    # HyAR-TD3's catch_point preset (HyAR's script's settings, 2026-12-03): seed 0 ran as a screen
-    # (benchmarks/hyar_scripts.md); ~20 CPU minutes a run
-    $s --seeds 1,2 --runs HyAR-TD3_on_Catch_Point
-    # MP-DQN on Goal and Hard Goal with the reward scale 1/50 ran on 2026-12-03, 3 seeds each (docs/results.md)
-    for run in Hard_Move_n=10 Hard_Move_n=6 Hard_Move_n=4 Hard_Goal Goal; do
+    # Done on 2026-12-03 (docs/results.md): HyAR-TD3 on Catch Point and Goal, MP-DQN on Goal and Hard Goal (3 seeds
+    # each), PATRPO on Catch Point with its new critic (3 seeds), MP-DQN on Catch Point (seed 0: 0.125 with the
+    # Platform preset; its other seeds wait for a preset worth running)
+    for run in Hard_Move_n=10 Hard_Move_n=6 Hard_Move_n=4 Hard_Goal; do
         $s --seeds 0 --runs "HyAR-TD3_on_$run"
     done
     $s --seeds 0 --runs P-DQN_on_Hard_Move_n=8,P-DQN_on_Hard_Move_n=10
