@@ -28,7 +28,9 @@ ENV = "pamdp/CatchPoint-v0"
 
 CATCH_POINT = {"init_log_std": -1.5, "entropy_coef": 0.05}
 """The ``catch_point`` preset of ``patrpo`` until 2026-12-03 (second session): these settings over the tuned preset;
-since then also the arm ``catch_point vf 256x256 10 epochs``'s."""
+since then also :data:`CRITIC`."""
+CRITIC = {"vf_hidden_sizes": (256, 256), "vf_epochs": 10}
+"""The critic of the arm ``catch_point vf 256x256 10 epochs``, in the ``catch_point`` preset since then."""
 
 # label -> (settings over the tuned preset, samples); the tuned preset's own init_log_std is -0.5.
 ARMS = {
@@ -54,15 +56,12 @@ ARMS = {
     "catch_point delta=0.005": ({**CATCH_POINT, "delta": 0.005}, 1_000_000),
     # 2026-12-03 (second session), against the failures of catch_point_failures.md: early catches (a better critic),
     # a sector given up and an imprecise heading near +-pi (a wider policy), noisy steps (a larger batch).
-    "catch_point vf 256x256 10 epochs": ({**CATCH_POINT, "vf_hidden_sizes": (256, 256), "vf_epochs": 10}, 1_000_000),
+    "catch_point vf 256x256 10 epochs": ({**CATCH_POINT, **CRITIC}, 1_000_000),
     "catch_point hidden_sizes=256x256": ({**CATCH_POINT, "hidden_sizes": (256, 256)}, 1_000_000),
     "catch_point batch_size=10000": ({**CATCH_POINT, "batch_size": 10_000}, 1_000_000),
     # the critic's arm scored 0.791, 0.934, 0.940 on seeds 0-2: more of it
-    "catch_point vf 256x256 20 epochs": ({**CATCH_POINT, "vf_hidden_sizes": (256, 256), "vf_epochs": 20}, 1_000_000),
-    "catch_point vf 256x256 10 epochs batch_size=10000": (
-        {**CATCH_POINT, "vf_hidden_sizes": (256, 256), "vf_epochs": 10, "batch_size": 10_000},
-        1_000_000,
-    ),
+    "catch_point vf 256x256 20 epochs": ({**CATCH_POINT, **CRITIC, "vf_epochs": 20}, 1_000_000),
+    "catch_point vf 256x256 10 epochs batch_size=10000": ({**CATCH_POINT, **CRITIC, "batch_size": 10_000}, 1_000_000),
 }
 
 EXPERIMENT = Experiment(

@@ -78,9 +78,11 @@ def find_groups(roots: list[str | os.PathLike]) -> dict[str, list[Path]]:
 def _run_dirs(root: Path) -> list[Path]:
     """The directories below ``root`` that hold a ``progress.csv``, sorted. Symbolic links are followed (a tree
     gathered from several places by links is read whole), each real directory once, so that two links to one
-    run count it once and a link back up the tree ends the walk there."""
+    run count it once and a link back up the tree ends the walk there. The walk goes in name order, so which of
+    two paths to one run is kept (its label comes from its parent's name) does not depend on the file system."""
     seen, runs = set(), []
     for path, subdirs, files in os.walk(root, followlinks=True):
+        subdirs.sort()
         real = os.path.realpath(path)
         if real in seen:
             subdirs.clear()
