@@ -62,6 +62,11 @@ ARMS = {
     # the critic's arm scored 0.791, 0.934, 0.940 on seeds 0-2: more of it
     "catch_point vf 256x256 20 epochs": ({**CATCH_POINT, **CRITIC, "vf_epochs": 20}, 1_000_000),
     "catch_point vf 256x256 10 epochs batch_size=10000": ({**CATCH_POINT, **CRITIC, "batch_size": 10_000}, 1_000_000),
+    # 2026-12-03 (third session): the catch_point preset (with its critic) and one change of the earlier arms that
+    # came close (delta 0.01, gae_lambda 0.9), or a slower, steadier fit of its larger critic.
+    "catch_point delta=0.01 (critic)": ({**CATCH_POINT, **CRITIC, "delta": 0.01}, 1_000_000),
+    "catch_point gae_lambda=0.9 (critic)": ({**CATCH_POINT, **CRITIC, "gae_lambda": 0.9}, 1_000_000),
+    "catch_point vf_lr=3e-4 (critic)": ({**CATCH_POINT, **CRITIC, "vf_lr": 3e-4}, 1_000_000),
 }
 
 EXPERIMENT = Experiment(
