@@ -261,7 +261,8 @@ class BatchedVectorEnv(VectorEnv):
             self.streams.refill(self.draws_per_step)
         obs, rewards, terminated, truncated, infos = self._step_copies(actions, resetting)
         self._autoreset = np.empty(self.num_envs, dtype=bool)  # a new array: ``resetting`` was handed out
-        _end_step(resetting, rewards, terminated, truncated, self._elapsed, self.max_episode_steps or 0, self._autoreset)
+        limit = self.max_episode_steps or 0
+        _end_step(resetting, rewards, terminated, truncated, self._elapsed, limit, self._autoreset)
         return obs, rewards, terminated, truncated, infos
 
     def render(self):
