@@ -1,9 +1,10 @@
-"""PATRPO on Catch Point (issue 26): the tuned preset against lower initial parameter noise, greedy success rates.
+"""PATRPO (and MP-DQN) on Catch Point (issue 26): arms of settings over a preset, greedy success rates.
 
     nice python benchmarks/bench_catch_point.py [--runs "tuned,init_log_std=-1.5"] [--seeds 0,1,2] [--out DIR]
         [--record-only]
 
-Each arm is PATRPO's tuned preset with the arm's settings over it. Runs the chosen arms (default: all) seed by
+Each arm is PATRPO's tuned preset with the arm's settings over it, or, where the arm names them, another
+algorithm's preset (MP-DQN's ``catch_point``: ``pdqn`` with multi-pass). Runs the chosen arms (default: all) seed by
 seed, one run at a time, each resuming from its checkpoint, and after every finished run rewrites
 benchmarks/catch_point.md: per arm, each finished seed's greedy success rate over 1000 episodes, their median,
 the median greedy return and the CPU time of a run. The runs go to DIR/catch_point/LABEL/seedN (default
@@ -69,16 +70,40 @@ ARMS = {
     "catch_point vf_lr=3e-4 (critic)": ({**CATCH_POINT, **CRITIC, "vf_lr": 3e-4}, 1_000_000),
 }
 
+# 2026-12-03 (third session): MP-DQN's catch_point preset (0.125 on seed 0, every greedy episode spent catching)
+# explores the parameters only by OU noise of scale 1e-4, so the heading of a move is never varied: arms that
+# explore it.
+MPDQN = ("pdqn", "catch_point")
+ARMS |= {
+    "MP-DQN explore_params": ({"explore_params": True}, 300_000, *MPDQN),
+    "MP-DQN explore_params gaussian 0.1": (
+        {"explore_params": True, "ou_sigma": 0.1, "ou_theta": 1.0},
+        300_000,
+        *MPDQN,
+    ),
+    "MP-DQN explore_params epsilon_steps=100000": (
+        {"explore_params": True, "epsilon_steps": 100_000},
+        300_000,
+        *MPDQN,
+    ),
+}
+
+
+def algo_preset(label: str) -> tuple[str, str]:
+    """The algorithm and preset an arm's settings go over: PATRPO's tuned one unless the arm names others."""
+    return tuple(ARMS[label][2:]) or ("patrpo", "tuned")
+
+
 EXPERIMENT = Experiment(
     "catch_point",
-    "PATRPO on Catch Point: the tuned preset and lower initial parameter noise",
+    "Catch Point: PATRPO's tuned preset and lower initial parameter noise, and MP-DQN's exploration",
     ENV,
     None,
     (0, 1, 2),
     1000,
     tuple(
-        {"label": label, "algo": "patrpo", "preset": "tuned", "settings": settings, "total_steps": steps}
-        for label, (settings, steps) in ARMS.items()
+        dict(zip(("algo", "preset"), algo_preset(label)), label=label, settings=arm[0], total_steps=arm[1])
+        for label, arm in ARMS.items()
     ),
 )
 
@@ -95,6 +120,8 @@ def _arm_row(label: str, jobs) -> str:
         elif rows:
             partial.append(where_unfinished(spec, rows))
     settings = ", ".join(f"{k} = {v}" for k, v in ARMS[label][0].items()) or "(the preset's)"
+    if algo_preset(label) != ("patrpo", "tuned"):
+        settings = "{} {}: {}".format(*algo_preset(label), settings)
     per_seed = ", ".join(f"{s}: {r:.3f}" for s, r, _, _ in done) or "-"
     rate, ret, cpu = (np.median([d[i] for d in done]) if done else None for i in (1, 2, 3))
     return (
@@ -106,12 +133,13 @@ def _arm_row(label: str, jobs) -> str:
 
 def write(arms: dict, command: str) -> None:
     lines = record_head(EXPERIMENT.description, command, rewritten=True) + [
-        f"- `pamdp train patrpo --env {ENV} --preset tuned --seed N --total-steps S [--SETTING VALUE]`, one run at a "
-        "time beside other long runs; success rate and return: 1000 greedy episodes of each seed's final model "
+        f"- `pamdp train patrpo --env {ENV} --preset tuned --seed N --total-steps S [--SETTING VALUE]` (an arm that "
+        "names another algorithm and preset: `pamdp train ALGO --preset PRESET ...`), one run at a time beside other "
+        "long runs; success rate and return: 1000 greedy episodes of each seed's final model "
         "(`pamdp evaluate RUN --episodes 1000 --json` gives the same figures)",
         "",
-        "| arm | settings over tuned | samples | greedy success rate per seed | median | median greedy return "
-        "| CPU min per run (median) | unfinished |",
+        "| arm | settings over PATRPO's tuned preset (or the named one) | samples | greedy success rate per seed "
+        "| median | median greedy return | CPU min per run (median) | unfinished |",
         "|---|---|---|---|---|---|---|---|",
     ]
     kept = kept_rows(RECORD, ARMS)
