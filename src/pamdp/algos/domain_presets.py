@@ -18,8 +18,9 @@ Sources:
 - MP-DQN's Goal script: the same repository's ``run_goal_pdqn.py``.
 - HyAR: Li et al. (ICLR 2022), its budgets (``../shared/specs/benchmarks.md``). HyAR's Catch Point script:
   ``main_embedding_direction_catch_td3.py`` of HyAR's code (TJU-DRL-LAB/AI-Optimizer's copy), read for ``hyar``'s
-  ``catch_point`` preset (``benchmarks/hyar_scripts.md``); the other ``hyar`` presets take TD3's settings or say
-  what they assume.
+  ``catch_point`` preset (``benchmarks/hyar_scripts.md``); HyAR's Hard Move script, ``main_embedding_hard_move_td3.py``
+  (Metro1998/HyAR's copy), for its ``hard_move`` preset; the other ``hyar`` presets take TD3's settings or say what
+  they assume.
 """
 
 from __future__ import annotations
@@ -129,31 +130,61 @@ def _hyar_hybrid(name: str, warmup: int, note: str) -> DomainPreset:
 
 
 HYAR_CATCH = "HyAR's Catch Point script"
+HYAR_HARD_MOVE = "HyAR's Hard Move script"
+_HYAR_NOT_EXPRESSIBLE = (
+    "over the cpu preset (a quarter of a TD3 update a sample, 128-wide networks: HyAR's ~1 update a sample at 256 "
+    "wide would cost several times more). Not expressible here: HyAR's separate TD3 replay without the warm-up, its "
+    "latent box on the parameters' latent only, its VAE's multiplicative input fusion and its relabelling tests "
+    "(benchmarks/hyar_scripts.md)."
+)
 
-_HYAR_CATCH_POINT = _derived(
+
+def _hyar_script(name: str, script: str, latents: int, episode: int, warmup_note: str, note: str) -> DomainPreset:
+    """HyAR-TD3 with the settings of one of HyAR's own scripts where pamdp has them: ``latents`` dimensions for the
+    embedding and for the parameters' latent, episodes of at most ``episode`` samples (the noise falls over 1000 of
+    them), a warm-up of 100 000 random samples inside the budget."""
+    return _derived(
+        name,
+        "cpu",
+        f"{note} {_HYAR_NOT_EXPRESSIBLE}",
+        _TD3_GAMMA,
+        ("embed_dim", latents, script),
+        ("latent_dim", latents, script),
+        # HyAR's loss: 2 x the reconstruction of one parameter + 0.5 x the KL's mean over the latent's dimensions
+        ("kl_weight", 0.5 / 2 / latents, f"{script}: its KL weight 0.5 over a mean, in pamdp's units"),
+        ("dynamics_weight", 0.5, f"{script}: its state-change weight against a reconstruction weight of 2"),
+        ("warmup_steps", 100_000, f"{script}: {warmup_note}"),
+        ("warmup_updates", 5_000, script),
+        ("buffer_size", 1_200_000, f"{script}: its representation's replay keeps every sample of the run"),
+        ("exploration_noise_start", 1.0, f"{script}: noise std 1.0 to 0.1 over 1000 episodes"),
+        ("exploration_noise_steps", 1000 * episode, f"{script}: 1000 episodes of at most {episode} samples"),
+        ("epsilon_start", 0.0, f"{script}: no epsilon-greedy"),
+        ("epsilon_end", 0.0, f"{script}: no epsilon-greedy"),
+        ("target_noise", 0.1, "HyAR's TD3 (P_TD3_relable.py)"),
+    )
+
+
+_HYAR_CATCH_POINT = _hyar_script(
     "catch_point",
-    "cpu",
-    "HyAR's Catch Point script's representation, exploration and replay, over the cpu preset (a quarter of a "
-    "TD3 update a sample, 128-wide networks: HyAR's ~1 update a sample at 256 wide would cost several times "
-    "more). Not expressible here: HyAR's separate TD3 replay of 1e5 samples without the warm-up, its latent box "
-    "on the parameters' latent only, its VAE's multiplicative input fusion and its relabelling tests "
-    "(benchmarks/hyar_scripts.md).",
-    _TD3_GAMMA,
-    ("embed_dim", 4, HYAR_CATCH),
-    ("latent_dim", 4, HYAR_CATCH),
-    ("kl_weight", 0.0625, f"{HYAR_CATCH}: its KL weight 0.5 over a mean, in pamdp's units"),
-    ("dynamics_weight", 0.5, f"{HYAR_CATCH}: its state-change weight against a reconstruction weight of 2"),
-    ("warmup_steps", 100_000, f"{HYAR_CATCH}: 5000 random episodes (~115 000 samples, not in its budget; in ours)"),
-    ("warmup_updates", 5_000, HYAR_CATCH),
-    ("buffer_size", 1_200_000, f"{HYAR_CATCH}: its representation's replay keeps every sample of the run"),
-    ("exploration_noise_start", 1.0, f"{HYAR_CATCH}: noise std 1.0 to 0.1 over 1000 episodes"),
-    ("exploration_noise_steps", 25_000, f"{HYAR_CATCH}: 1000 episodes of at most 25 samples"),
-    ("epsilon_start", 0.0, f"{HYAR_CATCH}: no epsilon-greedy"),
-    ("epsilon_end", 0.0, f"{HYAR_CATCH}: no epsilon-greedy"),
-    ("target_noise", 0.1, "HyAR's TD3 (P_TD3_relable.py)"),
+    HYAR_CATCH,
+    4,
+    25,
+    "5000 random episodes (~115 000 samples, not in its budget; in ours)",
+    "HyAR's Catch Point script's representation, exploration and replay,",
 )
 """HyAR-TD3 on Catch Point with the settings of HyAR's own script where pamdp has them (its update rate and network
 widths stay the cpu preset's)."""
+
+_HYAR_HARD_MOVE = _hyar_script(
+    "hard_move",
+    HYAR_HARD_MOVE,
+    6,
+    30,
+    "5000 random episodes (up to 150 000 samples, not in its budget; in ours, as on Catch Point)",
+    "HyAR's Hard Move script's representation, exploration and replay (since 2026-12-03; before, the cpu preset "
+    "with a 20 000-sample warm-up, 0.263 at n = 8),",
+)
+"""HyAR-TD3 on Hard Move with the settings of HyAR's own script where pamdp has them, as :data:`_HYAR_CATCH_POINT`."""
 
 
 def _mpdqn_hybrid(name: str, note: str, *more: tuple[str, Any, str]) -> DomainPreset:
@@ -314,7 +345,7 @@ DOMAIN_PRESETS: dict[tuple[str, str, tuple], DomainPreset] = {
     ("hyar", "pamdp/Goal-v0", ANY): _hyar_hybrid("goal", 5_000, "HyAR's Goal budget is 300k samples."),
     ("hyar", "pamdp/HardGoal-v0", ANY): _hyar_hybrid("hard_goal", 5_000, "HyAR's Hard Goal budget is 300k samples."),
     ("hyar", "pamdp/CatchPoint-v0", ANY): _HYAR_CATCH_POINT,
-    ("hyar", HARD_MOVE, ANY): _hyar_hybrid("hard_move", 20_000, "HyAR's Hard Move budget is 1M samples."),
+    ("hyar", HARD_MOVE, ANY): _HYAR_HARD_MOVE,
     ("pasvg0", HARD_MOVE, LARGE_K): _derived(
         "hard_move_large",
         "tuned",
