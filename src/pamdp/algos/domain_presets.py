@@ -19,8 +19,9 @@ Sources:
 - HyAR: Li et al. (ICLR 2022), its budgets (``../shared/specs/benchmarks.md``). HyAR's Catch Point script:
   ``main_embedding_direction_catch_td3.py`` of HyAR's code (TJU-DRL-LAB/AI-Optimizer's copy), read for ``hyar``'s
   ``catch_point`` preset (``benchmarks/hyar_scripts.md``); HyAR's Hard Move script, ``main_embedding_hard_move_td3.py``
-  (Metro1998/HyAR's copy), for its ``hard_move`` preset; the other ``hyar`` presets take TD3's settings or say what
-  they assume.
+  (Metro1998/HyAR's copy), for its ``hard_move`` preset; its Goal and Hard Goal scripts,
+  ``main_embedding_goal_td3.py`` and ``main_embedding_hard_goal_td3.py`` (the same settings), for ``goal`` and
+  ``hard_goal``; the other ``hyar`` presets take TD3's settings or say what they assume.
 """
 
 from __future__ import annotations
@@ -117,20 +118,9 @@ _HYAR_HFO = _derived(
 _TD3_GAMMA = ("gamma", 0.99, "TD3's discount (HyAR's code builds on TD3's)")
 
 
-def _hyar_hybrid(name: str, warmup: int, note: str) -> DomainPreset:
-    """HyAR-TD3 on one of HyAR's own domains: the cpu preset, TD3's discount, a warm-up of random samples."""
-    return _derived(
-        name,
-        "cpu",
-        note,
-        _TD3_GAMMA,
-        ("warmup_steps", warmup, "assumed: HyAR warms up on 5000 random episodes that its budget does not count"),
-        ("epsilon_steps", 100_000, "assumed: a tenth of the 1M budget"),
-    )
-
-
 HYAR_CATCH = "HyAR's Catch Point script"
 HYAR_HARD_MOVE = "HyAR's Hard Move script"
+HYAR_GOAL = "HyAR's Goal script"
 _HYAR_NOT_EXPRESSIBLE = (
     "over the cpu preset (a quarter of a TD3 update a sample, 128-wide networks: HyAR's ~1 update a sample at 256 "
     "wide would cost several times more). Not expressible here: HyAR's separate TD3 replay without the warm-up, its "
@@ -139,10 +129,13 @@ _HYAR_NOT_EXPRESSIBLE = (
 )
 
 
-def _hyar_script(name: str, script: str, latents: int, episode: int, warmup_note: str, note: str) -> DomainPreset:
+def _hyar_script(name: str, script: str, note: str, *, latents: int, params: int, warmup: tuple[int, str],
+                 buffer: int, noise_steps: tuple[int, str]) -> DomainPreset:  # fmt: skip
     """HyAR-TD3 with the settings of one of HyAR's own scripts where pamdp has them: ``latents`` dimensions for the
-    embedding and for the parameters' latent, episodes of at most ``episode`` samples (the noise falls over 1000 of
-    them), a warm-up of 100 000 random samples inside the budget."""
+    embedding and for the parameters' latent, a VAE that reconstructs ``params`` parameters, ``warmup`` random
+    samples (inside the budget; with where the number comes from), a replay of ``buffer`` samples (more than the
+    run: HyAR's representation replay keeps it all), exploration noise falling from 1.0 to 0.1 over
+    ``noise_steps`` samples (HyAR: over 1000 episodes)."""
     return _derived(
         name,
         "cpu",
@@ -150,14 +143,15 @@ def _hyar_script(name: str, script: str, latents: int, episode: int, warmup_note
         _TD3_GAMMA,
         ("embed_dim", latents, script),
         ("latent_dim", latents, script),
-        # HyAR's loss: 2 x the reconstruction of one parameter + 0.5 x the KL's mean over the latent's dimensions
-        ("kl_weight", 0.5 / 2 / latents, f"{script}: its KL weight 0.5 over a mean, in pamdp's units"),
-        ("dynamics_weight", 0.5, f"{script}: its state-change weight against a reconstruction weight of 2"),
-        ("warmup_steps", 100_000, f"{script}: {warmup_note}"),
+        # HyAR's VAE loss is state change + 2 x reconstruction + 0.5 x KL, each a mean over its dimensions; pamdp's
+        # sums the reconstruction and the KL, so HyAR's weights over its reconstruction weight become these.
+        ("kl_weight", params / 4 / latents, f"{script}: its KL weight 0.5 over a mean, in pamdp's units"),
+        ("dynamics_weight", params / 2, f"{script}: its state-change weight against a reconstruction weight of 2"),
+        ("warmup_steps", warmup[0], f"{script}: {warmup[1]}"),
         ("warmup_updates", 5_000, script),
-        ("buffer_size", 1_200_000, f"{script}: its representation's replay keeps every sample of the run"),
+        ("buffer_size", buffer, f"{script}: its representation's replay keeps every sample of the run"),
         ("exploration_noise_start", 1.0, f"{script}: noise std 1.0 to 0.1 over 1000 episodes"),
-        ("exploration_noise_steps", 1000 * episode, f"{script}: 1000 episodes of at most {episode} samples"),
+        ("exploration_noise_steps", noise_steps[0], f"{script}: {noise_steps[1]}"),
         ("epsilon_start", 0.0, f"{script}: no epsilon-greedy"),
         ("epsilon_end", 0.0, f"{script}: no epsilon-greedy"),
         ("target_noise", 0.1, "HyAR's TD3 (P_TD3_relable.py)"),
@@ -167,10 +161,12 @@ def _hyar_script(name: str, script: str, latents: int, episode: int, warmup_note
 _HYAR_CATCH_POINT = _hyar_script(
     "catch_point",
     HYAR_CATCH,
-    4,
-    25,
-    "5000 random episodes (~115 000 samples, not in its budget; in ours)",
     "HyAR's Catch Point script's representation, exploration and replay,",
+    latents=4,
+    params=1,
+    warmup=(100_000, "5000 random episodes (~115 000 samples, not in its budget; in ours)"),
+    buffer=1_200_000,
+    noise_steps=(25_000, "1000 episodes of at most 25 samples"),
 )
 """HyAR-TD3 on Catch Point with the settings of HyAR's own script where pamdp has them (its update rate and network
 widths stay the cpu preset's)."""
@@ -178,13 +174,31 @@ widths stay the cpu preset's)."""
 _HYAR_HARD_MOVE = _hyar_script(
     "hard_move",
     HYAR_HARD_MOVE,
-    6,
-    30,
-    "5000 random episodes (up to 150 000 samples, not in its budget; in ours, as on Catch Point)",
     "HyAR's Hard Move script's representation, exploration and replay (since 2026-12-03; before, the cpu preset "
     "with a 20 000-sample warm-up, 0.263 at n = 8),",
+    latents=6,
+    params=1,
+    warmup=(100_000, "5000 random episodes (up to 150 000 samples, not in its budget; in ours, as on Catch Point)"),
+    buffer=1_200_000,
+    noise_steps=(30_000, "1000 episodes of at most 30 samples"),
 )
 """HyAR-TD3 on Hard Move with the settings of HyAR's own script where pamdp has them, as :data:`_HYAR_CATCH_POINT`."""
+
+
+def _hyar_goal(name: str, domain: str) -> DomainPreset:
+    """HyAR-TD3 on Goal or Hard Goal with the settings of HyAR's Goal script (its Hard Goal script has the same: 6/6
+    latents, a VAE over two parameters, 20 000 random episodes, the same noise schedule)."""
+    return _hyar_script(
+        name,
+        HYAR_GOAL,
+        f"HyAR's Goal script's representation, exploration and replay on {domain} (since 2026-12-03; before, the cpu "
+        "preset with a 5 000-sample warm-up, 0.00 on Goal and 0.04 on Hard Goal over 3 seeds),",
+        latents=6,
+        params=2,
+        warmup=(30_000, "20 000 random episodes (~30 000 samples, not in its budget; in ours)"),
+        buffer=400_000,
+        noise_steps=(10_000, "1000 episodes, ~10 000 samples at the start of a run"),
+    )
 
 
 def _mpdqn_hybrid(name: str, note: str, *more: tuple[str, Any, str]) -> DomainPreset:
@@ -342,8 +356,8 @@ DOMAIN_PRESETS: dict[tuple[str, str, tuple], DomainPreset] = {
     ("pdqn", "pamdp/Sliding-v0", ANY): _mpdqn_hybrid(
         "sliding", "No published settings; the tuned preset with multi-pass."
     ),
-    ("hyar", "pamdp/Goal-v0", ANY): _hyar_hybrid("goal", 5_000, "HyAR's Goal budget is 300k samples."),
-    ("hyar", "pamdp/HardGoal-v0", ANY): _hyar_hybrid("hard_goal", 5_000, "HyAR's Hard Goal budget is 300k samples."),
+    ("hyar", "pamdp/Goal-v0", ANY): _hyar_goal("goal", "Goal"),
+    ("hyar", "pamdp/HardGoal-v0", ANY): _hyar_goal("hard_goal", "Hard Goal"),
     ("hyar", "pamdp/CatchPoint-v0", ANY): _HYAR_CATCH_POINT,
     ("hyar", HARD_MOVE, ANY): _HYAR_HARD_MOVE,
     ("pasvg0", HARD_MOVE, LARGE_K): _derived(
