@@ -337,7 +337,16 @@ DOMAIN_PRESETS: dict[tuple[str, str, tuple], DomainPreset] = {
         "(benchmarks/large_k_cost.md).",
         ("pi_c_input", "state", "measured: docs/results.md, benchmark suite (issue 26)"),
     ),
-    ("pdqn", "pamdp/CatchPoint-v0", ANY): _mpdqn_hybrid("catch_point", "HyAR's P-DQN settings were not read here."),
+    ("pdqn", "pamdp/CatchPoint-v0", ANY): _mpdqn_hybrid(
+        "catch_point",
+        "HyAR's P-DQN settings were not read here. The heading of a move must be explored (the tuned preset's OU "
+        "noise of 1e-4 never varies it, and MP-DQN gave up on moving: 0.125) and a one-layer 64-wide network "
+        "learns it too coarsely (benchmarks/catch_point.md).",
+        ("explore_params", True, "measured: benchmarks/catch_point.md (issue 26)"),
+        ("ou_sigma", 0.1, "measured: benchmarks/catch_point.md (issue 26)"),
+        ("ou_theta", 1.0, "measured: benchmarks/catch_point.md (issue 26): i.i.d. Gaussian noise"),
+        ("hidden_sizes", (128, 128), "measured: benchmarks/catch_point.md (issue 26)"),
+    ),
     ("pdqn", HARD_MOVE, ANY): _mpdqn_hybrid(
         "hard_move", "HyAR's P-DQN settings were not read here; 2^n actions, so a wider Q-network.", *_HARD_MOVE_Q
     ),
