@@ -129,8 +129,8 @@ _HYAR_NOT_EXPRESSIBLE = (
 )
 
 
-def _hyar_script(name: str, script: str, note: str, *, latents: int, params: int, warmup: tuple[int, str],
-                 buffer: int, noise_steps: tuple[int, str]) -> DomainPreset:  # fmt: skip
+def _hyar_script(name: str, script: str, note: str, *, latents: int, warmup: tuple[int, str],
+                 noise_steps: tuple[int, str], params: int = 1, buffer: int = 1_200_000) -> DomainPreset:  # fmt: skip
     """HyAR-TD3 with the settings of one of HyAR's own scripts where pamdp has them: ``latents`` dimensions for the
     embedding and for the parameters' latent, a VAE that reconstructs ``params`` parameters, ``warmup`` random
     samples (inside the budget; with where the number comes from), a replay of ``buffer`` samples (more than the
@@ -163,9 +163,7 @@ _HYAR_CATCH_POINT = _hyar_script(
     HYAR_CATCH,
     "HyAR's Catch Point script's representation, exploration and replay,",
     latents=4,
-    params=1,
     warmup=(100_000, "5000 random episodes (~115 000 samples, not in its budget; in ours)"),
-    buffer=1_200_000,
     noise_steps=(25_000, "1000 episodes of at most 25 samples"),
 )
 """HyAR-TD3 on Catch Point with the settings of HyAR's own script where pamdp has them (its update rate and network
@@ -177,9 +175,7 @@ _HYAR_HARD_MOVE = _hyar_script(
     "HyAR's Hard Move script's representation, exploration and replay (since 2026-12-03; before, the cpu preset "
     "with a 20 000-sample warm-up, 0.263 at n = 8),",
     latents=6,
-    params=1,
     warmup=(100_000, "5000 random episodes (up to 150 000 samples, not in its budget; in ours, as on Catch Point)"),
-    buffer=1_200_000,
     noise_steps=(30_000, "1000 episodes of at most 30 samples"),
 )
 """HyAR-TD3 on Hard Move with the settings of HyAR's own script where pamdp has them, as :data:`_HYAR_CATCH_POINT`."""
