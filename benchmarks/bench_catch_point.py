@@ -72,24 +72,23 @@ ARMS = {
 
 # 2026-12-03 (third session): MP-DQN's catch_point preset (0.125 on seed 0, every greedy episode spent catching)
 # explores the parameters only by OU noise of scale 1e-4, so the heading of a move is never varied: arms that
-# explore it.
-MPDQN = ("pdqn", "catch_point")
+# explore it. They go over the settings that preset had then (`pdqn`'s tuned preset with these), not over the
+# preset's name, which since names the last arm's settings.
+MPDQN = ("pdqn", "tuned")
+MPDQN_CATCH_POINT = {"multi_pass": True, "gamma": 0.99}
+"""MP-DQN's ``catch_point`` preset until 2026-12-03 (third session): these settings over ``pdqn``'s tuned preset."""
+GAUSSIAN = {**MPDQN_CATCH_POINT, "explore_params": True, "ou_sigma": 0.1, "ou_theta": 1.0}
 ARMS |= {
-    "MP-DQN explore_params": ({"explore_params": True}, 300_000, *MPDQN),
-    "MP-DQN explore_params gaussian 0.1": (
-        {"explore_params": True, "ou_sigma": 0.1, "ou_theta": 1.0},
-        300_000,
-        *MPDQN,
-    ),
+    "MP-DQN explore_params": ({**MPDQN_CATCH_POINT, "explore_params": True}, 300_000, *MPDQN),
+    "MP-DQN explore_params gaussian 0.1": (GAUSSIAN, 300_000, *MPDQN),
     "MP-DQN explore_params epsilon_steps=100000": (
-        {"explore_params": True, "epsilon_steps": 100_000},
+        {**MPDQN_CATCH_POINT, "explore_params": True, "epsilon_steps": 100_000},
         300_000,
         *MPDQN,
     ),
 }
 # Gaussian noise 0.1 scored 0.409 at 300k (explore_params alone 0.208): more of it, and the critics' targets scaled
 # down as on Goal (a catch's 20 as 1).
-GAUSSIAN = {"explore_params": True, "ou_sigma": 0.1, "ou_theta": 1.0}
 ARMS |= {
     "MP-DQN explore_params gaussian 0.2": ({**GAUSSIAN, "ou_sigma": 0.2}, 300_000, *MPDQN),
     "MP-DQN explore_params gaussian 0.1 reward_scale=0.05": ({**GAUSSIAN, "reward_scale": 0.05}, 300_000, *MPDQN),
@@ -100,7 +99,8 @@ ARMS |= {
     ),
 }
 # At 300k a 128x128 Q-network and actor with noise 0.1 scored 0.799 (its training success near 0.8 from 40k samples
-# on): it at HyAR's 1M. The two arms below it were stopped for it (seed 0 at 520k and 60k samples).
+# on): it at HyAR's 1M, since MP-DQN's catch_point preset. The two arms below it were stopped for it (seed 0 at 520k
+# and 60k samples).
 ARMS |= {
     "MP-DQN explore_params gaussian 0.1 hidden_sizes=128x128 1M": (
         {**GAUSSIAN, "hidden_sizes": (128, 128)},
