@@ -233,7 +233,7 @@ def test_td3_critic_loss_by_hand_and_the_policy_delay():
         "terminated": torch.rand(16, generator=gen) < 0.3,
         "latent": torch.zeros(16, m.latent_size),
     }
-    m.replay.sample = lambda n, rng: b
+    m.replay.sample = lambda n, rng, first=0: b
     m.config = dataclasses.replace(m.config, vae_updates=0)  # no representation round inside these updates
     m.n_updates = 10  # the next update (11) is odd: critics only
     with torch.no_grad():
@@ -254,6 +254,27 @@ def test_td3_critic_loss_by_hand_and_the_policy_delay():
     assert not all(torch.equal(p, q) for p, q in zip(actor_before, m.actor.parameters()))
     assert not all(torch.equal(p, q) for p, q in zip(target_before, m.critic_target.parameters()))
     assert all(torch.equal(p, q) for p, q in zip(critic_before, m.critic.parameters()))
+
+
+def test_td3_replay_draws_td3_batches_from_its_window_after_the_warm_up():
+    m = model(td3_replay=300)
+    calls, sample = [], m.replay.sample
+
+    def spy(n, rng, first=0):
+        calls.append((n, first, m.replay.added))
+        return sample(n, rng, first)
+
+    m.replay.sample = spy
+    m.learn(800, progress_bar=False)
+    warmup = calls[0][2]  # the replay when the representation's pre-training drew its first batch
+    assert m.rl_start == warmup >= SMALL.warmup_steps
+    td3 = [(first, added) for n, first, added in calls if n == SMALL.batch_size]  # the VAE's batches are 16 too
+    td3 = [(first, added) for first, added in td3 if first > 0]
+    assert len(td3) == m.n_updates > 0
+    for first, added in td3:
+        assert first == max(warmup, added - 300) and added - first >= SMALL.batch_size
+    assert td3[0][1] >= warmup + SMALL.batch_size  # no TD3 step before a batch of its own samples
+    assert td3[-1][1] - td3[-1][0] == 300  # the window, once the run is longer than it
 
 
 @pytest.mark.parametrize("bound", ["squash", "invert"])
@@ -305,6 +326,8 @@ def test_actor_gradient_through_the_latent_box_matches_finite_differences(bound)
         ({"exploration_noise_start": -0.1}, "exploration_noise_start = -0.1"),
         ({"bound": "zero"}, "bound = 'zero'"),
         ({"lsc_remap": True}, "lsc_remap = True.*squash"),
+        ({"td3_replay": 6_000}, "td3_replay = 6000.*<= buffer_size \\(5000\\)"),
+        ({"td3_replay": -1}, "td3_replay = -1"),
     ],
 )
 def test_bad_settings_raise_errors_naming_the_value(kwargs, match):

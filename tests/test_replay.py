@@ -73,6 +73,19 @@ def test_sampling_returns_stored_rows_from_the_given_rng():
     assert buf.data["a"][:30].min() == 0
 
 
+def test_sampling_since_a_counter_draws_uniformly_from_the_transitions_added_since():
+    buf = ReplayBuffer(8, FIELDS)
+    buf.add(**rows(range(12)))  # 0-3 overwritten: 4-11 held, in slots 4-7, 0-3
+    ids = buf.sample(20_000, np.random.default_rng(0), first=7)["a"].numpy()
+    np.testing.assert_allclose(np.bincount(ids, minlength=12)[7:] / 20_000, [0.2] * 5, atol=0.015)
+    assert ids.min() == 7
+    ids = buf.sample(20_000, np.random.default_rng(0), first=2)["a"].numpy()  # before the oldest held: all held
+    np.testing.assert_allclose(np.bincount(ids, minlength=12)[4:] / 20_000, [0.125] * 8, atol=0.015)
+    assert ids.min() == 4
+    with pytest.raises(ValueError, match="first = 12: no transition added since it.*expected first < 12"):
+        buf.sample(4, np.random.default_rng(0), first=12)
+
+
 def test_large_capacity_is_cheap_until_filled():
     t = time.perf_counter()
     buf = ReplayBuffer(10_000_000, {"obs": ((9,), np.float32), "next_obs": ((9,), np.float32), "a": ((), np.int64)})

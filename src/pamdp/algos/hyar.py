@@ -169,6 +169,14 @@ class HyARConfig(OffPolicyConfig, AlgoConfig):
     )
     target_noise_clip: float = setting(0.5, "Clip of the target policy smoothing noise (TD3: 0.5).", NON_NEGATIVE)
     policy_delay: int = setting(2, "Critic updates per actor and target update (TD3: 2).", at_least(1))
+    td3_replay: int = setting(
+        0,
+        "TD3's minibatches come only from the newest td3_replay samples taken after the representation's "
+        "pre-training, as HyAR's scripts keep TD3's replay (1e5 samples; 1e6 on Hard Move) apart from the "
+        "representation's, which holds the warm-up and the whole run; 0: TD3 samples the whole replay, the "
+        "warm-up's random actions included.",
+        at_least(0),
+    )
     save_replay: bool = shared_setting("save_replay", True, "true here: it is the representation's training data")
 
     def __post_init__(self):
@@ -180,6 +188,7 @@ class HyARConfig(OffPolicyConfig, AlgoConfig):
             "False with bound='squash' (a Tanh output cannot be rescaled exactly)",
         )
         self._check(self.buffer_size >= self.warmup_steps, "buffer_size", f">= warmup_steps ({self.warmup_steps})")
+        self._check(self.td3_replay <= self.buffer_size, "td3_replay", f"<= buffer_size ({self.buffer_size})")
 
     @property
     def learning_starts(self) -> int:
@@ -359,6 +368,7 @@ class HyAR(Algorithm):
         self.loop = OffPolicyLoop(cfg, h, self.replay)
         self.pretrained = False  # the warm-up round of representation training is done
         self.n_updates = 0  # TD3 updates so far (the policy delay and the representation rounds count them)
+        self.rl_start = 0  # the replay's insertion counter at the representation's pre-training (td3_replay)
 
     def _modules(self):
         return {
@@ -377,11 +387,13 @@ class HyAR(Algorithm):
             "loop": self.loop.state_dict(replay),
             "pretrained": self.pretrained,
             "n_updates": self.n_updates,
+            "rl_start": self.rl_start,
         }
 
     def _load_extra_state(self, state):
         self.loop.load_state_dict(state["loop"])
         self.pretrained, self.n_updates = bool(state["pretrained"]), int(state["n_updates"])
+        self.rl_start = int(state.get("rl_start", self.config.warmup_steps))  # checkpoints from before td3_replay
         if self.pretrained and len(self.replay) == 0:  # resumed without the replay: warm up again on new data
             self.pretrained = False
 
@@ -509,12 +521,18 @@ class HyAR(Algorithm):
             stats.update(self.train_representation(cfg.warmup_updates))
             self._reencode_replay()
             self.pretrained = True
+            self.rl_start = self.replay.added  # all held so far was taken before the representation was trained
+        first = 0
+        if cfg.td3_replay:
+            first = max(self.rl_start, self.replay.added - cfg.td3_replay)
+            if self.replay.added - first < cfg.batch_size:  # HyAR's TD3 waits for a batch of its own samples
+                return stats
         self.n_updates += 1
         every = max(1, round(cfg.vae_interval * cfg.updates_per_step))
         if self.n_updates % every == 0 and cfg.vae_updates > 0:
             stats.update(self.train_representation(cfg.vae_updates))
 
-        b = self.replay.sample(cfg.batch_size, self.np_rng)
+        b = self.replay.sample(cfg.batch_size, self.np_rng, first)
         obs, next_obs = b["obs"], b["next_obs"]
         latent, relabelled = self.relabel(b)
         with torch.no_grad():

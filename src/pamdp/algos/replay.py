@@ -128,12 +128,28 @@ class ReplayBuffer:
         keep = self.holds(counters)
         self._put(name, counters[keep], self._rows(name, values[keep], int(keep.sum())))
 
-    def sample(self, batch_size: int, rng: np.random.Generator) -> dict[str, torch.Tensor]:
+    def sample(self, batch_size: int, rng: np.random.Generator, first: int = 0) -> dict[str, torch.Tensor]:
         """``batch_size`` transitions drawn uniformly with replacement, as tensors on :attr:`device` sharing no memory
-        with the buffer (the indices come from ``rng``, so a seeded run draws the same batches on any device)."""
+        with the buffer (the indices come from ``rng``, so a seeded run draws the same batches on any device).
+
+        ``first`` (an insertion counter, as :meth:`add` returns) restricts the draw to the transitions added since
+        it that are still held: a window of the newest, or the data after a warm-up, without a second buffer.
+        """
+        oldest = self.added - len(self)
+        if first > oldest:
+            if first >= self.added:
+                raise ValueError(
+                    f"first = {first!r}: no transition added since it (the buffer has added {self.added}); "
+                    f"expected first < {self.added}"
+                )
+            slots = rng.integers(first, self.added, size=batch_size) % self.capacity
+            return self._gather(slots)
         if len(self) == 0:
             raise ValueError("cannot sample from an empty replay buffer")
-        idx = rng.integers(0, len(self), size=batch_size)
+        return self._gather(rng.integers(0, len(self), size=batch_size))
+
+    def _gather(self, idx: np.ndarray) -> dict[str, torch.Tensor]:
+        """The rows at slots ``idx``, copied out of the buffer onto its device."""
         if self._host is not None:
             return {name: torch.from_numpy(arr[idx]) for name, arr in self._host.items()}
         idx = torch.from_numpy(idx).to(self.device)
