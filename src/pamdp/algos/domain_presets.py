@@ -123,9 +123,9 @@ HYAR_HARD_MOVE = "HyAR's Hard Move script"
 HYAR_GOAL = "HyAR's Goal script"
 _HYAR_NOT_EXPRESSIBLE = (
     "over the cpu preset (a quarter of a TD3 update a sample, 128-wide networks: HyAR's ~1 update a sample at 256 "
-    "wide would cost several times more). Not expressible here: HyAR's separate TD3 replay without the warm-up, its "
-    "latent box on the parameters' latent only, its VAE's multiplicative input fusion and its relabelling tests "
-    "(benchmarks/hyar_scripts.md)."
+    "wide would cost several times more); TD3 replays the whole run (HyAR's scripts: TD3's own replay of the newest "
+    "1e5 samples, td3_replay, did not help on Goal). Not expressible here: its latent box on the parameters' latent "
+    "only, its VAE's multiplicative input fusion and its relabelling tests (benchmarks/hyar_scripts.md)."
 )
 
 
