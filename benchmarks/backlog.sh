@@ -14,8 +14,8 @@
 # Costs on this 2-core machine (CPU time a sample; docs/results.md, benchmarks/hfo_learning.md):
 #   soccer: PADDPG 3.3 ms (~4.6 h a run, 3 seeds), PATRPO ~1.4 h a run (3 seeds: their directories were lost
 #           with earlier machines, their results are recorded)                          ~18 core-hours
-#   suite:  HyAR-TD3 hard_move ~1.2 ms (~20 min per 1M), P-DQN hard_move_large 3.5-6 ms (1-1.7 h per 1M)
-#                                                                                       ~6 core-hours
+#   suite:  Hybrid SAC tuned 0.4-2 ms (7-33 min per 1M), P-DQN hard_move_large 3.5-6 ms (1-1.7 h per 1M),
+#           MP-DQN hard_move 10.6 ms (n = 4) and 33 ms (n = 6): 3 and 9 h per 1M          ~45 core-hours
 #   HFO:    PAPPO 0.46 ms (~40 min a run)
 set -euo pipefail
 cd "$(dirname "$0")"
@@ -33,12 +33,13 @@ soccer() {  # issue 27: the paper's soccer figure, one run at a time
 
 suite() {  # issue 26: the suite's missing cells, the cheapest first, then the other seeds; then HFO's PAPPO
     local s="pamdp reproduce benchmark-suite --out $SUITE_OUT"
-    # Done by 2026-12-03 (docs/results.md): HyAR-TD3 on Catch Point, Goal and Hard Goal, MP-DQN on Goal, Hard Goal and
-    # Catch Point, PATRPO everywhere (3 seeds each); HyAR-TD3 on Hard Move n = 4 (3 seeds) and 8 (seed 0) with the
-    # hard_move preset of HyAR's script (~20 CPU minutes a run, 1.2 ms a sample)
-    $s --seeds 1,2 --runs HyAR-TD3_on_Hard_Move_n=8
-    $s --seeds 0,1,2 --runs HyAR-TD3_on_Hard_Move_n=6,HyAR-TD3_on_Hard_Move_n=10
-    $s --seeds 0 --runs P-DQN_on_Hard_Move_n=8,P-DQN_on_Hard_Move_n=10
+    # Done by 2026-12-03 (docs/results.md): MP-DQN on Platform, Goal, Hard Goal and Catch Point; HyAR-TD3 and PATRPO
+    # everywhere (HyAR-TD3 on Hard Move with the hard_move preset of HyAR's script, ~22 CPU minutes a run); Hybrid SAC
+    # on Platform and Catch Point (3 seeds each), on Goal, Hard Goal and Hard Move n = 4 (seed 0).
+    $s --seeds 1,2 --runs "Hybrid_SAC_on_Hard_Move_n=4,Hybrid_SAC_on_Goal,Hybrid_SAC_on_Hard_Goal"
+    $s --seeds 0,1,2 --runs "Hybrid_SAC_on_Hard_Move_n=6,Hybrid_SAC_on_Hard_Move_n=8,Hybrid_SAC_on_Hard_Move_n=10"
+    $s --seeds 0,1,2 --runs P-DQN_on_Hard_Move_n=8,P-DQN_on_Hard_Move_n=10
+    $s --seeds 0,1,2 --runs MP-DQN_on_Hard_Move_n=4,MP-DQN_on_Hard_Move_n=6
     for seed in 1 2; do pamdp reproduce hfo_learning.toml --runs PAPPO --seeds "$seed" --out "$HFO_OUT"; done
 }
 

@@ -16,7 +16,8 @@ CONFIGS = [PASVG0Config, PADDPGConfig, PDQNConfig, HyARConfig]
 # Every preset's settings (and the defaults), in their order, as written out by the code before OffPolicyConfig existed
 # (commit 763e0d8), so that checkpoints and config files of earlier runs mean what they meant; with the settings
 # added since at values that change nothing: device (issue 31) at "auto", which on a machine without CUDA is the CPU
-# those runs had, action_mask off (issue 27), P-DQN's param_passthrough empty and reward_scale 1, HyAR's td3_replay 0 (issue 26).
+# those runs had, action_mask off (issue 27), P-DQN's param_passthrough empty and reward_scale 1, HyAR's td3_replay
+# 0 (issue 26).
 RECORDED = json.loads((Path(__file__).parent / "data" / "offpolicy_presets.json").read_text())
 
 
