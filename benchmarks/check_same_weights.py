@@ -24,6 +24,7 @@ import pamdp  # noqa: F401  (registers the envs)
 from pamdp.algos import algorithm_class
 
 OFF = {"learning_starts": 100, "epoch_steps": 100, "batch_size": 16}
+HYAR = {"epoch_steps": 100, "batch_size": 16}  # HyAR's first update comes after its warm-up
 CASES: dict[str, tuple[str, str, str | None, dict, int]] = {
     # name: (algorithm, env id, preset, settings, samples)
     "patrpo-platform": ("patrpo", "pamdp/Platform-v0", "tuned", {"batch_size": 200, "num_envs": 4}, 400),
@@ -34,7 +35,7 @@ CASES: dict[str, tuple[str, str, str | None, dict, int]] = {
     "pdqn-platform": ("pdqn", "pamdp/Platform-v0", "tuned", OFF, 300),
     "mpdqn-platform": ("pdqn", "pamdp/Platform-v0", "tuned", {**OFF, "multi_pass": True}, 300),
     "pdqn-goal": ("pdqn", "pamdp/Goal-v0", "goal", OFF, 300),
-    "hyar-platform": ("hyar", "pamdp/Platform-v0", "cpu", {"epoch_steps": 100, "batch_size": 16, "warmup_steps": 100, "warmup_updates": 20}, 300),
+    "hyar-platform": ("hyar", "pamdp/Platform-v0", "cpu", {**HYAR, "warmup_steps": 100, "warmup_updates": 20}, 300),
     "hsac-flat-platform": ("hsac", "pamdp/Platform-v0", "tuned", {**OFF, "form": "flat"}, 300),
     "hsac-hier-catch": ("hsac", "pamdp/CatchPoint-v0", "tuned", {**OFF, "form": "hierarchical"}, 300),
 }
