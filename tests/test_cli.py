@@ -178,7 +178,7 @@ def test_env_kwargs_reach_the_env(tmp_path):
     out = tmp_path / "hfo2016"
     argv = ["train", "patrpo", "--env", "pamdp/HalfFieldOffense-v0", "--env-kwargs", '{"profile": "hfo2016"}']
     assert main([*argv, "--total-steps", "300", "--out", str(out), "--eval-episodes", "0", *TINY]) == 0
-    from pamdp.algos.checkpoints import load_model
+    from pamdp.algos import load_model
 
     model = load_model(out)
     assert model.obs_dim == 58 and model.env_kwargs == {"profile": "hfo2016"}
