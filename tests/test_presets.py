@@ -77,6 +77,8 @@ def test_python_and_the_command_line_give_one_config(tmp_path):
     model = PATRPO(HFO)
     assert model.preset == "hfo" and model.config == PATRPOConfig.preset("hfo") and model.config.action_mask
     assert RunSpec("patrpo", HFO, 10).config().config == model.config
+    model.save(tmp_path / "m.pt")
+    assert PATRPO.load(tmp_path / "m.pt").preset == "hfo"  # the file keeps it
     model = PATRPO("pamdp/Platform-v0")
     assert model.preset == "tuned" and model.config == PATRPOConfig.preset("tuned")
     # An explicit config is never overridden.

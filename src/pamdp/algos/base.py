@@ -314,6 +314,7 @@ class Algorithm:
             "pamdp_version": __version__,
             "algo": type(self).__name__,
             "config": self.config.to_dict(),
+            "preset": self.preset,
             "env_id": self.env_id,
             "env_kwargs": self.env_kwargs,
             "num_timesteps": self.num_timesteps,
@@ -360,6 +361,7 @@ class Algorithm:
         for name, opt in algo._optimizers().items():
             opt.load_state_dict(payload["optimizers"][name])
         algo._load_extra_state(payload["extra"])
+        algo.preset = payload.get("preset")  # files written before it was kept: None
         algo.num_timesteps = int(payload["num_timesteps"])
         algo.epoch = int(payload["epoch"])
         algo.np_rng.bit_generator.state = payload["rng"]["numpy"]
