@@ -70,6 +70,7 @@ ALGORITHMS: dict[str, AlgoEntry] = {
 MODULE_OF = {entry.class_name: entry.module for entry in ALGORITHMS.values()}
 """Class name -> its module, e.g. ``"PATRPO" -> "pamdp.algos.patrpo"``."""
 
+
 def algorithm_class(name: str):
     """The class behind an algorithm's command-line name, or ``None`` if this install lacks its module."""
     if name not in ALGORITHMS:

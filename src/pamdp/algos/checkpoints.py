@@ -95,4 +95,3 @@ def read_checkpoint(path: str | os.PathLike) -> dict:
     if not isinstance(payload, dict) or payload.get("format") != FORMAT:
         raise ValueError(f"{path} is not a pamdp checkpoint (no '{FORMAT}' header)")
     return payload
-

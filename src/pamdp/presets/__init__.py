@@ -63,9 +63,7 @@ def default_preset(config_class, env_id: str | None = None, env_kwargs: dict | N
     return DEFAULT_PRESET if DEFAULT_PRESET in presets else next(iter(presets))
 
 
-def choose(
-    config_class, name: str | None = None, env_id: str | None = None, env_kwargs: dict | None = None
-) -> Choice:
+def choose(config_class, name: str | None = None, env_id: str | None = None, env_kwargs: dict | None = None) -> Choice:
     """Preset ``name`` of ``config_class`` (``None``: :func:`default_preset` for ``env_id`` and ``env_kwargs``).
 
     ``name`` is one of the config's own presets or one an env defines (its base with its overrides); an unknown name
