@@ -42,22 +42,23 @@ SAMPLES = {4: 1024, 6: 512, 8: 256, 10: 128}
 
 def env_preset(algo: str, n: int) -> str:
     """The preset ``pamdp train ALGO --env pamdp/HardMove-v0`` gets at ``n``."""
-    from pamdp.algos import algorithm_class, default_preset
+    from pamdp.algos import algorithm_class
 
-    return default_preset(algorithm_class(algo).config_class, ENV, {"n": n})
+    return algorithm_class(algo).config_class.for_env(ENV, {"n": n})[0]
 
 
 def worker(algo: str, n: int, preset: str, repeats: int) -> int:
     import torch
 
-    from pamdp.algos import algorithm_class, preset_config, preset_names
+    from pamdp.algos import algorithm_class
+    from pamdp.presets import preset_names
 
     cls = algorithm_class(algo)
     config_class = cls.config_class
     if preset not in preset_names(config_class):  # a preset newer than this version of the package
         print(json.dumps({"ms_per_sample": [], "preset": preset}), flush=True)
         return 0
-    config = preset_config(config_class, preset)
+    config = config_class.preset(preset, ENV, {"n": n})
     fields = {f.name for f in dataclasses.fields(config)}
     samples = SAMPLES[n]
     shorter = {"epoch_steps": samples, "buffer_size": 50_000}  # updates from the warm-up epoch's end on

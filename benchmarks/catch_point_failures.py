@@ -25,7 +25,7 @@ import gymnasium
 import numpy as np
 
 import pamdp  # noqa: F401  (registers the envs)
-from pamdp.algos.checkpoints import load_model
+from pamdp.algos import load_model
 from pamdp.envs import particle
 
 sys.path.insert(0, str(Path(__file__).parent))

@@ -1,5 +1,5 @@
 """Regenerate the tables of ``docs/cli.md`` that restate code: each algorithm's command-line name, default budget
-and presets (from :data:`pamdp.algos.ALGORITHMS` and the configs' ``presets()``).
+and presets (from :data:`pamdp.algos.ALGORITHMS` and :mod:`pamdp.presets`: the configs' own, then the envs').
 
 Each table sits between ``<!-- cli:NAME start -->`` and ``<!-- cli:NAME end -->``; everything between the
 markers is replaced.
@@ -15,7 +15,8 @@ import re
 import sys
 from pathlib import Path
 
-from pamdp.algos import ALGORITHMS, algorithm_class, default_preset
+from pamdp.algos import ALGORITHMS, algorithm_class
+from pamdp.presets import default_preset, preset_names
 
 DOC = Path(__file__).with_name("cli.md")
 BLOCK = re.compile(r"(<!-- cli:([\w-]+) start -->\n)(.*?)(<!-- cli:\2 end -->)", re.DOTALL)
@@ -29,7 +30,7 @@ def algorithms_table() -> str:
     for name, entry in ALGORITHMS.items():
         config_class = algorithm_class(name).config_class
         default = default_preset(config_class)
-        presets = ", ".join(f"**`{p}`**" if p == default else f"`{p}`" for p in config_class.presets())
+        presets = ", ".join(f"**`{p}`**" if p == default else f"`{p}`" for p in preset_names(config_class))
         rows.append(f"| `{name}` | {entry.help} | {entry.total_steps:,} | {presets} |")
     return "\n".join(rows) + "\n"
 

@@ -5,7 +5,7 @@ Each table sits between two marker comments, ``<!-- settings:NAME start -->`` an
 replaced. A row per ``dataclasses.fields(Config)``: the name, the type, the default, the value in each
 preset that differs from the default (blank where it does not), the field's ``metadata["help"]`` and the values
 its check accepts (``Config.check_of(name)``). Between ``<!-- domain-presets start -->`` and
-``<!-- domain-presets end -->``: the presets chosen by the env (``pamdp.algos.domain_presets.DOMAIN_PRESETS``),
+``<!-- domain-presets end -->``: the presets chosen by the env (``pamdp.presets.domains.DOMAIN_PRESETS``),
 each with the env arguments it asks for and each override with its source.
 
     python docs/gen_settings.py            # rewrite docs/algorithms.md in place
@@ -22,7 +22,7 @@ import typing
 from pathlib import Path
 
 from pamdp.algos import ALGORITHMS, algorithm_class
-from pamdp.algos.domain_presets import DOMAIN_PRESETS
+from pamdp.presets.domains import DOMAIN_PRESETS
 
 UNCONSTRAINED = {bool: "True or False", int: "any integer", float: "any finite number"}
 # every registered algorithm's config, so that a new algorithm's table is asked for (its markers) and written

@@ -178,7 +178,7 @@ def test_env_kwargs_reach_the_env(tmp_path):
     out = tmp_path / "hfo2016"
     argv = ["train", "patrpo", "--env", "pamdp/HalfFieldOffense-v0", "--env-kwargs", '{"profile": "hfo2016"}']
     assert main([*argv, "--total-steps", "300", "--out", str(out), "--eval-episodes", "0", *TINY]) == 0
-    from pamdp.algos.checkpoints import load_model
+    from pamdp.algos import load_model
 
     model = load_model(out)
     assert model.obs_dim == 58 and model.env_kwargs == {"profile": "hfo2016"}
@@ -247,3 +247,14 @@ def test_version_is_the_installed_distributions(capsys):
         main(["--version"])
     assert exit_info.value.code == 0
     assert capsys.readouterr().out.strip() == f"pamdp {version('pamdp')}"
+
+
+def test_train_resolves_its_config_once(tmp_path, monkeypatch):
+    import pamdp.experiments.runner as runner
+
+    calls = []
+    choose = runner.choose
+    monkeypatch.setattr(runner, "choose", lambda *args: calls.append(args) or choose(*args))
+    argv = ["train", "patrpo", "--total-steps", "500", "--eval-episodes", "0", "--out", str(tmp_path / "run")]
+    assert main([*argv, *TINY]) == 0
+    assert len(calls) == 1

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 import torch
 
-from pamdp.algos import ALGORITHMS, algorithm_class
+from pamdp.algos import ALGORITHMS, algorithm_class, load_model
 from pamdp.algos.base import resolve_device
-from pamdp.algos.checkpoints import load_model, read_checkpoint
+from pamdp.algos.checkpoints import read_checkpoint
 from pamdp.cli import main
 
 CUDA = pytest.mark.skipif(not torch.cuda.is_available(), reason="needs a CUDA device")

@@ -12,10 +12,10 @@ import tomllib
 import torch
 
 import pamdp  # noqa: F401  (registers the envs)
-from pamdp.algos.domain_presets import MASSON_GOAL_START
 from pamdp.algos.pdqn import PDQN, PDQNConfig
 from pamdp.envs.goal.env import hard_goal_shot
 from pamdp.experiments.runner import RunSpec
+from pamdp.presets.goal_start import MASSON_GOAL_START
 
 GOAL = "pamdp/Goal-v0"
 HARD_GOAL = "pamdp/HardGoal-v0"
@@ -24,7 +24,7 @@ SMALL = {"num_envs": 1, "device": "cpu", "hidden_sizes": [16], "batch_size": 16,
 
 def goal_config(env: str = GOAL, **settings) -> PDQNConfig:
     """The config ``pamdp train pdqn --env ENV`` gets, with ``settings`` over it."""
-    return RunSpec("pdqn", env, 10, settings=tuple(settings.items())).config()[2]
+    return RunSpec("pdqn", env, 10, settings=tuple(settings.items())).config().config
 
 
 def masson_in_metres(state: dict) -> tuple[float, float, float]:

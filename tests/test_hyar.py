@@ -12,7 +12,7 @@ import torch
 from numeric import finite_difference
 
 from pamdp import HyAR
-from pamdp.algos.checkpoints import load_model
+from pamdp.algos import load_model
 from pamdp.algos.hyar import ActionRepresentation, HyARConfig, latent_bounds
 from pamdp.algos.offpolicy import backprop_actor, invert_gradients
 from pamdp.cli import main

@@ -9,7 +9,7 @@ import torch
 
 import pamdp
 from pamdp import PADDPG
-from pamdp.algos.checkpoints import load_model
+from pamdp.algos import load_model
 from pamdp.algos.offpolicy import invert_gradients, zero_gradients
 from pamdp.algos.paddpg import Actor, Critic, PADDPGConfig
 from pamdp.cli import main

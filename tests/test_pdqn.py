@@ -13,7 +13,7 @@ from numeric import finite_difference
 
 import pamdp
 from pamdp import PDQN
-from pamdp.algos.checkpoints import load_model
+from pamdp.algos import load_model
 from pamdp.algos.offpolicy import OUNoise, backprop_actor, invert_gradients
 from pamdp.algos.pdqn import ParamActor, PDQNConfig, QNetwork, param_blocks
 from pamdp.cli import main

@@ -1,7 +1,8 @@
 """pamdp: deep reinforcement learning in parameterized action spaces.
 
 Importing the package registers its environments with Gymnasium (``pamdp/Platform-v0``,
-``pamdp/HalfFieldOffense-v0``). Algorithms are importable from here: ``from pamdp import PATRPO``.
+``pamdp/HalfFieldOffense-v0``) and installs the lookup of the env presets (``pamdp.presets``) into the algorithms'
+configs. Algorithms are importable from here: ``from pamdp import PATRPO``.
 """
 
 from importlib import import_module
@@ -9,9 +10,11 @@ from importlib import import_module
 from pamdp._version import __version__
 from pamdp.algos import MODULE_OF as _ALGOS
 from pamdp.envs import register_envs
+from pamdp.presets import install as _install_presets
 from pamdp.spaces import HybridActionSpace
 
 register_envs()
+_install_presets()
 
 
 __all__ = ["HybridActionSpace", "register_envs", "__version__", *_ALGOS]

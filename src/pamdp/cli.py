@@ -22,8 +22,9 @@ from pathlib import Path
 
 from pamdp import __version__
 from pamdp._memory import keep_freed_memory
-from pamdp.algos import preset_names
-from pamdp.experiments.runner import ALGORITHMS, RunSpec, algorithm_class, default_preset, train_run
+from pamdp.algos import ALGORITHMS, algorithm_class
+from pamdp.experiments.runner import RunSpec, train_run
+from pamdp.presets import default_preset, preset_names
 
 MAX_STEPS = 10**12  # a budget beyond this is a typing slip (10^12 steps take decades on one core)
 MAX_SEED = 2**32 - 1
@@ -309,11 +310,13 @@ def _train_spec(args, cls) -> RunSpec:
 def cmd_train(args) -> int:
     cls = algorithm_class(args.algo)
     spec = _train_spec(args, cls)
-    spec.check()  # the settings and the env's arguments, before any directory is created
+    run_config = spec.check()  # the settings and the env's arguments, before any directory is created
     stamp = dt.datetime.now().strftime("%Y%m%d-%H%M%S")
     out = Path(args.out or f"runs/{args.algo}-{args.env.split('/')[-1]}-seed{spec.seed}-{stamp}")
     try:
-        result = train_run(spec, out, progress_bar=not args.no_progress, log=lambda m: print(m, file=sys.stderr))
+        result = train_run(
+            spec, out, progress_bar=not args.no_progress, log=lambda m: print(m, file=sys.stderr), run_config=run_config
+        )
     except KeyboardInterrupt:
         from pamdp.algos.checkpoints import CHECKPOINT
 
@@ -405,7 +408,7 @@ def _format_evaluation(result: dict, policy: str = "greedy", env_id: str | None 
 
 
 def cmd_evaluate(args) -> int:
-    from pamdp.algos.checkpoints import load_model
+    from pamdp.algos import load_model
     from pamdp.evaluation import evaluate
 
     model = load_model(args.model)
@@ -420,7 +423,7 @@ def cmd_render(args) -> int:
     import gymnasium
 
     import pamdp  # noqa: F401  (registers the envs)
-    from pamdp.algos.checkpoints import load_model
+    from pamdp.algos import load_model
     from pamdp.algos.vector_env import env_creator
     from pamdp.envs.rendering import record_episode
 

@@ -1,22 +1,21 @@
-"""Greedy (or stochastic) evaluation of a trained model over many episodes, on the batched env."""
+"""Greedy (or stochastic) evaluation of a trained model over many episodes, on the batched env.
+
+Training's greedy evaluations call it (``Algorithm.learn(eval_every=...)``), so it imports no algorithm, not even
+for its types: a model is any :class:`~pamdp.algos.base.Algorithm`.
+"""
 
 from __future__ import annotations
-
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from pamdp.algos.logger import success_summary, successes
 from pamdp.algos.vector_env import info_action_masks, make_vector_env
 
-if TYPE_CHECKING:
-    from pamdp.algos.base import Algorithm
-
 __all__ = ["evaluate"]
 
 
 def evaluate(
-    model: Algorithm,
+    model,
     episodes: int = 1000,
     seed: int = 0,
     deterministic: bool = True,

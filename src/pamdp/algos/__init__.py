@@ -1,27 +1,24 @@
 """Learning algorithms for parameterized action spaces, sharing one API (``base.py``), and their registry.
 
 :data:`ALGORITHMS` is the one list of algorithms: the command line takes from it each algorithm's name, its
-one-line help and its default budget, and from the algorithm's config its presets, with those chosen by env
-in ``domain_presets.py`` (:func:`preset_names`, :func:`preset_config`; :func:`default_preset` names the one a
-run gets). A new algorithm needs one entry here. Modules are imported on first use only:
-they import torch, and ``import pamdp`` stays light.
+one-line help and its default budget; :func:`load_model` loads a model whichever of them wrote it. A new algorithm
+needs one entry here. Modules are imported on first use only: they import torch, and ``import pamdp`` stays light.
+The algorithms know no env: the presets that envs choose are ``pamdp.presets``'.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import os
 from importlib import import_module
 
 __all__ = [
     "ALGORITHMS",
     "AlgoEntry",
     "MODULE_OF",
-    "DEFAULT_PRESET",
     "algorithm_class",
     "class_named",
-    "default_preset",
-    "preset_names",
-    "preset_config",
+    "load_model",
 ]
 
 
@@ -73,8 +70,6 @@ ALGORITHMS: dict[str, AlgoEntry] = {
 MODULE_OF = {entry.class_name: entry.module for entry in ALGORITHMS.values()}
 """Class name -> its module, e.g. ``"PATRPO" -> "pamdp.algos.patrpo"``."""
 
-DEFAULT_PRESET = "tuned"
-
 
 def algorithm_class(name: str):
     """The class behind an algorithm's command-line name, or ``None`` if this install lacks its module."""
@@ -94,40 +89,14 @@ def class_named(name: str):
     return getattr(import_module(MODULE_OF[name]), name) if name in MODULE_OF else None
 
 
-def _algo_of(config_class) -> str | None:
-    """The command-line name of the algorithm whose module defines ``config_class`` (``None`` for another)."""
-    return next((name for name, e in ALGORITHMS.items() if e.module == config_class.__module__), None)
+def load_model(path: str | os.PathLike, env=None, device: str | None = None):
+    """Load any pamdp model (file or run directory), whichever of the registered algorithms wrote it, onto
+    ``device`` (as :meth:`Algorithm.load <pamdp.algos.base.Algorithm.load>` chooses it by default)."""
+    from pamdp.algos.checkpoints import read_checkpoint
 
-
-def preset_names(config_class) -> list[str]:
-    """Every preset ``config_class`` takes: its own, then those that envs choose (``domain_presets.py``)."""
-    from pamdp.algos.domain_presets import domain_presets_of
-
-    own = list(config_class.presets())
-    return own + [name for name in domain_presets_of(_algo_of(config_class)) if name not in own]
-
-
-def preset_config(config_class, name: str):
-    """The config of preset ``name``: one of the config's own, or an env's (its base with its overrides)."""
-    from pamdp.algos.domain_presets import domain_presets_of
-
-    table = config_class.presets()
-    if name in table:
-        return table[name]
-    derived = domain_presets_of(_algo_of(config_class)).get(name)
-    if derived is None:
-        names = ", ".join(preset_names(config_class))
-        raise ValueError(f"unknown preset {name!r} for {config_class.__name__}; expected one of {names}")
-    return config_class.from_dict(derived.settings, base=table[derived.base])
-
-
-def default_preset(config_class, env_id: str | None = None, env_kwargs: dict | None = None) -> str:
-    """The preset a run gets when none is named: the env's (``domain_presets.py``, for the env's arguments
-    ``env_kwargs``) where it has one, else ``tuned`` where the algorithm has it, else its first."""
-    from pamdp.algos.domain_presets import domain_preset
-
-    chosen = domain_preset(_algo_of(config_class), env_id, env_kwargs)
-    if chosen is not None:
-        return chosen.name
-    presets = config_class.presets()
-    return DEFAULT_PRESET if DEFAULT_PRESET in presets else next(iter(presets))
+    payload = read_checkpoint(path)
+    name = payload["algo"]
+    cls = class_named(name)
+    if cls is None:
+        raise ValueError(f"{path} was written by unknown algorithm {name!r}; expected one of {', '.join(MODULE_OF)}")
+    return cls._from_payload(payload, env, device)

@@ -80,8 +80,16 @@ class Algorithm:
     config_class: ClassVar[type[AlgoConfig]] = AlgoConfig
 
     def __init__(self, env, config: AlgoConfig | dict | None = None, env_kwargs: dict | None = None):
-        """``config``: the algorithm's config, or a dict of settings over the defaults (``{"delta": 0.01}``)."""
-        config = self.config_class() if config is None else config
+        """``config``: the algorithm's config, or a dict of settings over the defaults (``{"delta": 0.01}``); ``None``:
+        the preset ``pamdp train`` picks for the env (the env's where it has one, else the default), named in
+        :attr:`preset`."""
+        env_id, spec_kwargs, obs_space, act_space = describe_env(env, env_kwargs)
+        self.env_id = env_id
+        self.env_kwargs = {**spec_kwargs, **(env_kwargs or {})}
+        self.preset: str | None = None
+        """The preset a config of ``None`` took (``None`` for a config given)."""
+        if config is None:
+            self.preset, config = self.config_class.for_env(env_id, self.env_kwargs)
         if isinstance(config, dict):
             config = self.config_class.from_dict(config)
         if not isinstance(config, self.config_class):
@@ -90,9 +98,6 @@ class Algorithm:
                 f"got {type(config).__name__}"
             )
         self.config = config
-        env_id, spec_kwargs, obs_space, act_space = describe_env(env, env_kwargs)
-        self.env_id = env_id
-        self.env_kwargs = {**spec_kwargs, **(env_kwargs or {})}
         self._env_arg = None if isinstance(env, str) else env
         if not (isinstance(obs_space, spaces.Box) and len(obs_space.shape) == 1):
             raise ValueError(f"observation space {obs_space!r} is not supported; expected a 1-D Box")
@@ -309,6 +314,7 @@ class Algorithm:
             "pamdp_version": __version__,
             "algo": type(self).__name__,
             "config": self.config.to_dict(),
+            "preset": self.preset,
             "env_id": self.env_id,
             "env_kwargs": self.env_kwargs,
             "num_timesteps": self.num_timesteps,
@@ -355,6 +361,7 @@ class Algorithm:
         for name, opt in algo._optimizers().items():
             opt.load_state_dict(payload["optimizers"][name])
         algo._load_extra_state(payload["extra"])
+        algo.preset = payload.get("preset")  # files written before it was kept: None
         algo.num_timesteps = int(payload["num_timesteps"])
         algo.epoch = int(payload["epoch"])
         algo.np_rng.bit_generator.state = payload["rng"]["numpy"]

@@ -1,7 +1,8 @@
 """Checkpoints and atomic writes.
 
 A checkpoint is one file written atomically (a temporary file, fsync, rename) holding tensors and plain data
-only; it is read back with ``torch.load(weights_only=True)``, so loading never executes code.
+only; it is read back with ``torch.load(weights_only=True)``, so loading never executes code. Loading a model whichever
+algorithm wrote it is the registry's :func:`pamdp.algos.load_model`.
 """
 
 from __future__ import annotations
@@ -14,9 +15,7 @@ from typing import IO
 
 import torch
 
-from pamdp.algos import MODULE_OF, class_named
-
-__all__ = ["FINAL_MODEL", "CHECKPOINT", "FORMAT", "atomic_save", "atomic_write_text", "read_checkpoint", "load_model"]
+__all__ = ["FINAL_MODEL", "CHECKPOINT", "FORMAT", "atomic_save", "atomic_write_text", "read_checkpoint"]
 
 FINAL_MODEL = "final_model.pt"
 CHECKPOINT = "checkpoint.pt"
@@ -96,14 +95,3 @@ def read_checkpoint(path: str | os.PathLike) -> dict:
     if not isinstance(payload, dict) or payload.get("format") != FORMAT:
         raise ValueError(f"{path} is not a pamdp checkpoint (no '{FORMAT}' header)")
     return payload
-
-
-def load_model(path: str | os.PathLike, env=None, device: str | None = None):
-    """Load any pamdp model (file or run directory), whichever of the registered algorithms wrote it, onto
-    ``device`` (as :meth:`Algorithm.load <pamdp.algos.base.Algorithm.load>` chooses it by default)."""
-    payload = read_checkpoint(path)
-    name = payload["algo"]
-    cls = class_named(name)
-    if cls is None:
-        raise ValueError(f"{path} was written by unknown algorithm {name!r}; expected one of {', '.join(MODULE_OF)}")
-    return cls._from_payload(payload, env, device)

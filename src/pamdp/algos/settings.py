@@ -4,6 +4,10 @@ An algorithm's config subclasses :class:`AlgoConfig` and declares each setting w
 default, a one-line help (the field's documentation, its CLI help and its row in ``docs/algorithms.md``) and a
 :class:`Check` of its valid values. A value that fails its check, a non-finite float, an unknown name or a
 value of the wrong type is a ``ValueError`` naming the setting, the value and what was expected.
+
+A config's presets are its own (:meth:`AlgoConfig.presets`) and those the envs define, which live above the
+algorithms (``pamdp.presets``, allowed to know the envs): :meth:`AlgoConfig.preset` and :meth:`AlgoConfig.for_env`
+answer for both through the lookup that ``import pamdp`` installs (:func:`install_preset_lookup`).
 """
 
 from __future__ import annotations
@@ -14,6 +18,7 @@ import numbers
 import re
 import types
 import typing
+import warnings
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
@@ -31,6 +36,7 @@ __all__ = [
     "NON_NEGATIVE",
     "LAYERS",
     "DEVICE",
+    "install_preset_lookup",
 ]
 
 
@@ -65,6 +71,20 @@ POSITIVE = Check(lambda v: v > 0, "a positive number")
 NON_NEGATIVE = Check(lambda v: v >= 0, "a non-negative number")
 LAYERS = Check(lambda v: len(v) > 0 and all(h > 0 for h in v), "one or more positive layer sizes")
 DEVICE = Check(lambda v: re.fullmatch(r"auto|cpu|cuda(:[0-9]+)?", v) is not None, "'auto', 'cpu', 'cuda' or 'cuda:N'")
+
+
+PresetLookup = Callable[[type, str | None, str | None, dict | None], tuple]
+"""``(config class, preset name or None, env id or None, env arguments or None) -> (name, config, warning or
+None)``: the preset of that name (``None``: the one a run on the env gets), and a warning where it was made for
+another env."""
+_preset_lookup: PresetLookup | None = None
+
+
+def install_preset_lookup(lookup: PresetLookup) -> None:
+    """Answer :meth:`AlgoConfig.preset` and :meth:`AlgoConfig.for_env` with ``lookup`` (``pamdp.presets.choose``,
+    installed by ``import pamdp``): the algorithms' package reaches the env presets without importing them."""
+    global _preset_lookup
+    _preset_lookup = lookup
 
 
 def setting(default: Any, help: str, check: Check | None = None) -> Any:
@@ -145,11 +165,27 @@ class AlgoConfig:
         return {"default": cls()}
 
     @classmethod
-    def preset(cls, name: str) -> Self:
-        table = cls.presets()
-        if name not in table:
-            raise ValueError(f"unknown preset {name!r} for {cls.__name__}; expected one of {', '.join(table)}")
-        return table[name]
+    def preset(cls, name: str, env_id: str | None = None, env_kwargs: dict | None = None) -> Self:
+        """Preset ``name``, as ``pamdp train --preset NAME [--env ENV_ID]`` gives it: one of :meth:`presets`, or one
+        an env defines (``pamdp.presets.domains``). Given ``env_id``, a preset made for another env is a
+        ``UserWarning`` naming both; an unknown name is a ``ValueError`` naming the valid ones."""
+        _, config, warning = cls._look_up(name, env_id, env_kwargs)
+        if warning is not None:
+            warnings.warn(warning, UserWarning, stacklevel=2)
+        return config
+
+    @classmethod
+    def for_env(cls, env_id: str | None, env_kwargs: dict | None = None) -> tuple[str, Self]:
+        """``(name, config)`` of the preset a run on ``env_id`` (with arguments ``env_kwargs``) gets when none is
+        named, as ``pamdp train`` picks it: the env's where it has one, else the algorithm's default."""
+        name, config, _ = cls._look_up(None, env_id, env_kwargs)
+        return name, config
+
+    @classmethod
+    def _look_up(cls, name: str | None, env_id: str | None, env_kwargs: dict | None):
+        if _preset_lookup is None:  # only while pamdp/__init__.py has not yet run to its end
+            raise RuntimeError("no preset lookup is installed: import pamdp (it installs pamdp.presets') first")
+        return _preset_lookup(cls, name, env_id, env_kwargs)
 
     def to_dict(self) -> dict[str, Any]:
         return {

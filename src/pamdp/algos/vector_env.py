@@ -47,8 +47,8 @@ def env_spec(env_id: str) -> gymnasium.envs.registration.EnvSpec:
         return gymnasium.spec(name)
     except gymnasium.error.Error as exc:
         raise ValueError(
-            f"env {env_id!r} is not registered ({exc}); expected a Gymnasium id such as pamdp/Platform-v0, "
-            "or module:EnvId-v0 to import the module that registers it"
+            f"env {env_id!r} is not registered ({exc}); expected a registered Gymnasium id (pamdp's are listed in "
+            "pamdp.envs), or module:EnvId-v0 to import the module that registers it"
         ) from exc
 
 

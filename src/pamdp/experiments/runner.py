@@ -23,23 +23,15 @@ import socket
 import sys
 import time
 import traceback
+import warnings
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
-from pamdp.algos import ALGORITHMS, DEFAULT_PRESET, algorithm_class, default_preset, preset_config
+from pamdp.algos import algorithm_class
 from pamdp.algos.vector_env import check_env_kwargs
+from pamdp.presets import choose
 
-__all__ = [
-    "RunSpec",
-    "default_preset",
-    "train_run",
-    "run_lock",
-    "is_finished",
-    "run_all",
-    "algorithm_class",
-    "ALGORITHMS",
-    "DEFAULT_PRESET",
-]
+__all__ = ["RunConfig", "RunSpec", "train_run", "run_lock", "is_finished", "run_all"]
 
 LOCK_FILE = ".lock"
 _CUT_SHORT = ".cut-short"  # a first epoch's log kept aside when its checkpoint was cut short by a kill
@@ -62,19 +54,34 @@ class RunSpec:
     env_kwargs: tuple[tuple[str, Any], ...] = ()
     eval_every: int = 0  # epochs between greedy evaluations of 100 episodes during training (0: none)
 
-    def config(self):
+    def config(self) -> RunConfig:
+        """The run's algorithm and settings: its preset (the env's where it names none, as
+        :func:`pamdp.presets.choose` picks it), then its settings and seed over it."""
         cls = algorithm_class(self.algo)
         if cls is None:
             raise ValueError(f"algorithm {self.algo!r} is not available in this install")
-        preset = self.preset or default_preset(cls.config_class, self.env, dict(self.env_kwargs))
-        base = preset_config(cls.config_class, preset)
-        return cls, preset, cls.config_class.from_dict({**dict(self.settings), "seed": self.seed}, base=base)
+        choice = choose(cls.config_class, self.preset, self.env, dict(self.env_kwargs))
+        config = cls.config_class.from_dict({**dict(self.settings), "seed": self.seed}, base=choice.config)
+        return RunConfig(cls, choice.name, config, choice.warning)
 
-    def check(self):
+    def check(self) -> RunConfig:
         """:meth:`config`, after checking the env's id and arguments against its constructor: everything a run
         needs before anything is written."""
         check_env_kwargs(self.env, dict(self.env_kwargs))
         return self.config()
+
+
+class RunConfig(NamedTuple):
+    """What :meth:`RunSpec.config` resolves, once per run."""
+
+    cls: type
+    """The algorithm's class."""
+    preset: str
+    """The preset the settings go over."""
+    config: Any
+    """The algorithm's config."""
+    warning: str | None
+    """Why the preset does not suit the env (one made for another env), or ``None``."""
 
 
 @contextlib.contextmanager
@@ -207,12 +214,14 @@ def _check_fresh_directory(out: Path) -> None:
         )
 
 
-def _prepare(spec: RunSpec, out: str | os.PathLike, log=print) -> tuple[Any, dict | None]:
+def _prepare(
+    spec: RunSpec, out: str | os.PathLike, log=print, run_config: RunConfig | None = None
+) -> tuple[Any, dict | None]:
     """The model to train for ``spec`` in ``out`` (new or resumed) and ``None``, or ``None`` and the evaluation of
     a run already finished. The caller holds ``out``'s :func:`run_lock`."""
     from pamdp.algos.checkpoints import CHECKPOINT, FINAL_MODEL, atomic_write_text
 
-    cls, preset, config = spec.check()
+    cls, preset, config, warning = run_config or spec.check()
     out = Path(out)
     run_info = {
         "algo": spec.algo,
@@ -222,6 +231,9 @@ def _prepare(spec: RunSpec, out: str | os.PathLike, log=print) -> tuple[Any, dic
         "total_steps": spec.total_steps,
         "config": config.to_dict(),
     }
+    if warning is not None:  # a preset made for another env: said at the run's start and kept with it
+        warnings.warn(warning, UserWarning, stacklevel=2)
+        run_info["preset_warning"] = warning
     if spec.label:  # what figures and tables call the run (its directory holds a file-name-safe form)
         run_info["label"] = spec.label
     run_file, eval_file = out / "run.json", out / "evaluation.json"
@@ -288,13 +300,21 @@ def _train(model, spec: RunSpec, out: str | os.PathLike, progress_bar: bool, log
     return result
 
 
-def train_run(spec: RunSpec, out: str | os.PathLike, progress_bar: bool = True, log=print, callback=None) -> dict:
+def train_run(
+    spec: RunSpec,
+    out: str | os.PathLike,
+    progress_bar: bool = True,
+    log=print,
+    callback=None,
+    run_config: RunConfig | None = None,
+) -> dict:
     """Train (or resume, or skip) one run in ``out``; returns its evaluation (or ``{}`` without one).
 
     ``callback``: called after every epoch (and its checkpoint) with the model and the epoch's statistics.
+    ``run_config``: ``spec.check()`` where the caller has checked the spec already (``None``: checked here).
     """
     with run_lock(out):
-        model, done = _prepare(spec, out, log)
+        model, done = _prepare(spec, out, log, run_config)
         return done if model is None else _train(model, spec, out, progress_bar, log, callback=callback)
 
 

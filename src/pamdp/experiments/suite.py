@@ -42,7 +42,8 @@ DOMAINS: tuple[tuple[str, str, dict], ...] = (
 )
 """``(name, env id, env arguments)`` of the eight domains of HyAR's Table 2, in its order."""
 
-# HyAR's Table 2 (Li et al., ICLR 2022), as ../shared/specs/benchmarks.md gives it: mean +- std over 5 runs
+# HyAR's Table 2 (Li et al., "HyAR: Addressing Discrete-Continuous Action Reinforcement Learning via Hybrid Action
+# Representation", ICLR 2022): mean +- std over 5 runs
 # (std where the table gives one). The methods nearest pamdp's: P-DQN (MP-DQN), HPPO (PATRPO, PAPPO), HyAR-TD3.
 HYAR_TABLE: dict[str, dict[str, str]] = {
     "HyAR-TD3": dict(

@@ -1,5 +1,7 @@
 """Presets chosen by the env: for each algorithm, env id and env arguments, the preset a run gets when none is named.
 
+``PDQN("pamdp/HalfFieldOffense-v0")`` in Python gets the same preset (:mod:`pamdp.presets` answers for both).
+
 ``pamdp train pdqn --env pamdp/HalfFieldOffense-v0`` trains with :data:`DOMAIN_PRESETS`' ``("pdqn",
 "pamdp/HalfFieldOffense-v0", ANY)`` entry; an explicit ``--preset`` (or a config file's ``preset``) still wins, and an
 env without an entry gets the algorithm's default preset. An entry may ask for some of the env's arguments
@@ -16,7 +18,8 @@ Sources:
 - MP-DQN's HFO script: Bester et al.'s code, ``run_soccer_pdqn.py`` (cycraig/MP-DQN), the settings of their
   Half Field Offense results, as issue 27 lists them.
 - MP-DQN's Goal script: the same repository's ``run_goal_pdqn.py``.
-- HyAR: Li et al. (ICLR 2022), its budgets (``../shared/specs/benchmarks.md``). HyAR's Catch Point script:
+- HyAR: Li et al., "HyAR: Addressing Discrete-Continuous Action Reinforcement Learning via Hybrid Action
+  Representation" (ICLR 2022), its budgets. HyAR's Catch Point script:
   ``main_embedding_direction_catch_td3.py`` of HyAR's code (TJU-DRL-LAB/AI-Optimizer's copy), read for ``hyar``'s
   ``catch_point`` preset (``benchmarks/hyar_scripts.md``); HyAR's Hard Move script, ``main_embedding_hard_move_td3.py``
   (Metro1998/HyAR's copy), for its ``hard_move`` preset; its Goal and Hard Goal scripts,
@@ -29,15 +32,16 @@ from __future__ import annotations
 import dataclasses
 from typing import Any
 
+from pamdp.presets.goal_start import MASSON_GOAL_START, MASSON_HARD_GOAL_START
+
 __all__ = [
     "ANY",
     "DomainPreset",
     "DOMAIN_PRESETS",
     "LARGE_K",
-    "MASSON_GOAL_START",
-    "MASSON_HARD_GOAL_START",
     "domain_preset",
     "domain_presets_of",
+    "envs_named_by",
     "when",
 ]
 
@@ -208,28 +212,6 @@ def _mpdqn_hybrid(name: str, note: str, *more: tuple[str, Any, str]) -> DomainPr
         *more,
     )
 
-
-def _linear_map(n_obs: int, rows: tuple[tuple[float, dict[int, float]], ...]) -> tuple[float, ...]:
-    """A :attr:`~pamdp.algos.pdqn.PDQNConfig.param_passthrough` value from one ``(bias, {feature: weight})`` per
-    parameter: each row the ``n_obs`` weights, then the bias."""
-    return tuple(v for bias, weights in rows for v in (*(weights.get(i, 0.0) for i in range(n_obs)), bias))
-
-
-# Masson's hand-set start, in [-1, 1] units of pamdp's Goal observation (features 10, 11: the ball's x, y; 14, 15:
-# the unit vector from the keeper to the ball) and parameters (kick-to x, y; shoot-left y; shoot-right y), as MP-DQN's
-# Goal script sets its passthrough layer (``initialise_params``, with ``scale_actions``). In metres it is Masson's
-# kick to x = Bx + 2.5 + 1.25 f14, y = (5/6) By + (5/3) f15 (the port reads only x: it kicks towards (x, x)),
-# and shots 1 m inside either post, y = +-6.01.
-_MASSON_KICK = ((-0.375, {10: 0.5, 14: 0.0625}), (0.0, {11: 5 / 6, 15: 1 / 9}))
-MASSON_GOAL_START = _linear_map(17, (*_MASSON_KICK, (6.01 / 7.01, {}), (-6.01 / 7.01, {})))
-
-# Masson's start carried over to Hard Goal (not published): kick-to as on Goal; the shots into the goal mouth's
-# outer parts (j = 0 and 4: actions 1, 6 and 5, 10) 1 m inside either post. Hard Goal maps a shot's p to
-# y = 7.010000228881836 q with q = p m_j + o_j, m_j = -0.2, o_0 = -0.8, o_4 = 0.8 (env spec 4.2), so p = (q - o_j) / m_j
-# for q = -+6.01 / 7.010000228881836; the three inner parts start at their middles (p = 0).
-_POST = 6.01 / 7.010000228881836
-_HARD_GOAL_SHOTS = ((-_POST + 0.8) / -0.2, 0.0, 0.0, 0.0, (_POST - 0.8) / -0.2)
-MASSON_HARD_GOAL_START = _linear_map(17, (*_MASSON_KICK, *((p, {}) for p in _HARD_GOAL_SHOTS * 2)))
 
 GOAL_NOTE = (
     "The parameter network starts from Masson's hand-set linear weights, as MP-DQN's Goal runs did "
@@ -414,3 +396,9 @@ def _env_arguments(env_id: str, env_kwargs: dict, names: set[str]) -> dict[str, 
 def domain_presets_of(algo: str) -> dict[str, DomainPreset]:
     """``{name: DomainPreset}`` of the new presets (those with a name of their own) of algorithm ``algo``."""
     return {p.name: p for (a, _, _), p in DOMAIN_PRESETS.items() if a == algo and p.name != p.base}
+
+
+def envs_named_by(algo: str, name: str) -> list[str]:
+    """The env ids for which preset ``name`` of algorithm ``algo`` was made (empty for one of the algorithm's own:
+    those are for any env)."""
+    return sorted({e for (a, e, _), p in DOMAIN_PRESETS.items() if a == algo and p.name == name and p.name != p.base})
