@@ -98,7 +98,8 @@ def _seed_of(run: Path, recorded: dict) -> int | None:
 def suite_finals(groups: dict[str, list[Path]]) -> list[dict]:
     """One entry per run of the groups (:func:`plots.find_groups`) on a suite domain with a figure:
     ``{"domain", "method", "seed", "value", "final", "source"}`` (``final``: its evaluation of 1000 episodes, else
-    its last greedy evaluation during training; ``source``: the run's directory)."""
+    its last greedy evaluation during training; ``source``: the run's directory, its last three parts, as
+    ``benchmark-suite/PATRPO_on_Goal/seed0``: where it lies under the runs' root, without a machine's own path)."""
     from pamdp.experiments.plots import _recorded
 
     finals = []
@@ -111,7 +112,7 @@ def suite_finals(groups: dict[str, list[Path]]) -> list[dict]:
                 method = str(recorded.get("label") or label).split(" on ")[0]
                 seed = _seed_of(run, recorded)
                 finals.append(dict(domain=domain, method=method, seed=seed, value=figure[0], final=figure[1]))
-                finals[-1]["source"] = str(run)
+                finals[-1]["source"] = Path(*Path(run).resolve().parts[-3:]).as_posix()
     return finals
 
 
