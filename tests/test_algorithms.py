@@ -1,0 +1,215 @@
+"""The contract every algorithm of the registry keeps, checked over each one (MP-DQN and Hybrid SAC's two forms too):
+save -> load -> predict gives the same model and the same actions, the same seed the same weights to the bit, a
+resumed run goes on from its checkpoint, and ``pamdp train`` -> again -> ``pamdp evaluate`` works end to end.
+
+What one algorithm alone does is tested in its own file. A resumed run is not the uninterrupted run (docs/algorithms.md,
+"Checkpoints and resuming": env states are not saved, so it starts new episodes), and that is not asserted here.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import shutil
+
+import gymnasium
+import numpy as np
+import pytest
+import torch
+from conftest import ENV, module_bytes, progress_rows, small_settings
+
+from pamdp.algos import ALGORITHMS, algorithm_class
+from pamdp.algos.checkpoints import CHECKPOINT, load_model, read_checkpoint
+from pamdp.cli import main
+
+STEPS = 200  # two 100-sample epochs: updates in both
+
+
+@dataclasses.dataclass(frozen=True)
+class Case:
+    algo: str
+    settings: dict = dataclasses.field(default_factory=dict)
+    replay: bool = False
+    """Whether it learns from a replay buffer: its checkpoint then holds the buffer (``save_replay``), and one update
+    (``_update()``) from the same buffer, weights and random streams is the same update."""
+
+    @property
+    def cls(self):
+        return algorithm_class(self.algo)
+
+    def config(self, **extra):
+        return self.cls.config_class.from_dict(small_settings(self.cls, **self.settings, **extra))
+
+
+OFF = {"save_replay": True}
+CASES = {
+    "patrpo": Case("patrpo"),
+    "pappo": Case("pappo"),
+    "pasvg0": Case("pasvg0", OFF, replay=True),
+    "paddpg": Case("paddpg", OFF, replay=True),
+    "pdqn": Case("pdqn", OFF, replay=True),
+    "mpdqn": Case("pdqn", {**OFF, "multi_pass": True}, replay=True),
+    "hyar": Case("hyar", OFF, replay=True),
+    "hsac-flat": Case("hsac", {**OFF, "form": "flat"}, replay=True),
+    "hsac-hierarchical": Case("hsac", {**OFF, "form": "hierarchical"}, replay=True),
+}
+
+
+def test_every_registered_algorithm_has_a_case():
+    assert {case.algo for case in CASES.values()} == set(ALGORITHMS)
+
+
+@dataclasses.dataclass
+class Trained:
+    case: Case
+    model: object
+    run_dir: object
+    initial: dict[str, bytes]
+    final: dict[str, bytes]
+    steps: int
+    """The samples it took: ``STEPS`` or a few more (each epoch ends on a step of every env copy)."""
+
+
+@pytest.fixture(scope="module", params=list(CASES), ids=list(CASES))
+def trained(request, tmp_path_factory) -> Trained:
+    """A model of each case trained ``STEPS`` samples from seed 0, with its run directory (its last checkpoint is
+    the model as it ended), and its modules' bytes before and after. Tests may act with the model, not train it."""
+    case = CASES[request.param]
+    run_dir = tmp_path_factory.mktemp(request.param)
+    model = case.cls(ENV, case.config())
+    initial = module_bytes(model)
+    model.learn(STEPS, progress_bar=False, run_dir=run_dir)
+    assert STEPS <= model.num_timesteps < STEPS + 2 * model.config.num_envs and model.epoch == 2
+    return Trained(case, model, run_dir, initial, module_bytes(model), model.num_timesteps)
+
+
+def assert_same(a, b, where="payload"):
+    """``a`` and ``b`` (checkpoint payloads: nested dicts, lists, tensors, arrays, plain values) equal to the bit."""
+    assert type(a) is type(b), where
+    if isinstance(a, dict):
+        assert a.keys() == b.keys(), where
+        for key in a:
+            assert_same(a[key], b[key], f"{where}.{key}")
+    elif isinstance(a, (list, tuple)):
+        assert len(a) == len(b), where
+        for i, (x, y) in enumerate(zip(a, b)):
+            assert_same(x, y, f"{where}[{i}]")
+    elif isinstance(a, (torch.Tensor, np.ndarray)):  # bytes: a NaN (a return not yet known) equals itself
+        a, b = (x.numpy() if isinstance(x, torch.Tensor) else x for x in (a, b))
+        assert a.dtype == b.dtype and a.shape == b.shape and a.tobytes() == b.tobytes(), where
+    elif isinstance(a, float) and np.isnan(a):
+        assert np.isnan(b), where
+    else:
+        assert a == b, where
+
+
+def assert_same_actions(first, second):
+    a1, p1 = first
+    a2, p2 = second
+    np.testing.assert_array_equal(a1, a2)
+    assert len(p1) == len(p2)
+    for x, y in zip(p1, p2):
+        np.testing.assert_array_equal(x, y)
+
+
+def test_the_weights_learnt(trained):
+    """Every saved module changes in a short run (the trained networks, their targets), so the checks below compare
+    models that learnt, not initial weights; where the run holds still-untrained modules, they are named here."""
+    unchanged = [name for name in trained.final if trained.final[name] == trained.initial[name]]
+    assert unchanged == []
+
+
+def test_save_load_predict_round_trip(trained, tmp_path):
+    model, cls = trained.model, trained.case.cls
+    model.save(tmp_path / "m.pt")
+    for loaded in (cls.load(tmp_path / "m.pt"), load_model(tmp_path / "m.pt")):
+        assert type(loaded) is cls and loaded.config == model.config
+        assert (loaded.num_timesteps, loaded.epoch) == (model.num_timesteps, model.epoch) == (trained.steps, 2)
+        assert module_bytes(loaded) == module_bytes(model)
+    # What the loaded model saves is what it was loaded from: optimiser states, replay, random streams, counters.
+    loaded.save(tmp_path / "again.pt")
+    saved = read_checkpoint(tmp_path / "m.pt")
+    assert_same(saved, read_checkpoint(tmp_path / "again.pt"))
+    if trained.case.replay:
+        assert len(loaded.replay) == len(model.replay) == trained.steps
+
+    obs = np.random.default_rng(0).uniform(0, 1, size=(32, model.obs_dim)).astype(np.float32)
+    for deterministic in (True, False):  # sampled actions continue the same random streams
+        torch.manual_seed(0)
+        ours = model.predict(obs, deterministic=deterministic)
+        torch.manual_seed(0)
+        assert_same_actions(ours, loaded.predict(obs, deterministic=deterministic))
+    if trained.case.replay:  # the same next update: the buffer and the random streams came back too
+        assert model._update() == loaded._update()
+        assert module_bytes(loaded) == module_bytes(model)
+    env = gymnasium.make(ENV)
+    o, _ = env.reset(seed=0)
+    for deterministic in (True, False):  # one observation: an action the scalar env takes
+        action = loaded.predict(o, deterministic=deterministic)
+        assert env.action_space.contains(action)
+        env.step(action)
+
+
+def test_same_seed_same_weights_to_the_bit_other_seed_others(trained):
+    case = trained.case
+    again = case.cls(ENV, case.config()).learn(STEPS, progress_bar=False)
+    assert module_bytes(again) == trained.final
+    other = case.cls(ENV, case.config(seed=1)).learn(STEPS, progress_bar=False)
+    assert [n for n, b in module_bytes(other).items() if b == trained.final[n]] == []
+
+
+def test_resumed_runs_go_on_from_the_checkpoint_alike(trained, tmp_path):
+    """Loading the last checkpoint and training on continues the counters and the log; two resumptions of one
+    checkpoint train alike, so a resumed run is as reproducible as one from the start."""
+    resumed = []
+    for i in range(2):
+        run_dir = shutil.copytree(trained.run_dir, tmp_path / f"resumed{i}")
+        model = trained.case.cls.load(run_dir / CHECKPOINT)
+        assert (model.num_timesteps, model.epoch) == (trained.steps, 2) and module_bytes(model) == trained.final
+        model.learn(100, progress_bar=False, run_dir=run_dir)
+        assert trained.steps + 100 <= model.num_timesteps and model.epoch == 3
+        rows = progress_rows(run_dir)
+        assert [float(r["time/epoch"]) for r in rows] == [1.0, 2.0, 3.0]
+        assert float(rows[1]["time/total_timesteps"]) == trained.steps
+        assert float(rows[2]["time/total_timesteps"]) == model.num_timesteps
+        resumed.append(module_bytes(model))
+    assert resumed[0] == resumed[1]
+    assert [n for n, b in resumed[0].items() if b == trained.final[n]] == []  # it went on learning
+
+
+def flags(settings: dict) -> list[str]:
+    """``settings`` as ``pamdp train`` flags: ``{"hidden_sizes": (16,)}`` -> ``["--hidden-sizes", "16"]``."""
+    out = []
+    for name, value in settings.items():
+        if isinstance(value, tuple):
+            value = ",".join(map(str, value))
+        elif isinstance(value, bool):
+            value = str(value).lower()
+        out += ["--" + name.replace("_", "-"), str(value)]
+    return out
+
+
+@pytest.mark.parametrize("name", list(ALGORITHMS))
+def test_cli_trains_skips_a_finished_run_resumes_and_evaluates(name, tmp_path, capsys):
+    out = tmp_path / "run"
+    settings = small_settings(name, save_replay=True)  # where the algorithm has the setting
+    argv = ["train", name, "--out", str(out), "--eval-episodes", "3", "--no-progress", *flags(settings)]
+    assert main([*argv, "--total-steps", "200"]) == 0
+    assert "greedy return over 3 episodes" in capsys.readouterr().out
+    run = json.loads((out / "run.json").read_text())
+    config = algorithm_class(name).config_class.from_dict(settings).to_dict()
+    assert {k: run["config"][k] for k in settings} == {k: config[k] for k in settings}  # every flag arrived
+    assert run["algo"] == name and run["total_steps"] == 200 and len(progress_rows(out)) == 2
+
+    checkpoint, at = (out / CHECKPOINT).read_bytes(), read_checkpoint(out / CHECKPOINT)["num_timesteps"]
+    assert main([*argv, "--total-steps", "200"]) == 0  # the same command: nothing left to train
+    assert "already finished" in capsys.readouterr().err and (out / CHECKPOINT).read_bytes() == checkpoint
+
+    assert main([*argv, "--total-steps", "300"]) == 0  # a larger budget: it resumes
+    assert f"resuming {out} at step {at:,} of 300" in capsys.readouterr().err
+    assert [float(r["time/epoch"]) for r in progress_rows(out)] == [1.0, 2.0, 3.0]
+
+    assert main(["evaluate", str(out), "--episodes", "3", "--json"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert result["episodes"] == 3 and result["policy"] == "greedy"
+    assert 0.0 <= result["mean_return"] <= 1.0 and result["mean_length"] >= 1  # Platform's returns lie in [0, 1]
