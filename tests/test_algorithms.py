@@ -18,6 +18,7 @@ import pytest
 import torch
 from conftest import ENV, module_bytes, progress_rows, small_settings
 
+import pamdp
 from pamdp.algos import ALGORITHMS, algorithm_class
 from pamdp.algos.checkpoints import CHECKPOINT, load_model, read_checkpoint
 from pamdp.cli import main
@@ -55,8 +56,11 @@ CASES = {
 }
 
 
-def test_every_registered_algorithm_has_a_case():
+def test_every_registered_algorithm_has_a_case_and_is_importable_from_pamdp():
     assert {case.algo for case in CASES.values()} == set(ALGORITHMS)
+    for name in ALGORITHMS:
+        cls = algorithm_class(name)
+        assert getattr(pamdp, cls.__name__) is cls and cls.__name__ in pamdp.__all__
 
 
 @dataclasses.dataclass
@@ -122,7 +126,7 @@ def test_the_weights_learnt(trained):
 def test_save_load_predict_round_trip(trained, tmp_path):
     model, cls = trained.model, trained.case.cls
     model.save(tmp_path / "m.pt")
-    for loaded in (cls.load(tmp_path / "m.pt"), load_model(tmp_path / "m.pt")):
+    for loaded in (cls.load(tmp_path / "m.pt", env=ENV), load_model(tmp_path / "m.pt")):
         assert type(loaded) is cls and loaded.config == model.config
         assert (loaded.num_timesteps, loaded.epoch) == (model.num_timesteps, model.epoch) == (trained.steps, 2)
         assert module_bytes(loaded) == module_bytes(model)
@@ -132,6 +136,9 @@ def test_save_load_predict_round_trip(trained, tmp_path):
     assert_same(saved, read_checkpoint(tmp_path / "again.pt"))
     if trained.case.replay:
         assert len(loaded.replay) == len(model.replay) == trained.steps
+        model.save(tmp_path / "acting.pt", replay=False)  # a run directory's final model: for acting only
+        assert len(cls.load(tmp_path / "acting.pt").replay) == 0
+        assert (tmp_path / "acting.pt").stat().st_size < (tmp_path / "m.pt").stat().st_size
 
     obs = np.random.default_rng(0).uniform(0, 1, size=(32, model.obs_dim)).astype(np.float32)
     for deterministic in (True, False):  # sampled actions continue the same random streams
@@ -172,6 +179,8 @@ def test_resumed_runs_go_on_from_the_checkpoint_alike(trained, tmp_path):
         assert [float(r["time/epoch"]) for r in rows] == [1.0, 2.0, 3.0]
         assert float(rows[1]["time/total_timesteps"]) == trained.steps
         assert float(rows[2]["time/total_timesteps"]) == model.num_timesteps
+        if trained.case.replay:  # the buffer came back and goes on: the checkpoint's samples and the new ones
+            assert len(model.replay) == model.num_timesteps
         resumed.append(module_bytes(model))
     assert resumed[0] == resumed[1]
     assert [n for n, b in resumed[0].items() if b == trained.final[n]] == []  # it went on learning
@@ -189,17 +198,18 @@ def flags(settings: dict) -> list[str]:
     return out
 
 
-@pytest.mark.parametrize("name", list(ALGORITHMS))
-def test_cli_trains_skips_a_finished_run_resumes_and_evaluates(name, tmp_path, capsys):
-    out = tmp_path / "run"
-    settings = small_settings(name, save_replay=True)  # where the algorithm has the setting
+@pytest.mark.parametrize("case", list(CASES))
+def test_cli_trains_skips_a_finished_run_resumes_and_evaluates(case, tmp_path, capsys):
+    out, name, settings = tmp_path / "run", CASES[case].algo, small_settings(CASES[case].cls, **CASES[case].settings)
     argv = ["train", name, "--out", str(out), "--eval-episodes", "3", "--no-progress", *flags(settings)]
     assert main([*argv, "--total-steps", "200"]) == 0
     assert "greedy return over 3 episodes" in capsys.readouterr().out
     run = json.loads((out / "run.json").read_text())
-    config = algorithm_class(name).config_class.from_dict(settings).to_dict()
+    config = CASES[case].config().to_dict()
     assert {k: run["config"][k] for k in settings} == {k: config[k] for k in settings}  # every flag arrived
     assert run["algo"] == name and run["total_steps"] == 200 and len(progress_rows(out)) == 2
+    if CASES[case].replay:  # the checkpoint keeps the buffer for resuming; the final model, for acting, does not
+        assert len(load_model(out / CHECKPOINT).replay) > 0 and len(load_model(out / "final_model.pt").replay) == 0
 
     checkpoint, at = (out / CHECKPOINT).read_bytes(), read_checkpoint(out / CHECKPOINT)["num_timesteps"]
     assert main([*argv, "--total-steps", "200"]) == 0  # the same command: nothing left to train
