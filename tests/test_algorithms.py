@@ -1,6 +1,7 @@
 """The contract every algorithm of the registry keeps, checked over each one (MP-DQN and Hybrid SAC's two forms too):
 save -> load -> predict gives the same model and the same actions, the same seed the same weights to the bit, a
-resumed run goes on from its checkpoint, and ``pamdp train`` -> again -> ``pamdp evaluate`` works end to end.
+resumed run goes on from its checkpoint, ``pamdp train`` -> again -> ``pamdp evaluate`` works end to end, and a bad
+setting is refused naming its value.
 
 What one algorithm alone does is tested in its own file. A resumed run is not the uninterrupted run (docs/algorithms.md,
 "Checkpoints and resuming": env states are not saved, so it starts new episodes), and that is not asserted here.
@@ -184,6 +185,92 @@ def test_resumed_runs_go_on_from_the_checkpoint_alike(trained, tmp_path):
         resumed.append(module_bytes(model))
     assert resumed[0] == resumed[1]
     assert [n for n, b in resumed[0].items() if b == trained.final[n]] == []  # it went on learning
+
+
+# Settings out of their range, each algorithm's own, and what the refusal must name (the device setting: test_device).
+BAD_SETTINGS = [
+    ("patrpo", {"delta": -0.1}, "delta = -0.1"),
+    ("patrpo", {"kl_estimator": "exact"}, "kl_estimator = 'exact'"),
+    ("patrpo", {"hidden_sizes": ()}, "hidden_sizes"),
+    ("patrpo", {"gamma": float("nan")}, "gamma = nan"),
+    ("patrpo", {"baseline": "zero"}, "baseline = 'zero'"),
+    ("patrpo", {"fvp": "exact"}, "fvp = 'exact'"),
+    ("patrpo", {"pi_c_input": "one_hot"}, "pi_c_input = 'one_hot'; expected one of 'onehot', 'state'"),
+    ("patrpo", {"fvp": "gauss_newton", "kl_estimator": "joint_sample"}, "fvp = 'gauss_newton'.*joint_sample"),
+    ("pappo", {"clip_range": 0.0}, "PAPPOConfig.clip_range = 0.0"),
+    ("pappo", {"clip_range": 1.5}, "clip_range = 1.5"),
+    ("pappo", {"n_epochs": 0}, "n_epochs = 0"),
+    ("pappo", {"minibatch_size": 8192}, "minibatch_size = 8192; expected an integer in \\[1, batch_size=4096\\]"),
+    ("pappo", {"lr": -1e-3}, "lr = -0.001"),
+    ("pappo", {"ent_coef_d": -0.1}, "ent_coef_d = -0.1"),
+    ("pappo", {"ent_coef_c": -1.0}, "ent_coef_c = -1.0"),
+    ("pappo", {"vf_coef": 0.0}, "vf_coef = 0.0"),
+    ("pappo", {"max_grad_norm": 0.0}, "max_grad_norm = 0.0"),
+    ("pappo", {"target_kl": -0.01}, "target_kl = -0.01"),
+    ("pappo", {"gae_lambda": 1.5}, "gae_lambda = 1.5"),
+    ("pappo", {"gamma": float("nan")}, "gamma = nan"),
+    ("pappo", {"activation": "sigmoid"}, "activation = 'sigmoid'"),
+    ("pappo", {"vf_hidden_sizes": (0,)}, "vf_hidden_sizes = \\(0,\\)"),
+    ("pappo", {"num_envs": 0}, "num_envs = 0"),
+    ("pasvg0", {"temperature": 0.0}, "temperature = 0.0"),
+    ("pasvg0", {"tau": 1.5}, "tau = 1.5"),
+    ("pasvg0", {"updates_per_step": -1.0}, "updates_per_step = -1.0"),
+    ("pasvg0", {"activation": "swish"}, "activation = 'swish'"),
+    ("pasvg0", {"policy_lr": float("inf")}, "policy_lr = inf"),
+    ("pasvg0", {"target_entropy": -0.1, "entropy_coef": 0.1}, "target_entropy = -0.1"),
+    ("pasvg0", {"target_entropy": 0.5, "entropy_coef": 0.0}, "entropy_coef = 0.0"),
+    ("pasvg0", {"explore_epsilon": 1.5}, "explore_epsilon = 1.5"),
+    ("pasvg0", {"policy_delay": 0}, "policy_delay = 0"),
+    ("pasvg0", {"discrete_gradient": "reinforce"}, "discrete_gradient = 'reinforce'"),
+    ("pasvg0", {"discrete_gradient": "expected", "straight_through": False}, "straight_through = False"),
+    ("paddpg", {"bound": "clip"}, "bound = 'clip'"),
+    ("paddpg", {"beta": 1.5}, "beta = 1.5"),
+    ("paddpg", {"epsilon_end": -0.1}, "epsilon_end = -0.1"),
+    ("paddpg", {"batch_size": 0}, "batch_size = 0"),
+    ("paddpg", {"hidden_sizes": (0,)}, "hidden_sizes"),
+    ("pdqn", {"bound": "clip"}, "bound = 'clip'"),
+    ("pdqn", {"tau_q": 0.0}, "tau_q = 0.0"),
+    ("pdqn", {"tau_actor": 1.5}, "tau_actor = 1.5"),
+    ("pdqn", {"epsilon_end": 1.5}, "epsilon_end = 1.5"),
+    ("pdqn", {"updates_per_step": 0.0}, "updates_per_step = 0.0"),
+    ("pdqn", {"beta": -0.1}, "beta = -0.1"),
+    ("pdqn", {"ou_theta": 0.0}, "ou_theta = 0.0"),
+    ("pdqn", {"hidden_sizes": ()}, "hidden_sizes = \\(\\)"),
+    ("pdqn", {"activation": "gelu"}, "activation = 'gelu'"),
+    ("hyar", {"relabel": "some"}, "relabel = 'some'"),
+    ("hyar", {"lsc_percent": 0.0}, "lsc_percent = 0.0"),
+    ("hyar", {"lsc_percent": 101.0}, "lsc_percent = 101.0"),
+    ("hyar", {"embed_dim": 0}, "embed_dim = 0"),
+    ("hyar", {"warmup_steps": 0}, "warmup_steps = 0"),
+    ("hyar", {"policy_delay": 0}, "policy_delay = 0"),
+    ("hyar", {"tau": 0.0}, "tau = 0.0"),
+    ("hyar", {"buffer_size": 100}, "buffer_size = 100"),
+    ("hyar", {"vae_hidden_sizes": ()}, "vae_hidden_sizes = \\(\\)"),
+    ("hyar", {"kl_weight": -1.0}, "kl_weight = -1.0"),
+    ("hyar", {"epsilon_start": 1.5}, "epsilon_start = 1.5"),
+    ("hyar", {"exploration_noise_steps": -1}, "exploration_noise_steps = -1"),
+    ("hyar", {"exploration_noise_start": -0.1}, "exploration_noise_start = -0.1"),
+    ("hyar", {"bound": "zero"}, "bound = 'zero'"),
+    ("hyar", {"lsc_remap": True}, "lsc_remap = True.*squash"),
+    (
+        "hyar",
+        {"td3_replay": 6_000, "buffer_size": 5_000, "warmup_steps": 150},
+        "td3_replay = 6000.*<= buffer_size \\(5000\\)",
+    ),
+    ("hyar", {"td3_replay": -1}, "td3_replay = -1"),
+    ("hsac", {"form": "tree"}, "form = 'tree'; expected one of 'flat', 'hierarchical'"),
+    ("hsac", {"target_entropy_d": 1.5}, "target_entropy_d = 1.5"),
+    ("hsac", {"target_entropy_c": 0.7}, "target_entropy_c = 0.7; expected a number below log 2"),
+    ("hsac", {"init_alpha_c": 0.0}, "init_alpha_c = 0.0"),
+    ("hsac", {"alpha_lr": -1e-3}, "alpha_lr = -0.001"),
+    ("hsac", {"tau": 0.0}, "tau = 0.0"),
+]
+
+
+@pytest.mark.parametrize("algo, settings, match", BAD_SETTINGS, ids=[f"{a}-{'-'.join(s)}" for a, s, _ in BAD_SETTINGS])
+def test_a_bad_setting_is_refused_naming_the_value(algo, settings, match):
+    with pytest.raises(ValueError, match=match):
+        algorithm_class(algo).config_class(**settings)
 
 
 def flags(settings: dict) -> list[str]:

@@ -168,25 +168,6 @@ def test_ou_noise_restarts_per_episode_and_is_gaussian_at_theta_one():
     assert state[0, 0] == pytest.approx(0.3 * np.random.default_rng(1).standard_normal())
 
 
-@pytest.mark.parametrize(
-    "kwargs, match",
-    [
-        ({"bound": "clip"}, "bound = 'clip'"),
-        ({"tau_q": 0.0}, "tau_q = 0.0"),
-        ({"tau_actor": 1.5}, "tau_actor = 1.5"),
-        ({"epsilon_end": 1.5}, "epsilon_end = 1.5"),
-        ({"updates_per_step": 0.0}, "updates_per_step = 0.0"),
-        ({"beta": -0.1}, "beta = -0.1"),
-        ({"ou_theta": 0.0}, "ou_theta = 0.0"),
-        ({"hidden_sizes": ()}, "hidden_sizes = \\(\\)"),
-        ({"activation": "gelu"}, "activation = 'gelu'"),
-    ],
-)
-def test_bad_settings_raise_errors_naming_the_value(kwargs, match):
-    with pytest.raises(ValueError, match=match):
-        PDQNConfig(**kwargs)
-
-
 def test_bad_types_from_plain_data_are_named():
     with pytest.raises(ValueError, match="'multi_pass' = 'yes'"):
         PDQNConfig.from_dict({"multi_pass": "yes"})
