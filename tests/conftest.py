@@ -9,7 +9,6 @@ import dataclasses
 from pathlib import Path
 
 import numpy as np
-import torch
 
 from pamdp.algos import algorithm_class
 from pamdp.spaces import HybridActionSpace
@@ -71,13 +70,6 @@ def module_bytes(model) -> dict[str, bytes]:
         name: b"".join(t.detach().cpu().contiguous().numpy().tobytes() for t in module.state_dict().values())
         for name, module in model._modules().items()
     }
-
-
-def flat_weights(model, names=None) -> torch.Tensor:
-    """The parameters of ``model``'s saved modules (those named in ``names``, else all) as one vector."""
-    modules = model._modules()
-    chosen = [modules[n] for n in names] if names is not None else list(modules.values())
-    return torch.cat([p.detach().flatten() for m in chosen for p in m.parameters()])
 
 
 def progress_rows(run_dir: str | Path) -> list[dict[str, str]]:
