@@ -78,7 +78,8 @@ class Trained:
 @pytest.fixture(scope="module", params=list(CASES), ids=list(CASES))
 def trained(request, tmp_path_factory) -> Trained:
     """A model of each case trained ``STEPS`` samples from seed 0, with its run directory (its last checkpoint is
-    the model as it ended), and its modules' bytes before and after. Tests may act with the model, not train it."""
+    the model as it ended), and its modules' bytes before and after. A test may act with the model or update it: the
+    others compare with the bytes and the checkpoint."""
     case = CASES[request.param]
     run_dir = tmp_path_factory.mktemp(request.param)
     model = case.cls(ENV, case.config())
@@ -118,8 +119,8 @@ def assert_same_actions(first, second):
 
 
 def test_the_weights_learnt(trained):
-    """Every saved module changes in a short run (the trained networks, their targets), so the checks below compare
-    models that learnt, not initial weights; where the run holds still-untrained modules, they are named here."""
+    """Every saved module changes in the short run (the trained networks, their targets, the temperatures), so the
+    checks below compare models that learnt, not initial weights."""
     unchanged = [name for name in trained.final if trained.final[name] == trained.initial[name]]
     assert unchanged == []
 
