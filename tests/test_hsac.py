@@ -1,6 +1,7 @@
 """Hybrid SAC: the squashed hybrid distribution's log-probabilities and entropies against torch.distributions,
 histograms and quadrature, the target's exact expectation against sampling (masked too), the temperature step,
-both forms' layout, save/load, seeded determinism, and a masked action never chosen."""
+both forms' layout, and a masked action never chosen (save/load and seeded determinism of both forms:
+test_algorithms)."""
 
 import dataclasses
 import math
@@ -9,6 +10,7 @@ import gymnasium
 import numpy as np
 import pytest
 import torch
+from conftest import OFF_POLICY_SMALL
 from gymnasium import spaces
 from torch.distributions import Normal, TanhTransform, TransformedDistribution
 
@@ -16,15 +18,7 @@ from pamdp import HybridSAC
 from pamdp.algos.hsac import HybridSACActor, HybridSACConfig, SquashedHybrid, temperature_gradient
 from pamdp.spaces import HybridActionSpace
 
-SMALL = HybridSACConfig(
-    hidden_sizes=(16, 16),
-    num_envs=4,
-    epoch_steps=200,
-    learning_starts=100,
-    batch_size=16,
-    buffer_size=5_000,
-    updates_per_step=0.5,
-)
+SMALL = HybridSACConfig(hidden_sizes=(16, 16), updates_per_step=0.5, **OFF_POLICY_SMALL)
 # Three actions with 2, 0 and 1 parameters: padded to m = 2, the all-actions vector [x_0, x_0' | x_2].
 HYBRID = HybridActionSpace(
     (np.array([-1.0, 0.0]), np.zeros(0), np.array([-2.0])), (np.array([1.0, 3.0]), np.zeros(0), np.array([2.0]))
@@ -202,37 +196,6 @@ def test_temperature_gradient_sign_and_fixed_point():
     assert fixed.alphas == pytest.approx(start, abs=1e-7)
 
 
-def _weights(model: HybridSAC) -> torch.Tensor:
-    return torch.cat([p.detach().flatten() for m in model._modules().values() for p in m.parameters()])
-
-
-@pytest.mark.parametrize("form", ["flat", "hierarchical"])
-def test_seeded_runs_are_identical_and_seeds_differ(form):
-    runs = [_model(form=form, seed=s).learn(400, progress_bar=False) for s in (3, 3, 4)]
-    assert torch.equal(_weights(runs[0]), _weights(runs[1]))
-    assert runs[0].alphas == runs[1].alphas and runs[0].alphas != (1.0, 1.0)
-    assert not torch.equal(_weights(runs[0]), _weights(runs[2]))
-
-
-def test_save_load_round_trip(tmp_path):
-    model = _model(form="hierarchical", save_replay=True).learn(400, progress_bar=False)
-    model.save(tmp_path / "m.pt")
-    loaded = HybridSAC.load(tmp_path / "m.pt")
-    assert loaded.config == model.config and loaded.num_timesteps == model.num_timesteps
-    assert torch.equal(_weights(loaded), _weights(model)) and loaded.alphas == model.alphas
-    assert len(loaded.replay) == len(model.replay)
-    for name, opt in model._optimizers().items():
-        assert str(opt.state_dict()) == str(loaded._optimizers()[name].state_dict())
-    obs = np.random.default_rng(5).uniform(0, 1, size=(32, 9)).astype(np.float32)
-    a, b = model.predict(obs), loaded.predict(obs)
-    np.testing.assert_array_equal(a[0], b[0])
-    for p, q in zip(a[1], b[1]):
-        np.testing.assert_array_equal(p, q)
-    # the same update from the same state: the RNG streams and the replay came back too
-    torch.testing.assert_close(model._update()["losses/critic_loss"], loaded._update()["losses/critic_loss"])
-    assert torch.equal(_weights(loaded), _weights(model))
-
-
 class _MaskedEnv(gymnasium.Env):
     """Three actions with 2, 0 and 1 parameters; action 0 pays but is forbidden in every other state, action 2 in
     states where the observation's first entry is negative. Counts the forbidden actions taken."""
@@ -276,19 +239,3 @@ def test_masked_actions_are_never_chosen():
         assert torch.all(a == 1)
     a, _ = model._act(obs, False, torch.tensor([[True, True, False]]).expand(2000, -1))
     assert not (a == 2).any()
-
-
-@pytest.mark.parametrize(
-    "kwargs, match",
-    [
-        ({"form": "tree"}, "form = 'tree'; expected one of 'flat', 'hierarchical'"),
-        ({"target_entropy_d": 1.5}, "target_entropy_d = 1.5"),
-        ({"target_entropy_c": 0.7}, "target_entropy_c = 0.7; expected a number below log 2"),
-        ({"init_alpha_c": 0.0}, "init_alpha_c = 0.0"),
-        ({"alpha_lr": -1e-3}, "alpha_lr = -0.001"),
-        ({"tau": 0.0}, "tau = 0.0"),
-    ],
-)
-def test_bad_settings_are_refused_by_name(kwargs, match):
-    with pytest.raises(ValueError, match=match.replace("(", "\\(").replace("[", "\\[")):
-        HybridSACConfig(**kwargs)

@@ -1,22 +1,18 @@
 """HyAR-TD3: decoding by hand, the VAE's loss against closed forms, the latent bounds against NumPy, the
-representation learning to reconstruct, relabelling, TD3's target and policy delay by hand, the warm-up, save/load,
-resuming, a tiny learning run, the CLI."""
+representation learning to reconstruct, relabelling, TD3's target and policy delay by hand, the warm-up, resuming
+without the replay, a tiny learning run (save/load, resuming and the CLI as every algorithm: test_algorithms)."""
 
-import csv
 import dataclasses
-import json
 
 import numpy as np
 import pytest
 import torch
+from conftest import HYBRID, progress_rows
 from numeric import finite_difference
 
 from pamdp import HyAR
-from pamdp.algos import load_model
 from pamdp.algos.hyar import ActionRepresentation, HyARConfig, latent_bounds
 from pamdp.algos.offpolicy import backprop_actor, invert_gradients
-from pamdp.cli import main
-from pamdp.spaces import HybridActionSpace
 
 SMALL = HyARConfig(
     num_envs=4,
@@ -34,10 +30,6 @@ SMALL = HyARConfig(
     lsc_samples=100,
     buffer_size=5_000,
     updates_per_step=0.25,
-)
-# Three actions with 1, 2 and 1 parameters, padded to 2.
-HYBRID = HybridActionSpace(
-    (np.array([-1.0]), np.array([0.0, 0.0]), np.array([-2.0])), (np.array([1.0]), np.array([1.0, 3.0]), np.array([2.0]))
 )
 
 
@@ -308,53 +300,6 @@ def test_actor_gradient_through_the_latent_box_matches_finite_differences(bound)
         torch.testing.assert_close(x, m.rep.decode(obs.float(), m.actor.to_latent(u))[1])
 
 
-@pytest.mark.parametrize(
-    "kwargs, match",
-    [
-        ({"relabel": "some"}, "relabel = 'some'"),
-        ({"lsc_percent": 0.0}, "lsc_percent = 0.0"),
-        ({"lsc_percent": 101.0}, "lsc_percent = 101.0"),
-        ({"embed_dim": 0}, "embed_dim = 0"),
-        ({"warmup_steps": 0}, "warmup_steps = 0"),
-        ({"policy_delay": 0}, "policy_delay = 0"),
-        ({"tau": 0.0}, "tau = 0.0"),
-        ({"buffer_size": 100}, "buffer_size = 100"),
-        ({"vae_hidden_sizes": ()}, "vae_hidden_sizes = \\(\\)"),
-        ({"kl_weight": -1.0}, "kl_weight = -1.0"),
-        ({"epsilon_start": 1.5}, "epsilon_start = 1.5"),
-        ({"exploration_noise_steps": -1}, "exploration_noise_steps = -1"),
-        ({"exploration_noise_start": -0.1}, "exploration_noise_start = -0.1"),
-        ({"bound": "zero"}, "bound = 'zero'"),
-        ({"lsc_remap": True}, "lsc_remap = True.*squash"),
-        ({"td3_replay": 6_000}, "td3_replay = 6000.*<= buffer_size \\(5000\\)"),
-        ({"td3_replay": -1}, "td3_replay = -1"),
-    ],
-)
-def test_bad_settings_raise_errors_naming_the_value(kwargs, match):
-    with pytest.raises(ValueError, match=match):
-        dataclasses.replace(SMALL, **kwargs)
-
-
-def test_save_load_predict_round_trip(tmp_path):
-    m = model()
-    m.learn(400, progress_bar=False)
-    m.save(tmp_path / "m.pt")
-    saved_rng = m.np_rng.bit_generator.state
-    for loaded in (HyAR.load(tmp_path / "m.pt"), load_model(tmp_path / "m.pt")):
-        m.np_rng.bit_generator.state = saved_rng
-        assert isinstance(loaded, HyAR) and loaded.config == m.config and loaded.pretrained
-        torch.testing.assert_close(loaded.actor.low, m.actor.low)
-        torch.testing.assert_close(loaded.actor.high, m.actor.high)
-        obs = np.random.default_rng(0).uniform(0, 1, size=(32, 9))
-        for deterministic in (True, False):
-            a1, p1 = m.predict(obs, deterministic=deterministic)
-            a2, p2 = loaded.predict(obs, deterministic=deterministic)
-            np.testing.assert_array_equal(a1, a2)
-            for x, y in zip(p1, p2):
-                np.testing.assert_array_equal(x, y)
-    assert m.action_space.contains(m.predict(obs[0]))
-
-
 def test_resume_keeps_the_representation_schedule(tmp_path):
     m = model()
     m.learn(400, progress_bar=False, run_dir=tmp_path)
@@ -374,22 +319,9 @@ def test_resume_keeps_the_representation_schedule(tmp_path):
 def test_tiny_learning_run_logs(tmp_path):
     m = model()
     m.learn(800, progress_bar=False, run_dir=tmp_path)
-    with open(tmp_path / "progress.csv", newline="") as f:
-        rows = list(csv.DictReader(f))
+    rows = progress_rows(tmp_path)
     assert len(rows) == 4
     last = rows[-1]
     for key in ("losses/critic_loss", "losses/actor_loss", "losses/vae_recon", "losses/vae_kl", "train/relabelled"):
         assert np.isfinite(float(last[key])), key
     assert 0.0 <= float(last["train/relabelled"]) <= 1.0 and float(last["train/latent_box_width"]) > 0
-
-
-def test_cli_trains_and_evaluates(tmp_path, capsys):
-    out = tmp_path / "run"
-    tiny = ["--hidden-sizes", "16", "--vae-hidden-sizes", "16,16", "--num-envs", "4", "--epoch-steps", "200"]
-    tiny += ["--warmup-steps", "150", "--warmup-updates", "10", "--batch-size", "16", "--buffer-size", "5000"]
-    assert main(["train", "hyar", "--total-steps", "400", "--out", str(out), "--eval-episodes", "20", *tiny]) == 0
-    assert "greedy return over 20 episodes" in capsys.readouterr().out
-    run = json.loads((out / "run.json").read_text())
-    assert run["config"]["warmup_steps"] == 150 and run["preset"] == "cpu"
-    assert main(["evaluate", str(out), "--episodes", "10", "--json"]) == 0
-    assert json.loads(capsys.readouterr().out)["episodes"] == 10

@@ -3,13 +3,13 @@ parameter boxes), boxes of different sizes, and the generic action masks (``info
 
 from __future__ import annotations
 
-import dataclasses
 import math
 
 import gymnasium
 import numpy as np
 import pytest
 import torch
+from conftest import small_config
 from gymnasium import spaces
 
 from pamdp.algos import ALGORITHMS, algorithm_class
@@ -77,37 +77,6 @@ class MaskedLine(gymnasium.Env):
         return self._obs(), reward, success, truncated, info
 
 
-def small_config(cls, action_mask: bool, **extra):
-    """Settings small enough for a few hundred steps, where the algorithm has them."""
-    values = dict(
-        num_envs=4,
-        device="cpu",
-        action_mask=action_mask,
-        hidden_sizes=(16,),
-        vf_hidden_sizes=(16,),
-        vae_hidden_sizes=(16, 16),
-        epoch_steps=100,
-        learning_starts=64,
-        warmup_steps=64,
-        warmup_updates=10,
-        vae_interval=50,
-        vae_updates=5,
-        vae_batch_size=16,
-        lsc_samples=64,
-        buffer_size=2_000,
-        epsilon_steps=200,
-        n_epochs=2,
-        minibatch_size=32,
-        vf_epochs=1,
-        updates_per_step=0.25,
-    )
-    fields = {f.name for f in dataclasses.fields(cls.config_class)}
-    on_policy = "gae_lambda" in fields and "learning_starts" not in fields
-    values["batch_size"] = 100 if on_policy else 16
-    values.update(extra)
-    return cls.config_class.from_dict({k: v for k, v in values.items() if k in fields})
-
-
 CASES = [(name, {}) for name in ALGORITHMS] + [
     ("patrpo", {"fvp": "double_backprop"}),
     ("pasvg0", {"discrete_gradient": "expected", "explore_epsilon": 0.2}),
@@ -122,7 +91,7 @@ def test_every_algorithm_trains_on_boxes_of_sizes_2_0_1_and_honours_the_mask(nam
     if cls is None:
         pytest.skip(f"{name}'s module is not installed")
     envs = gymnasium.vector.SyncVectorEnv([MaskedLine for _ in range(4)])
-    model = cls(envs, small_config(cls, action_mask, **extra))
+    model = cls(envs, small_config(cls, action_mask=action_mask, **extra))
     model.learn(300, progress_bar=False)
     copies = envs.envs
     assert sum(e.outside for e in copies) == 0  # every action handed over lies in the env's action space
@@ -149,7 +118,7 @@ def test_the_mask_changes_nothing_where_every_action_is_allowed():
     """A mask allowing everything (an env that reports none) acts as no mask, to the bit."""
     cls = algorithm_class("pdqn")
     obs = torch.randn(5, 3)
-    model = cls(MaskedLine(), small_config(cls, True))
+    model = cls(MaskedLine(), small_config(cls, action_mask=True))
     for deterministic in (True, False):
         model.np_rng = np.random.default_rng(1)
         plain = model._act(obs, deterministic)
@@ -169,12 +138,12 @@ def test_an_env_whose_actions_are_all_parameterless_is_refused():
         cls = algorithm_class(name)
         if cls is not None:
             with pytest.raises(ValueError, match="no action has parameters"):
-                cls(Buttons(), small_config(cls, False))
+                cls(Buttons(), small_config(cls, action_mask=False))
 
 
 def test_predict_refuses_a_mask_of_the_wrong_shape():
     cls = algorithm_class("patrpo")
-    model = cls(MaskedLine(), small_config(cls, True))
+    model = cls(MaskedLine(), small_config(cls, action_mask=True))
     with pytest.raises(ValueError, match=r"expected bool of shape \(3,\)"):
         model.predict(np.zeros(3), True, np.ones(2, dtype=bool))
 
@@ -317,7 +286,7 @@ def test_hybrid_policy_samples_only_allowed_actions():
 # -- the masked Q target, by hand -------------------------------------------------------------------------
 def test_pdqn_target_takes_the_max_over_the_next_states_allowed_actions():
     cls = algorithm_class("pdqn")
-    model = cls(MaskedLine(), small_config(cls, True, batch_size=4, gamma=0.5))
+    model = cls(MaskedLine(), small_config(cls, action_mask=True, batch_size=4, gamma=0.5))
     assert {"mask", "next_mask"} <= set(model.replay.fields)
     g = np.random.default_rng(3)
     n = 4
@@ -402,7 +371,7 @@ def test_evaluation_acts_within_the_mask_when_the_model_was_trained_with_it(acti
     from pamdp.evaluation import evaluate
 
     cls = algorithm_class("patrpo")
-    model = cls(gymnasium.vector.SyncVectorEnv([MaskedLine] * 2), small_config(cls, action_mask))
+    model = cls(gymnasium.vector.SyncVectorEnv([MaskedLine] * 2), small_config(cls, action_mask=action_mask))
     gymnasium.register("test/CountingLine-v0", entry_point=CountingLine)
     CountingLine.picks = 0
     try:

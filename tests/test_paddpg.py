@@ -1,32 +1,18 @@
-"""PADDPG: bounded-output gradients by hand, the action mapping, exploration, MC targets, save/load, the CLI."""
+"""PADDPG: bounded-output gradients by hand, the action mapping, exploration, MC targets (save/load and the CLI as
+every algorithm: test_algorithms)."""
 
 import dataclasses
-import json
 
 import numpy as np
 import pytest
 import torch
+from conftest import HYBRID, OFF_POLICY_SMALL
 
-import pamdp
 from pamdp import PADDPG
-from pamdp.algos import load_model
 from pamdp.algos.offpolicy import invert_gradients, zero_gradients
 from pamdp.algos.paddpg import Actor, Critic, PADDPGConfig
-from pamdp.cli import main
-from pamdp.spaces import HybridActionSpace
 
-SMALL = PADDPGConfig(
-    hidden_sizes=(16, 16),
-    num_envs=4,
-    epoch_steps=200,
-    learning_starts=100,
-    batch_size=16,
-    buffer_size=5_000,
-    epsilon_steps=300,
-)
-HYBRID = HybridActionSpace(
-    (np.array([-1.0]), np.array([0.0, 0.0]), np.array([-2.0])), (np.array([1.0]), np.array([1.0, 3.0]), np.array([2.0]))
-)
+SMALL = PADDPGConfig(hidden_sizes=(16, 16), epsilon_steps=300, **OFF_POLICY_SMALL)
 
 
 def test_inverting_gradients_by_hand():
@@ -112,21 +98,6 @@ def test_epsilon_is_annealed_linearly():
     assert model.epsilon(10**6) == pytest.approx(0.1)
 
 
-@pytest.mark.parametrize(
-    "kwargs, match",
-    [
-        ({"bound": "clip"}, "bound = 'clip'"),
-        ({"beta": 1.5}, "beta = 1.5"),
-        ({"epsilon_end": -0.1}, "epsilon_end = -0.1"),
-        ({"batch_size": 0}, "batch_size = 0"),
-        ({"hidden_sizes": (0,)}, "hidden_sizes"),
-    ],
-)
-def test_bad_settings_raise_clear_errors(kwargs, match):
-    with pytest.raises(ValueError, match=match):
-        PADDPGConfig(**kwargs)
-
-
 def test_epoch_stores_monte_carlo_returns_and_explores():
     model = PADDPG("pamdp/Platform-v0", dataclasses.replace(SMALL, ou_sigma=0.2))
     stats = []
@@ -144,38 +115,6 @@ def test_epoch_stores_monte_carlo_returns_and_explores():
     assert stats[-1]["train/updates"] > 0 and stats[-1]["train/epsilon"] < 1.0
     for key in ("losses/critic_loss", "losses/actor_loss", "train/q_mean", "train/action_freq_0"):
         assert np.isfinite(stats[-1][key]), key
-
-
-def flat_params(model):
-    return torch.cat([p.detach().flatten() for m in (model.actor, model.critic) for p in m.parameters()])
-
-
-def test_same_seed_gives_identical_first_epoch():
-    runs = []
-    for seed in (0, 0, 1):
-        model = PADDPG("pamdp/Platform-v0", dataclasses.replace(SMALL, seed=seed))
-        model.learn(200, progress_bar=False)
-        runs.append(flat_params(model))
-    torch.testing.assert_close(runs[0], runs[1], rtol=0, atol=0)
-    assert not torch.equal(runs[0], runs[2])
-
-
-def test_save_load_predict_round_trip(tmp_path):
-    model = PADDPG("pamdp/Platform-v0", SMALL)
-    model.learn(200, progress_bar=False)
-    model.save(tmp_path / "m.pt")
-    loaded = PADDPG.load(tmp_path / "m.pt")
-    assert loaded.config == model.config and loaded.num_timesteps == model.num_timesteps
-    obs = np.random.default_rng(0).uniform(0, 1, size=(32, 9))
-    for deterministic in (True, False):
-        a1, p1 = model.predict(obs, deterministic=deterministic)
-        a2, p2 = loaded.predict(obs, deterministic=deterministic)
-        np.testing.assert_array_equal(a1, a2)
-        for x, y in zip(p1, p2):
-            np.testing.assert_array_equal(x, y)
-    for name, module in model._modules().items():
-        for p, q in zip(module.state_dict().values(), loaded._modules()[name].state_dict().values()):
-            assert torch.equal(p, q), name
 
 
 def test_beta_zero_stores_no_returns_and_learns_from_the_pure_td_target():
@@ -206,25 +145,3 @@ def test_critic_loss_falls_on_a_fixed_batch():
         model.critic_optimizer.step()
         losses.append(loss.item())
     assert losses[-1] < 0.2 * losses[0]
-
-
-@pytest.mark.parametrize("algo", ["paddpg", "pasvg0"])
-def test_cli_trains_resumes_and_evaluates(tmp_path, capsys, algo):
-    out = tmp_path / "run"
-    tiny = ["--hidden-sizes", "16", "--num-envs", "4", "--epoch-steps", "200", "--learning-starts", "100"]
-    tiny += ["--batch-size", "16", "--buffer-size", "5000", "--save-replay", "true", "--no-progress"]
-    assert main(["train", algo, "--total-steps", "200", "--out", str(out), "--eval-episodes", "20", *tiny]) == 0
-    for name in ("run.json", "progress.csv", "checkpoint.pt", "final_model.pt", "evaluation.json"):
-        assert (out / name).exists(), name
-    # the checkpoint keeps the replay buffer for resuming; the final model, for acting, does not
-    assert len(load_model(out / "checkpoint.pt").replay) > 0 and len(load_model(out / "final_model.pt").replay) == 0
-    assert "greedy return over 20 episodes" in capsys.readouterr().out
-    assert json.loads((out / "run.json").read_text())["config"]["hidden_sizes"] == [16]
-    assert main(["train", algo, "--total-steps", "400", "--out", str(out), "--eval-episodes", "0", *tiny]) == 0
-    assert "resuming" in capsys.readouterr().err
-    assert main(["evaluate", str(out), "--episodes", "10", "--json"]) == 0
-    assert json.loads(capsys.readouterr().out)["episodes"] == 10
-
-
-def test_top_level_import():
-    assert pamdp.PADDPG is PADDPG

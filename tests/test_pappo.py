@@ -1,31 +1,23 @@
 """PAPPO: the clipped surrogate and its gradient by hand, the whole loss against torch.distributions and
-finite differences, the value loss, the KL early stop, settings, save/load, resuming and the command line."""
+finite differences, the value loss, the KL early stop, settings (save/load, resuming and the command line as every
+algorithm: test_algorithms)."""
 
-import csv
 import dataclasses
-import json
 import math
 
-import gymnasium
 import numpy as np
 import pytest
 import torch
+from conftest import HYBRID
 from numeric import finite_difference
 from torch.distributions import Categorical, Normal
 
-import pamdp
 from pamdp import PAPPO
 from pamdp.algos.pappo import PAPPOConfig, clipped_surrogate, ppo_loss
-from pamdp.cli import main
 from pamdp.policies import HybridPolicy, ValueNetwork
-from pamdp.spaces import HybridActionSpace
 
 SMALL = PAPPOConfig(
     hidden_sizes=(16, 16), vf_hidden_sizes=(16,), batch_size=500, minibatch_size=100, n_epochs=2, num_envs=4
-)
-# Three actions with 1, 2 and 1 parameters, so that pi_c's padding (mask) is exercised.
-HYBRID = HybridActionSpace(
-    (np.array([-1.0]), np.array([0.0, 0.0]), np.array([-2.0])), (np.array([1.0]), np.array([1.0, 3.0]), np.array([2.0]))
 )
 
 
@@ -153,109 +145,8 @@ def test_update_improves_the_surrogate_and_target_kl_stops_it_early():
     assert stats["train/early_stop"] == 1 and 1 <= stats["train/updates"] < 5 * n_minibatches
 
 
-@pytest.mark.parametrize(
-    "kwargs, match",
-    [
-        ({"clip_range": 0.0}, "PAPPOConfig.clip_range = 0.0"),
-        ({"clip_range": 1.5}, "clip_range = 1.5"),
-        ({"n_epochs": 0}, "n_epochs = 0"),
-        ({"minibatch_size": 8192}, "minibatch_size = 8192; expected an integer in \\[1, batch_size=4096\\]"),
-        ({"lr": -1e-3}, "lr = -0.001"),
-        ({"ent_coef_d": -0.1}, "ent_coef_d = -0.1"),
-        ({"ent_coef_c": -1.0}, "ent_coef_c = -1.0"),
-        ({"vf_coef": 0.0}, "vf_coef = 0.0"),
-        ({"max_grad_norm": 0.0}, "max_grad_norm = 0.0"),
-        ({"target_kl": -0.01}, "target_kl = -0.01"),
-        ({"gae_lambda": 1.5}, "gae_lambda = 1.5"),
-        ({"gamma": float("nan")}, "gamma = nan"),
-        ({"activation": "sigmoid"}, "activation = 'sigmoid'"),
-        ({"vf_hidden_sizes": (0,)}, "vf_hidden_sizes = \\(0,\\)"),
-        ({"num_envs": 0}, "num_envs = 0"),
-    ],
-)
-def test_bad_settings_raise_errors_naming_the_field(kwargs, match):
-    with pytest.raises(ValueError, match=match):
-        PAPPOConfig(**kwargs)
-
-
 def test_plain_data_with_an_unknown_or_mistyped_setting_is_refused_naming_it():
     with pytest.raises(ValueError, match="unknown PAPPOConfig setting"):
         PAPPOConfig.from_dict({"clip": 0.1})
     with pytest.raises(ValueError, match="'n_epochs' = 2.5"):
         PAPPOConfig.from_dict({"n_epochs": 2.5})
-
-
-def test_same_seed_gives_identical_first_epochs():
-    params = []
-    for _ in range(2):
-        model = PAPPO("pamdp/Platform-v0", SMALL)
-        model.learn(500, progress_bar=False)
-        params.append(torch.cat([p.detach().flatten() for p in model.policy.parameters()]))
-    torch.testing.assert_close(params[0], params[1], rtol=0, atol=0)
-
-
-def test_save_load_predict_round_trip(tmp_path):
-    model = PAPPO("pamdp/Platform-v0", SMALL)
-    model.learn(500, progress_bar=False)
-    model.save(tmp_path / "m.pt")
-    loaded = PAPPO.load(tmp_path / "m.pt")
-    assert loaded.config == model.config and loaded.num_timesteps == model.num_timesteps
-    obs = np.random.default_rng(0).uniform(0, 1, size=(16, 9))
-    for deterministic in (True, False):  # stochastic predictions continue the same random stream
-        a1, p1 = model.predict(obs, deterministic=deterministic)
-        a2, p2 = loaded.predict(obs, deterministic=deterministic)
-        np.testing.assert_array_equal(a1, a2)
-        for u, v in zip(p1, p2):
-            np.testing.assert_array_equal(u, v)
-    env = gymnasium.make("pamdp/Platform-v0")
-    o, _ = env.reset(seed=0)
-    for deterministic in (True, False):
-        action = loaded.predict(o, deterministic=deterministic)
-        assert env.action_space.contains(action)
-        env.step(action)
-    assert pamdp.PAPPO is PAPPO
-
-
-def _rows(run_dir):
-    with open(run_dir / "progress.csv", newline="") as f:
-        return list(csv.DictReader(f))
-
-
-def test_resume_from_a_checkpoint(tmp_path):
-    model = PAPPO("pamdp/Platform-v0", SMALL)
-    model.learn(1000, progress_bar=False, run_dir=tmp_path)
-    resumed = PAPPO.load(tmp_path / "checkpoint.pt")
-    assert (resumed.num_timesteps, resumed.epoch) == (model.num_timesteps, model.epoch) and model.epoch == 2
-    for p, q in zip(
-        [*model.policy.parameters(), *model.value.parameters()],
-        [*resumed.policy.parameters(), *resumed.value.parameters()],
-    ):
-        torch.testing.assert_close(p, q, rtol=0, atol=0)
-    steps = resumed.optimizer.state_dict()["state"][0]["step"]
-    assert steps == model.optimizer.state_dict()["state"][0]["step"] == 2 * 2 * (500 // 100)
-
-    resumed.learn(500, progress_bar=False, run_dir=tmp_path)
-    rows = _rows(tmp_path)
-    assert [float(r["time/epoch"]) for r in rows] == [1.0, 2.0, 3.0]
-    assert float(rows[-1]["time/total_timesteps"]) == resumed.num_timesteps >= 1500
-
-
-def test_cli_trains_resumes_and_evaluates(tmp_path, capsys):
-    out = tmp_path / "run"
-    tiny = ["--hidden-sizes", "16,16", "--vf-hidden-sizes", "16", "--batch-size", "1000", "--minibatch-size", "250"]
-    tiny += ["--num-envs", "8", "--no-progress"]
-    assert main(["train", "pappo", "--total-steps", "3000", "--out", str(out), "--eval-episodes", "20", *tiny]) == 0
-    assert "greedy return over 20 episodes" in capsys.readouterr().out
-    run = json.loads((out / "run.json").read_text())
-    assert run["preset"] == "tuned" and run["config"]["minibatch_size"] == 250
-    rows = _rows(out)
-    assert len(rows) == 3
-    for key in ("losses/policy_loss", "losses/value_loss", "losses/entropy_d", "train/kl", "train/clip_fraction"):
-        assert np.isfinite(float(rows[-1][key])), key
-    assert 0.0 <= float(rows[-1]["charts/episodic_return"]) <= 1.0
-    assert 0.0 <= json.loads((out / "evaluation.json").read_text())["mean_return"] <= 1.0
-
-    assert main(["train", "pappo", "--total-steps", "4000", "--out", str(out), "--eval-episodes", "0", *tiny]) == 0
-    assert "resuming" in capsys.readouterr().err and len(_rows(out)) == 4
-    assert main(["train", "pappo", "--clip-range", "2", "--out", str(tmp_path / "bad")]) == 2
-    assert "clip_range = 2.0" in capsys.readouterr().err

@@ -1,37 +1,21 @@
 """P-DQN and MP-DQN: the multi-pass Q by hand, which parameters Q_k depends on, the actor's gradient by finite
-differences, acting and exploration, save/load, resuming, a tiny learning run, the CLI."""
+differences, acting and exploration, replay, a tiny learning run (save/load, resuming and the CLI: test_algorithms)."""
 
-import csv
 import dataclasses
-import json
 
 import gymnasium
 import numpy as np
 import pytest
 import torch
+from conftest import HYBRID, OFF_POLICY_SMALL, progress_rows
 from numeric import finite_difference
 
-import pamdp
 from pamdp import PDQN
-from pamdp.algos import load_model
 from pamdp.algos.offpolicy import OUNoise, backprop_actor, invert_gradients
 from pamdp.algos.pdqn import ParamActor, PDQNConfig, QNetwork, param_blocks
-from pamdp.cli import main
-from pamdp.spaces import HybridActionSpace
 
-SMALL = PDQNConfig(
-    hidden_sizes=(16,),
-    num_envs=4,
-    epoch_steps=200,
-    learning_starts=100,
-    batch_size=16,
-    buffer_size=5_000,
-    epsilon_steps=300,
-)
-# Three actions with 1, 2 and 1 parameters: the flat vector is [x_0 | x_1, x_1' | x_2], 4 values.
-HYBRID = HybridActionSpace(
-    (np.array([-1.0]), np.array([0.0, 0.0]), np.array([-2.0])), (np.array([1.0]), np.array([1.0, 3.0]), np.array([2.0]))
-)
+SMALL = PDQNConfig(hidden_sizes=(16,), epsilon_steps=300, **OFF_POLICY_SMALL)
+# HYBRID's three actions have 1, 2 and 1 parameters: the flat vector is [x_0 | x_1, x_1' | x_2], 4 values.
 BLOCKS = [slice(0, 1), slice(1, 3), slice(3, 4)]
 
 
@@ -184,25 +168,6 @@ def test_ou_noise_restarts_per_episode_and_is_gaussian_at_theta_one():
     assert state[0, 0] == pytest.approx(0.3 * np.random.default_rng(1).standard_normal())
 
 
-@pytest.mark.parametrize(
-    "kwargs, match",
-    [
-        ({"bound": "clip"}, "bound = 'clip'"),
-        ({"tau_q": 0.0}, "tau_q = 0.0"),
-        ({"tau_actor": 1.5}, "tau_actor = 1.5"),
-        ({"epsilon_end": 1.5}, "epsilon_end = 1.5"),
-        ({"updates_per_step": 0.0}, "updates_per_step = 0.0"),
-        ({"beta": -0.1}, "beta = -0.1"),
-        ({"ou_theta": 0.0}, "ou_theta = 0.0"),
-        ({"hidden_sizes": ()}, "hidden_sizes = \\(\\)"),
-        ({"activation": "gelu"}, "activation = 'gelu'"),
-    ],
-)
-def test_bad_settings_raise_errors_naming_the_value(kwargs, match):
-    with pytest.raises(ValueError, match=match):
-        PDQNConfig(**kwargs)
-
-
 def test_bad_types_from_plain_data_are_named():
     with pytest.raises(ValueError, match="'multi_pass' = 'yes'"):
         PDQNConfig.from_dict({"multi_pass": "yes"})
@@ -220,80 +185,12 @@ def test_replay_holds_what_q_saw_and_monte_carlo_returns():
     assert np.isfinite(d["mc"]).mean() > 0.9
 
 
-def flat_params(model):
-    return torch.cat([p.detach().flatten() for m in (model.actor, model.q_net) for p in m.parameters()])
-
-
-def test_same_seed_gives_identical_first_epochs():
-    runs = []
-    for seed in (0, 0, 1):
-        model = PDQN("pamdp/Platform-v0", dataclasses.replace(SMALL, seed=seed, multi_pass=True))
-        model.learn(200, progress_bar=False)
-        runs.append(flat_params(model))
-    torch.testing.assert_close(runs[0], runs[1], rtol=0, atol=0)
-    assert not torch.equal(runs[0], runs[2])
-
-
-@pytest.mark.parametrize("multi_pass", [False, True])
-def test_save_load_predict_round_trip(tmp_path, multi_pass):
-    model = PDQN("pamdp/Platform-v0", dataclasses.replace(SMALL, multi_pass=multi_pass))
-    model.learn(400, progress_bar=False)
-    model.save(tmp_path / "m.pt")
-    saved_rng = model.np_rng.bit_generator.state
-    for loaded in (PDQN.load(tmp_path / "m.pt"), load_model(tmp_path / "m.pt")):
-        model.np_rng.bit_generator.state = saved_rng  # the stochastic predictions below draw from it
-        assert isinstance(loaded, PDQN) and loaded.q_net.multi_pass == multi_pass
-        assert loaded.config == model.config and loaded.num_timesteps == model.num_timesteps
-        obs = np.random.default_rng(0).uniform(0, 1, size=(32, 9))
-        for deterministic in (True, False):
-            a1, p1 = model.predict(obs, deterministic=deterministic)
-            a2, p2 = loaded.predict(obs, deterministic=deterministic)
-            np.testing.assert_array_equal(a1, a2)
-            for x, y in zip(p1, p2):
-                np.testing.assert_array_equal(x, y)
-        for name, module in model._modules().items():
-            for p, q in zip(module.state_dict().values(), loaded._modules()[name].state_dict().values()):
-                assert torch.equal(p, q), name
-
-
-def _rows(run_dir):
-    with open(run_dir / "progress.csv", newline="") as f:
-        return list(csv.DictReader(f))
-
-
-def test_resume_from_a_checkpoint(tmp_path):
-    cfg = dataclasses.replace(SMALL, save_replay=True, multi_pass=True, updates_per_step=0.5)
-    model = PDQN("pamdp/Platform-v0", cfg)
-    model.learn(600, progress_bar=False, run_dir=tmp_path)
-    resumed = PDQN.load(tmp_path / "checkpoint.pt")
-    assert (resumed.num_timesteps, resumed.epoch) == (model.num_timesteps, model.epoch)
-    assert len(resumed.replay) == len(model.replay) and resumed.loop.update_credit == model.loop.update_credit
-    n = len(model.replay)
-    assert torch.equal(resumed.replay.data["params"][:n], model.replay.data["params"][:n])
-    steps = resumed.q_optimizer.state_dict()["state"][0]["step"]
-    assert steps == model.q_optimizer.state_dict()["state"][0]["step"] > 0
-
-    stats = []
-    resumed.learn(400, progress_bar=False, run_dir=tmp_path, callback=lambda m, s: stats.append(s))
-    assert stats[0]["train/updates"] > 0  # the replay came back, so no wait for learning_starts
-    rows = _rows(tmp_path)
-    assert [float(r["time/epoch"]) for r in rows] == [1.0, 2.0, 3.0, 4.0, 5.0]
-    assert float(rows[-1]["time/total_timesteps"]) == resumed.num_timesteps >= 1000
-
-    fresh = PDQN.load(tmp_path / "checkpoint.pt", env="pamdp/Platform-v0")
-    assert fresh.num_timesteps == resumed.num_timesteps
-    no_replay = PDQN("pamdp/Platform-v0", SMALL)
-    no_replay.learn(200, progress_bar=False)
-    no_replay.save(tmp_path / "n.pt")
-    assert len(PDQN.load(tmp_path / "n.pt").replay) == 0  # without save_replay it refills
-
-
 @pytest.mark.parametrize("multi_pass", [False, True])
 def test_tiny_learning_run_logs(tmp_path, multi_pass):
     cfg = dataclasses.replace(SMALL, multi_pass=multi_pass, epoch_steps=500, epsilon_steps=1000, updates_per_step=0.25)
     model = PDQN("pamdp/Platform-v0", cfg)
     model.learn(2000, progress_bar=False, run_dir=tmp_path)
-    rows = _rows(tmp_path)
+    rows = progress_rows(tmp_path)
     assert len(rows) == 4 and (tmp_path / "tb").is_dir() and (tmp_path / "checkpoint.pt").is_file()
     last = rows[-1]
     keys = ("losses/critic_loss", "losses/actor_loss", "train/q_mean", "train/epsilon", "train/updates")
@@ -302,22 +199,3 @@ def test_tiny_learning_run_logs(tmp_path, multi_pass):
         assert np.isfinite(float(last[key])), key
     assert float(last["train/epsilon"]) == pytest.approx(cfg.epsilon_end)
     assert 0.0 <= float(last["charts/episodic_return"]) <= 1.0
-
-
-def test_cli_trains_mp_dqn_resumes_and_evaluates(tmp_path, capsys):
-    out = tmp_path / "run"
-    tiny = ["--hidden-sizes", "16", "--num-envs", "4", "--epoch-steps", "200", "--learning-starts", "100"]
-    tiny += ["--batch-size", "16", "--buffer-size", "5000", "--no-progress", "--multi-pass", "true"]
-    assert main(["train", "pdqn", "--total-steps", "200", "--out", str(out), "--eval-episodes", "20", *tiny]) == 0
-    assert "greedy return over 20 episodes" in capsys.readouterr().out
-    run = json.loads((out / "run.json").read_text())
-    assert run["config"]["multi_pass"] is True and run["preset"] == "tuned"
-    assert PDQN.load(out).q_net.multi_pass
-    assert main(["train", "pdqn", "--total-steps", "400", "--out", str(out), "--eval-episodes", "0", *tiny]) == 0
-    assert "resuming" in capsys.readouterr().err
-    assert main(["evaluate", str(out), "--episodes", "10", "--json"]) == 0
-    assert json.loads(capsys.readouterr().out)["episodes"] == 10
-
-
-def test_top_level_import():
-    assert pamdp.PDQN is PDQN
