@@ -20,8 +20,7 @@ import torch
 from conftest import ENV, module_bytes, progress_rows, small_settings
 
 import pamdp
-from pamdp.algos import ALGORITHMS, algorithm_class
-from pamdp.algos import load_model
+from pamdp.algos import ALGORITHMS, algorithm_class, load_model
 from pamdp.algos.checkpoints import CHECKPOINT, read_checkpoint
 from pamdp.cli import main
 
