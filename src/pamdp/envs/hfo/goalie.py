@@ -724,7 +724,7 @@ def _long_step(g, n, bx, by, c, infos, count):
     for _ in range(turns):
         st, ef, rc = stamina_wait(st, ef, rc)
     first_power = 0.0
-    success = False
+    success = overtaken = False
     for k in range(dashes):
         power = min(100.0, max(0.0, st - RECOVER_DEC_THR) * (0.5 if backward else 1.0))
         if k == 0:
@@ -734,7 +734,7 @@ def _long_step(g, n, bx, by, c, infos, count):
         vx, vy = vx * PLAYER_DECAY, vy * PLAYER_DECAY
         st, ef, rc = stamina_dash(st, ef, rc, -power if backward else power)
         if ox * (1.0 - 0.01 * PLAYER_RAND) + 0.1 > target:
-            success = True
+            success = overtaken = True
             break
     if not success:
         travel = math.hypot(ox, oy)
@@ -745,8 +745,8 @@ def _long_step(g, n, bx, by, c, infos, count):
     dx, dy = polar(ox, a)
     sx, sy = polar(oy, a + 90.0)
     ex, ey = g[G_PX] + dx + sx, g[G_PY] + dy + sy
-    if math.hypot(ex - bx, ey - by) > 0.1:
-        ix, iy = self_at(g, n)
+    ix, iy = self_at(g, n)
+    if overtaken and math.hypot(ex - ix, ey - iy) > 0.1:
         lx, ly = ex - ix, ey - iy
         ll = lx * lx + ly * ly
         if ll > 0.0:
