@@ -557,7 +557,11 @@ def _short_turn_dash(g, n, bx, by, c, backward, buffer, best, s_b):
     for _ in range(turns):
         st, ef, rc = stamina_wait(st, ef, rc)
     if math.hypot(ix - bx, iy - by) < c - 0.15:
-        _fill(cand, 0.0, turns, dashes, 0.0, 0.0, ix, iy, math.hypot(ix - bx, iy - by), st)
+        # No dash needed: the goalie waits all n cycles (the recording needs the stamina of n waits here).
+        wait_st, wait_ef, wait_rc = st, ef, rc
+        for _ in range(dashes):
+            wait_st, wait_ef, wait_rc = stamina_wait(wait_st, wait_ef, wait_rc)
+        _fill(cand, 0.0, turns, dashes, 0.0, 0.0, ix, iy, math.hypot(ix - bx, iy - by), wait_st)
         _offer(best, cand, s_b)
     if abs(nrm(th(bx - ix, by - iy) - a)) > 90.0:
         return
@@ -1288,7 +1292,7 @@ def _intercept(g, infos, count, save):
             if reach > 2:
                 rx, ry = g[G_BX] - ix, g[G_BY] - iy
                 fx, fy = ix - ry, iy + rx
-                if ix + ry < fx:
+                if ix + ry > fx:
                     fx, fy = ix + ry, iy - rx
             else:
                 fx, fy = 50.5, 0.9 * g[G_PY]
@@ -1598,6 +1602,17 @@ def _six_digits(x):
 
 
 @jit
+def _forced_kickable(g):
+    """librcsc also treats a ball just inside the kickable area (beyond its 0.055 buffer) as kickable when
+    nobody else would get it soon, or when it is about to leave the field."""
+    n_self, n_opp = g[G_N_SELF], g[G_N_OPP]
+    if n_self >= 10 or (n_opp < n_self - 7 and n_opp < 1000 - 7):
+        return True
+    bx, by = ball_at(g, min(n_self, n_opp))
+    return abs(bx) > -GOAL_X or abs(by) > PITCH_HALF_WIDTH
+
+
+@jit
 def decide(world, memory):
     """The goalie's body command for one cycle, decided on ``world`` (``W_*`` layout, server frame).
 
@@ -1617,6 +1632,8 @@ def decide(world, memory):
     else:
         count = self_intercept(g, min(30, length), infos)
         g[G_N_SELF] = infos[0, I_TURNS] + infos[0, I_DASHES] if count and not infos[0, I_EXHAUST] else 1000
+    if not g[G_SELF_KICKABLE] and g[G_DB] < KICKABLE_AREA - 0.001 and _forced_kickable(g):
+        g[G_SELF_KICKABLE] = 1.0
     memory[M_PREV_BX], memory[M_PREV_BY] = g[G_BX], g[G_BY]
     memory[M_PREV_UX], memory[M_PREV_UY] = g[G_UX], g[G_UY]
     memory[M_PREV_VALID] = 1.0
