@@ -1,9 +1,11 @@
 """Command replay of the goalie against a recording of the real HFO server.
 
-``tests/data/hfo_goalie_trace_seed42.json.gz`` is a stripped copy of the seed-42 goalie recording
-(``shared/specs/hfo_goalie_traces/``): per server cycle the true state of ball, agent and goalie (logged to
-1e-4 m and 1e-3 degrees) and the body commands both sides sent in that cycle. The goalie sends the command
-logged at cycle c after deciding on the state logged at cycle c, so each recorded command is compared with
+``tests/data/hfo_goalie_trace_seed42.json.gz`` is a stripped copy of a recording of the real server with its
+goalie (LARG/HFO b8b2a1d, mhauskn/rcssserver 82212ee, mhauskn/librcsc d222758; ``--offense-agents 1
+--defense-npcs 1 --deterministic --fullstate --seed 42``): per server cycle the true state of ball, agent and
+goalie (logged to 1e-4 m and 1e-3 degrees), the body commands both sides sent in that cycle, and the cycles
+in which the referee reset the field. The goalie sends the command logged at cycle c after deciding on the
+state logged at cycle c, so each recorded command is compared with
 :func:`pamdp.envs.hfo.goalie.decide` on that state. The goalie's memory is carried through the whole
 recording in cycle order, as the real client carries it across episodes; at each reset the referee's
 play_on ends goalie-catch mode.

@@ -1,0 +1,239 @@
+"""HFO's goalie (``pamdp.envs.hfo.goalie``): hand-worked examples and a command replay of the real server.
+
+The examples are those worked by hand in section 5 of the goalie specification (positions in the goalie's
+frame G there; :func:`world` converts to the server frame the decision takes). The replay feeds every
+recorded cycle of the seed-42 recording into the decision and compares with the command the real goalie
+sent (``tests/hfo_goalie_replay.py``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hfo_goalie_replay import load, rates, replay
+
+import pamdp.envs.hfo.goalie as gl
+
+
+def world(ball=(-40.0, 0.0), u=(0.0, 0.0), agent=(-20.0, 0.0), agent_body=180.0, agent_v=(0.0, 0.0),
+          goalie=(-50.0, 0.0), theta=0.0, v=(0.0, 0.0), stamina=8000.0, cycle=100):  # fmt: skip
+    """A ``world`` vector from goalie-frame (G) quantities: positions and velocities negated, angles + 180."""
+    return gl.world_from_fields(
+        ball=(-ball[0], -ball[1], -u[0], -u[1]),
+        agent=(-agent[0], -agent[1], -agent_v[0], -agent_v[1]),
+        agent_body=agent_body + 180.0,
+        goalie=(-goalie[0], -goalie[1], -v[0], -v[1]),
+        goalie_body=theta + 180.0,
+        stamina=stamina,
+        effort=1.0,
+        recovery=1.0,
+        cycle=cycle,
+    )
+
+
+def model(w, memory=None):
+    """The goalie's per-cycle world model with both reach cycles filled in, and its interception list."""
+    memory = gl.new_memory() if memory is None else memory
+    g = gl._world_model(w, memory)
+    gl._update_last_kicker(g, w, memory)
+    cache = np.empty((gl.MAX_CACHE, 2))
+    length = gl.ball_cache(g, cache)
+    g[gl.G_N_OPP] = gl.opponent_reach(g, cache, length)
+    infos = np.empty((gl.MAX_INFOS, gl.INFO_SIZE))
+    count = gl.self_intercept(g, min(30, length), infos)
+    g[gl.G_N_SELF] = infos[0, gl.I_TURNS] + infos[0, gl.I_DASHES]
+    return g, infos[:count]
+
+
+# --- 5.1 Tables ---------------------------------------------------------------------------------------
+def test_dash_distance_table():
+    expected = [0.6, 1.44, 2.376, 3.3504, 4.3402, 5.3361, 6.3344, 7.3338, 8.3335, 9.3334]
+    np.testing.assert_allclose(gl.DASH_DISTANCE[1:11], expected, atol=1e-4)
+
+
+@pytest.mark.parametrize(
+    "d, n", [(0.5, 1), (0.601, 1), (1.44, 2), (2.0, 3), (7.415, 9), (8.85, 10), (20.0, 21), (60.0, 61)]
+)
+def test_dash_cycles(d, n):
+    assert gl.dash_cycles(d) == n
+
+
+@pytest.mark.parametrize("x, p", [(1.1, 0.9723), (1.3, 0.9246), (1.5, 0.8220), (1.53, 0.7996)])
+def test_tackle_probability_straight_ahead(x, p):
+    g = gl._world_model(world(ball=(-50.0 + x, 0.0)), gl.new_memory())
+    assert gl.tackle_probability(g, gl.TACKLE_EXPONENT) == pytest.approx(p, abs=1e-4)
+
+
+def test_tackle_thresholds():
+    """Probability 0.8 at x = 2 * 0.2**(1/6) for a tackle, at 1.7027 for a foul."""
+    g = gl._world_model(world(ball=(-50.0 + 2.0 * 0.2 ** (1 / 6), 0.0)), gl.new_memory())
+    assert gl.tackle_probability(g, gl.TACKLE_EXPONENT) == pytest.approx(0.8)
+    g = gl._world_model(world(ball=(-50.0 + 1.7027, 0.0)), gl.new_memory())
+    assert gl.tackle_probability(g, gl.FOUL_EXPONENT) == pytest.approx(0.8, abs=1e-4)
+
+
+@pytest.mark.parametrize("db, dq, r", [(5.0, 5.0, 1.285), (8.0, 9.0, 1.425), (12.5, 13.0, 1.585)])
+def test_opponent_kickable_radius(db, dq, r):
+    assert gl.opponent_kickable_radius(db, dq) == pytest.approx(r)
+
+
+# --- 5.2 Target points --------------------------------------------------------------------------------
+@pytest.mark.parametrize(
+    "ball, u, agent, target",
+    [
+        ((-5.0, 20.0), (0.0, 0.0), (0.0, 0.0), (-49.8, 3.5596)),
+        ((-45.0, 20.0), (0.0, 0.0), (0.0, 0.0), (-51.5, 7.011)),
+        ((-45.0, -10.5), (0.0, 0.0), (0.0, 0.0), (-49.8, -6.91)),
+        ((-48.0, 9.5), (0.0, 0.0), (0.0, 0.0), (-49.8, 6.91)),
+        ((-20.0, 0.0), (0.0, 0.0), (-19.5, 0.0), (-49.8, 0.0)),  # the agent has the ball
+    ],
+)
+def test_target_point(ball, u, agent, target):
+    g, _ = model(world(ball=ball, u=u, agent=agent))
+    np.testing.assert_allclose(gl.target_point(g), target, atol=1e-4)
+
+
+@pytest.mark.parametrize("n_opp, target_y", [(3, -1.5249), (12, -1.0442)])
+def test_target_point_moving_ball(n_opp, target_y):
+    """The ball is extrapolated to the agent's reach cycle, then again by up to 5 cycles of its current velocity."""
+    g, _ = model(world(ball=(-30.0, -5.0), u=(-1.5, 0.3)))
+    g[gl.G_N_OPP] = n_opp
+    np.testing.assert_allclose(gl.target_point(g), (-49.8, target_y), atol=1e-4)
+
+
+# --- 5.3 Catch ----------------------------------------------------------------------------------------
+def test_catch():
+    w = world(ball=(-49.0, 0.7), goalie=(-50.0, 0.0))
+    memory = gl.new_memory()
+    kind, direction, _ = gl.decide(w, memory)
+    assert kind == gl.CATCH
+    assert direction == pytest.approx(57.6119, abs=1e-4)
+    assert memory[gl.M_LAST_CATCH] == w[gl.W_CYCLE] + 1
+    assert memory[gl.M_CATCH_MODE] == 1.0
+
+
+def test_no_catch_from_1_28_m():
+    """A ball 1.2807 m away is not tried (the goalie keeps 0.05 inside the 1.3 m the server would accept)."""
+    assert gl.decide(world(ball=(-49.0, 0.8), goalie=(-50.0, 0.0)), gl.new_memory())[0] != gl.CATCH
+
+
+def test_catch_waits_after_a_catch():
+    """After a catch decided at t, the next one is possible at t + 7 (the client stamps it at t + 1)."""
+    memory = gl.new_memory()
+    assert gl.decide(world(ball=(-49.0, 0.7), cycle=100), memory)[0] == gl.CATCH
+    gl.start_episode(memory)
+    assert gl.decide(world(ball=(-49.0, 0.7), cycle=106), memory)[0] != gl.CATCH
+    assert gl.decide(world(ball=(-49.0, 0.7), cycle=107), memory)[0] == gl.CATCH
+
+
+# --- 5.4 First commands after a reset -------------------------------------------------------------------
+def test_first_commands_after_reset():
+    w = world(ball=(-5.0, 20.0), agent=(0.0, 0.0), goalie=(-52.5, 0.0), theta=0.0)
+    assert gl.decide(w, gl.new_memory()) == (gl.TURN, 52.819, 0.0)
+    w = world(ball=(-5.0, 20.0), agent=(0.0, 0.0), goalie=(-52.5, 0.0), theta=52.819)
+    assert gl.decide(w, gl.new_memory()) == (gl.DASH, 45.0, 0.0)
+    w = world(
+        ball=(-5.0, 20.0), agent=(0.0, 0.0), goalie=(-52.33683, 0.21512), v=(0.065268, 0.086047), theta=52.819,
+        stamina=8000.0 - 45.0 + 45.0,
+    )  # fmt: skip
+    assert gl.decide(w, gl.new_memory()) == (gl.DASH, 45.0, 0.0)
+
+
+def test_first_commands_recorded():
+    """The recording's own counterpart: goalie at S(52.5, 0) with body 180, ball S(3.9327, 16.1319) at rest."""
+    w = world(ball=(-3.9327, -16.1319), agent=(10.0, 20.0), goalie=(-52.5, 0.0), theta=0.0)
+    assert gl.decide(w, gl.new_memory()) == (gl.TURN, -46.205, 0.0)
+
+
+# --- 5.5 Opponent reach -----------------------------------------------------------------------------------
+@pytest.mark.parametrize("ball, agent, n_opp", [((-10.0, 0.0), (0.0, 0.0), 9), ((-40.0, 0.0), (-20.0, 0.0), 19)])
+def test_opponent_reach_resting_ball(ball, agent, n_opp):
+    g, _ = model(world(ball=ball, agent=agent, agent_body=180.0, goalie=(-50.0, 0.0)))
+    assert g[gl.G_N_OPP] == n_opp
+
+
+# --- 5.6 Self reach, chase and intercept ----------------------------------------------------------------
+def test_self_reach_and_intercept_resting_ball():
+    w = world(ball=(-40.0, 0.0), agent=(-20.0, 0.0), goalie=(-50.0, 0.0))
+    g, infos = model(w)
+    assert len(infos) == 1
+    assert tuple(infos[0, [gl.I_EXHAUST, gl.I_TURNS, gl.I_DASHES, gl.I_POWER]]) == (0.0, 0.0, 10.0, 100.0)
+    assert g[gl.G_N_SELF] == 10 and g[gl.G_N_OPP] == 19
+    assert gl._is_chase_situation(g)
+    assert gl.decide(w, gl.new_memory()) == (gl.DASH, 100.0, 0.0)
+
+
+# --- 5.7 Stop dash ----------------------------------------------------------------------------------------
+def test_stop_dash():
+    g = gl._world_model(world(v=(0.4, 0.0)), gl.new_memory())
+    issued, kind, power, direction = gl._stop_dash(g, True)
+    assert issued and kind == gl.DASH and direction == 0.0
+    assert power == pytest.approx(-66.667, abs=1e-3)
+
+
+# --- 5.8 Go to catch point -------------------------------------------------------------------------------
+@pytest.mark.parametrize(
+    "point, theta, kind, arg",
+    [
+        ((-47.0, 3.0), 35.0, gl.DASH, 100.0),
+        ((-53.0, 0.5), 0.0, gl.DASH, -100.0),
+        ((-48.0, -3.0), 10.0, gl.TURN, -66.31),
+    ],
+)
+def test_go_to_catch_point(point, theta, kind, arg):
+    g = gl._world_model(world(goalie=(-50.0, 0.0), theta=theta), gl.new_memory())
+    issued, k, a1, _ = gl._go_to_catch_point(g, *point)
+    assert issued and k == kind
+    assert a1 == pytest.approx(arg, abs=5e-3)
+
+
+# --- 5.9 Basic dash power ---------------------------------------------------------------------------------
+@pytest.mark.parametrize(
+    "ball, stamina, n_opp, goalie_y, power",
+    [
+        ((-20.0, 0.0), 8000.0, 10, 0.0, 45.0),
+        ((-20.0, 0.0), 7000.0, 10, 0.0, 22.5),
+        ((-33.0, 5.0), 8000.0, 2, 0.0, 100.0),
+        ((-33.0, 5.0), 8000.0, 8, 0.0, 60.0),
+        ((-33.0, 21.0), 8000.0, 8, 0.0, 45.0),
+        ((-40.0, 16.0), 8000.0, 8, 3.0, 45.0),
+        ((-40.0, 16.0), 8000.0, 8, -2.0, 100.0),
+        ((-40.0, 10.0), 8000.0, 8, 0.0, 100.0),
+    ],
+)
+def test_basic_dash_power(ball, stamina, n_opp, goalie_y, power):
+    g = gl._world_model(world(ball=ball, goalie=(-50.0, goalie_y), stamina=stamina), gl.new_memory())
+    g[gl.G_N_OPP] = n_opp
+    assert gl.basic_dash_power(g, -49.8) == pytest.approx(power)
+    assert gl.basic_dash_power(g, -45.0) == 100.0  # more than 3 m off the target's x
+
+
+# --- Memory ----------------------------------------------------------------------------------------------
+def test_last_kicker_follows_the_agents_kick():
+    """A ball whose velocity jumps within 6 m of an agent that just kicked was kicked by the agent (while the
+    agent may still kick it, the goalie treats the ball as at rest and sees no jump: hence 2.5 m here)."""
+    memory = gl.new_memory()
+    gl.decide(world(ball=(-20.0, 0.0), agent=(-19.5, 0.5)), memory)
+    assert memory[gl.M_LAST_KICKER] == gl.NEUTRAL
+    w = world(ball=(-21.0, 0.0), u=(-2.0, 0.0), agent=(-18.5, 0.5))
+    w[gl.W_AGENT_KICKED] = 1.0
+    gl.decide(w, memory)
+    assert memory[gl.M_LAST_KICKER] == gl.AGENT_SIDE
+
+
+def test_frozen_goalie_sends_nothing():
+    w = world()
+    w[gl.W_GOALIE_FREEZE] = 3.0
+    assert gl.decide(w, gl.new_memory())[0] == gl.NONE
+
+
+# --- Replay of the real server ----------------------------------------------------------------------------
+#: Matching recorded commands (kind equal, arguments within the recording's rounding), overall and per kind;
+#: floors at the rates reached, so that a change cannot lower them unnoticed.
+REPLAY_FLOOR = {"all": 2054, "turn": 1602, "turn 0": 1492, "dash": 434, "catch": 18}
+
+
+def test_command_replay():
+    result = rates(replay(load()))
+    for name, floor in REPLAY_FLOOR.items():
+        assert result[name][0] >= floor, (name, result[name])
