@@ -8,6 +8,8 @@ sent (``tests/hfo_goalie_replay.py``).
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 from hfo_goalie_replay import load, rates, replay
@@ -225,6 +227,62 @@ def test_frozen_goalie_sends_nothing():
     w = world()
     w[gl.W_GOALIE_FREEZE] = 3.0
     assert gl.decide(w, gl.new_memory())[0] == gl.NONE
+
+
+# --- Branches the recording does not reach ------------------------------------------------------------------
+def test_tackle_on_a_kickable_agent_outside_the_box():
+    """Outside its box the goalie cannot catch; with the ball 1.3 m ahead and the agent on it, it tackles, in a
+    direction on the 9-degree grid that sends the ball away from its goal. Outside the box the foul variant
+    (success 1 - 0.65**10 = 0.987 against 0.925) is chosen, as the agent may kick the ball."""
+    w = world(ball=(-28.7, 0.0), agent=(-28.0, 0.6), goalie=(-30.0, 0.0), theta=0.0)
+    kind, direction, foul = gl.decide(w, gl.new_memory())
+    assert kind == gl.TACKLE and foul == 1.0
+    assert direction % 9.0 == 0.0
+    power = 100.0 * (1.0 - abs(direction) / 180.0) * gl.KICK_POWER_RATE
+    assert math.cos(math.radians(direction)) * power > 0.0
+
+
+def test_no_tackle_when_the_agent_is_far():
+    """The same ball without the agent near it: no need to tackle (the goalie goes for it instead)."""
+    w = world(ball=(-28.7, 0.0), agent=(-10.0, 0.0), goalie=(-30.0, 0.0), theta=0.0)
+    assert gl.decide(w, gl.new_memory())[0] != gl.TACKLE
+
+
+def test_random_states_give_legal_commands():
+    """Random states over the goalie's half (moving ball, moving goalie, low stamina, either last kicker, either
+    play mode): every command is legal, as the server would receive it, and the interceptions are sorted."""
+    rng = np.random.default_rng(0)
+    kinds = set()
+    for _ in range(3000):
+        speed, heading = rng.uniform(0, 3.0), rng.uniform(-180, 180)
+        u = (speed * math.cos(math.radians(heading)), speed * math.sin(math.radians(heading)))
+        gs, gh = rng.uniform(0, 0.4), rng.uniform(-180, 180)
+        v = (gs * math.cos(math.radians(gh)), gs * math.sin(math.radians(gh)))
+        goalie = (rng.uniform(-52.5, -30.0), rng.uniform(-20.0, 20.0))
+        near = rng.random() < 0.5
+        ball = (goalie[0] + rng.uniform(-3, 5), goalie[1] + rng.uniform(-4, 4)) if near else (
+            rng.uniform(-52.0, 0.0), rng.uniform(-34.0, 34.0))  # fmt: skip
+        agent = (ball[0] + rng.uniform(-3, 3), ball[1] + rng.uniform(-3, 3))
+        w = world(ball=ball, u=u, agent=agent, agent_body=rng.uniform(-180, 180), goalie=goalie,
+                  theta=rng.uniform(-180, 180), v=v, stamina=rng.uniform(1000.0, 8000.0))  # fmt: skip
+        memory = gl.new_memory()
+        memory[gl.M_LAST_KICKER] = rng.choice([gl.NEUTRAL, gl.GOALIE_SIDE, gl.AGENT_SIDE])
+        memory[gl.M_CATCH_MODE] = rng.random() < 0.2
+        _, infos = model(w, memory.copy())
+        reach = infos[:, gl.I_TURNS] + infos[:, gl.I_DASHES]
+        assert len(infos) > 0 and np.all(np.diff(reach) >= 0)
+        kind, a1, a2 = gl.decide(w, memory)
+        kinds.add(kind)
+        if kind == gl.KICK:
+            continue
+        assert math.isfinite(a1) and math.isfinite(a2)
+        if kind == gl.TURN:
+            assert abs(a1) <= 180.0 and a1 == round(a1, 3)
+        elif kind == gl.DASH:
+            assert abs(a1) <= 100.0 and a2 % 45.0 == 0.0 and a1 == round(a1, 3)
+        elif kind in (gl.CATCH, gl.TACKLE):
+            assert -180.0 <= a1 <= 180.0
+    assert {gl.TURN, gl.DASH, gl.CATCH, gl.TACKLE} <= kinds
 
 
 # --- Replay of the real server ----------------------------------------------------------------------------
