@@ -12,9 +12,10 @@ import math
 
 import numpy as np
 import pytest
-from hfo_goalie_replay import load, rates, replay
+from hfo_goalie_replay import load, rates, recorded_command, replay
 
 import pamdp.envs.hfo.goalie as gl
+import pamdp.envs.hfo.two_player as tp
 
 
 def world(ball=(-40.0, 0.0), u=(0.0, 0.0), agent=(-20.0, 0.0), agent_body=180.0, agent_v=(0.0, 0.0),
@@ -283,6 +284,48 @@ def test_random_states_give_legal_commands():
         elif kind in (gl.CATCH, gl.TACKLE):
             assert -180.0 <= a1 <= 180.0
     assert {gl.TURN, gl.DASH, gl.CATCH, gl.TACKLE} <= kinds
+
+
+# --- The server's catch (two_player) --------------------------------------------------------------------
+def test_server_catch_worked_example():
+    """5.3 on the server, in its frame: goalie S(50, 0) body 180, ball S(49, -0.7) at rest, ``(catch 57.6119)``:
+    the goalie jumps to S(49.31540, -0.47922) facing the ball; the double-precision squared distance lands
+    below 0.385**2, so the pair collides at once."""
+    ok, ban, gx, gy, body, bx, by, bvx, bvy, collided = tp.catch(50.0, 0.0, 180.0, 57.6119, 0, 49.0, -0.7, 0.0, 0.0)
+    assert ok and ban == tp.CATCH_BAN_CYCLE and collided
+    assert (gx, gy) == pytest.approx((49.31540, -0.47922), abs=1e-5)
+    assert body == pytest.approx(-145.008, abs=5e-4)
+    assert math.hypot(bx - gx, by - gy) > tp.BALL_SIZE + tp.PLAYER_SIZE
+
+
+def test_server_catch_rectangle_and_ban():
+    """Inside the 1.2 x 1.0 rectangle (inclusive) the catch works unless banned; outside it fails but still bans."""
+    assert tp.catchable(0.0, 0.0, 0.0, 0.0, 1.2, 0.5) and not tp.catchable(0.0, 0.0, 0.0, 0.0, 1.21, 0.0)
+    assert not tp.catchable(0.0, 0.0, 0.0, 0.0, -0.01, 0.0)
+    assert tp.catch(0.0, 0.0, 0.0, 0.0, 3, 1.0, 0.0, 0.0, 0.0)[:2] == (False, 3)
+    assert tp.catch(0.0, 0.0, 0.0, 0.0, 0, 1.3, 0.0, 0.0, 0.0)[:2] == (False, tp.CATCH_BAN_CYCLE)
+
+
+def test_server_catch_recorded():
+    """Every recorded catch: the goalie's body after it faces the ball (to the 1e-3 degree logging, plus the
+    rounding of the logged positions), and after a catch in live play the goalie stands where the jump put it,
+    except once, where the ball's own movement then pushed it off by 0.18 m (an ordinary collision)."""
+    trace = load()
+    fields, resets = trace["rcg_states_fields"], set(trace["reset_cycles"])
+    jumps = []
+    for c in sorted(int(k) for k in trace["rcl_commands"]):
+        cmd = recorded_command(trace["rcl_commands"][str(c)][1])
+        if cmd is None or cmd[0] != gl.CATCH:
+            continue
+        now = dict(zip(fields, trace["rcg_states"][str(c)]))
+        after = dict(zip(fields, trace["rcg_states"][str(c + 1)]))
+        result = tp.catch(now["goalie_x"], now["goalie_y"], now["goalie_body_deg"], cmd[1], 0,
+                          now["ball_x"], now["ball_y"], now["ball_vx"], now["ball_vy"])  # fmt: skip
+        assert result[0]
+        assert abs(gl.nrm(result[4] - after["goalie_body_deg"])) < 0.011
+        if c + 1 not in resets:
+            jumps.append(math.hypot(result[2] - after["goalie_x"], result[3] - after["goalie_y"]))
+    assert len(jumps) == 6 and sum(j < 2e-4 for j in jumps) == 5
 
 
 # --- Replay of the real server ----------------------------------------------------------------------------

@@ -1,0 +1,74 @@
+"""Server rules that need the goalie on the pitch: the goalie's catch, and the ball-player collision after it.
+
+rcssserver (the HFO fork, mhauskn/rcssserver) applies a goalie's ``(catch dir)`` when the command arrives,
+before the cycle's movement. In HFO mode the server's catch referee is off, so the goalie may catch anywhere
+and no free kick follows: a successful catch only teleports the goalie next to the ball, facing it, at rest;
+the ball keeps its velocity. The server then resolves collisions at once, and whether the ball and the goalie
+overlap after the jump is decided by the last bits of the arithmetic (the jump lands them exactly touching).
+
+All in the server frame (metres, degrees). Pure functions of scalars, compiled by Numba, so that an
+environment can call them per copy.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+
+jit = numba.njit(cache=True, nogil=True, error_model="numpy")
+
+#: The catch rectangle: 1.2 m along the catch direction, 1.0 m wide (player type 0: no stretch).
+CATCHABLE_AREA_L = 1.2
+CATCHABLE_AREA_W = 1.0
+CATCH_BAN_CYCLE = 5
+PLAYER_SIZE = 0.3
+BALL_SIZE = 0.085
+#: Every object of a collision has its velocity multiplied by this once.
+COLLISION_VELOCITY_FACTOR = -0.1
+#: Added to each half of a resolved contact so that the pair ends strictly apart.
+SEPARATION_EPSILON = 1e-10
+
+
+@jit
+def catchable(goalie_x, goalie_y, body, direction, ball_x, ball_y):
+    """Whether the ball lies in the catch rectangle of a catch ``direction`` degrees off the body (inclusive)."""
+    kappa = math.radians(body + min(max(direction, -180.0), 180.0))
+    dx, dy = ball_x - goalie_x, ball_y - goalie_y
+    x = dx * math.cos(kappa) + dy * math.sin(kappa)
+    y = -dx * math.sin(kappa) + dy * math.cos(kappa)
+    return 0.0 <= x <= CATCHABLE_AREA_L and -CATCHABLE_AREA_W / 2.0 <= y <= CATCHABLE_AREA_W / 2.0
+
+
+@jit
+def catch(goalie_x, goalie_y, body, direction, ban, ball_x, ball_y, ball_vx, ball_vy):
+    """The server's catch command (play_on, catch probability 1).
+
+    Returns ``(success, ban, goalie_x, goalie_y, body, ball_x, ball_y, ball_vx, ball_vy, collided)``: the new
+    ban counter (5 after any catch that is not refused by the ban itself), the goalie after its jump (velocity
+    0), and the ball after the immediate collision pass, which fires when the double-precision squared distance
+    lands below the touching distance squared.
+    """
+    if ban > 0:
+        return False, ban, goalie_x, goalie_y, body, ball_x, ball_y, ball_vx, ball_vy, False
+    if not catchable(goalie_x, goalie_y, body, direction, ball_x, ball_y):
+        return False, CATCH_BAN_CYCLE, goalie_x, goalie_y, body, ball_x, ball_y, ball_vx, ball_vy, False
+    dx, dy = ball_x - goalie_x, ball_y - goalie_y
+    dist = math.sqrt(dx * dx + dy * dy)
+    scale = (dist - (BALL_SIZE + PLAYER_SIZE)) / dist
+    goalie_x += dx * scale
+    goalie_y += dy * scale
+    body = math.degrees(math.atan2(dy, dx))
+    touch = BALL_SIZE + PLAYER_SIZE
+    dx, dy = ball_x - goalie_x, ball_y - goalie_y
+    collided = dx * dx + dy * dy < touch * touch
+    if collided:
+        # Both moved apart symmetrically about their midpoint to half the touching distance each.
+        mx, my = (ball_x + goalie_x) / 2.0, (ball_y + goalie_y) / 2.0
+        d = math.sqrt(dx * dx + dy * dy)
+        half = touch / 2.0 + SEPARATION_EPSILON
+        ball_x, ball_y = mx + dx / d * half, my + dy / d * half
+        goalie_x, goalie_y = mx - dx / d * half, my - dy / d * half
+        ball_vx *= COLLISION_VELOCITY_FACTOR
+        ball_vy *= COLLISION_VELOCITY_FACTOR
+    return True, CATCH_BAN_CYCLE, goalie_x, goalie_y, body, ball_x, ball_y, ball_vx, ball_vy, collided
