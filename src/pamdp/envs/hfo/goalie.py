@@ -212,11 +212,6 @@ def line_distance(px, py, ox, oy, a):
     return abs(rel(px - ox, py - oy, a)[1])
 
 
-@jit
-def in_rect(x, y, x_max, y_abs):
-    return x < x_max and abs(y) < y_abs
-
-
 # --- Stamina predictions (the server's per-cycle update on a copy) ---------------------------------------
 @jit
 def stamina_wait(stamina, effort, recovery):
@@ -557,7 +552,8 @@ def _short_turn_dash(g, n, bx, by, c, backward, buffer, best, s_b):
     for _ in range(turns):
         st, ef, rc = stamina_wait(st, ef, rc)
     if math.hypot(ix - bx, iy - by) < c - 0.15:
-        # No dash needed: the goalie waits all n cycles (the recording needs the stamina of n waits here).
+        # No dash needed: the goalie waits all n cycles, and its stamina is that after n waits (one recorded
+        # cycle of the seed-42 run needs it: with the stamina after the turns alone, a dash would win).
         wait_st, wait_ef, wait_rc = st, ef, rc
         for _ in range(dashes):
             wait_st, wait_ef, wait_rc = stamina_wait(wait_st, wait_ef, wait_rc)
@@ -749,6 +745,10 @@ def _long_step(g, n, bx, by, c, infos, count):
     dx, dy = polar(ox, a)
     sx, sy = polar(oy, a + 90.0)
     ex, ey = g[G_PX] + dx + sx, g[G_PY] + dy + sy
+    # Once the goalie overtakes the ball along its dash, its end point is taken on the line from its inertia
+    # point through the end, level with the ball; an interception found only by the final reach test keeps its
+    # own end and ball distance, so it is no goalie-box candidate for the intercept (the recording's chase turns
+    # need exactly this: 7 cycles of the seed-42 run).
     ix, iy = self_at(g, n)
     if overtaken and math.hypot(ex - ix, ey - iy) > 0.1:
         lx, ly = ex - ix, ey - iy
@@ -1290,6 +1290,8 @@ def _intercept(g, infos, count, save):
             extra = 0.0
         if math.hypot(dx, dy) <= KICKABLE_AREA - 0.3 + extra:
             if reach > 2:
+                # Face across the ball's line, to the side of the larger x (towards the field): the recording
+                # (3 cycles of the seed-42 run) contradicts a reading that takes the smaller x.
                 rx, ry = g[G_BX] - ix, g[G_BY] - iy
                 fx, fy = ix - ry, iy + rx
                 if ix + ry > fx:
