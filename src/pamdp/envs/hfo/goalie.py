@@ -40,10 +40,9 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 
-jit = numba.njit(cache=True, nogil=True, error_model="numpy")
+from pamdp.envs.hfo.dynamics import jit
 
 # --- Inputs: one cycle's state in the server frame ------------------------------------------------
 W_BX, W_BY, W_BVX, W_BVY = range(4)

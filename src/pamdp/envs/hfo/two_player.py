@@ -14,9 +14,7 @@ from __future__ import annotations
 
 import math
 
-import numba
-
-jit = numba.njit(cache=True, nogil=True, error_model="numpy")
+from pamdp.envs.hfo.dynamics import jit
 
 #: The catch rectangle: 1.2 m along the catch direction, 1.0 m wide (player type 0: no stretch).
 CATCHABLE_AREA_L = 1.2
