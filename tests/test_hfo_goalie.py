@@ -251,7 +251,8 @@ def test_no_tackle_when_the_agent_is_far():
 
 def test_random_states_give_legal_commands():
     """Random states over the goalie's half (moving ball, moving goalie, low stamina, either last kicker, either
-    play mode): every command is legal, as the server would receive it, and the interceptions are sorted."""
+    play mode, noise factors on or off): every command is legal, as the server would receive it, and the
+    interceptions are sorted."""
     rng = np.random.default_rng(0)
     kinds = set()
     for _ in range(3000):
@@ -266,6 +267,8 @@ def test_random_states_give_legal_commands():
         agent = (ball[0] + rng.uniform(-3, 3), ball[1] + rng.uniform(-3, 3))
         w = world(ball=ball, u=u, agent=agent, agent_body=rng.uniform(-180, 180), goalie=goalie,
                   theta=rng.uniform(-180, 180), v=v, stamina=rng.uniform(1000.0, 8000.0))  # fmt: skip
+        if rng.random() < 0.5:  # the noise factors of a run without --deterministic
+            w[gl.W_PLAYER_RAND], w[gl.W_BALL_RAND] = 0.1, 0.05
         memory = gl.new_memory()
         memory[gl.M_LAST_KICKER] = rng.choice([gl.NEUTRAL, gl.GOALIE_SIDE, gl.AGENT_SIDE])
         memory[gl.M_CATCH_MODE] = rng.random() < 0.2

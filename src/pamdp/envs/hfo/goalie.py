@@ -31,9 +31,9 @@ Layouts. ``world`` (float64, :data:`WORLD_SIZE`): the cycle's state in the serve
 The result is ``(kind, arg1, arg2)`` with ``kind`` one of ``NONE, TURN, DASH, CATCH, TACKLE, KICK``:
 turn (moment), dash (power, direction), catch (direction), tackle (direction, foul flag).
 
-Under ``--deterministic`` the server sends the goalie zero noise factors, and the goalie's buffers that
-scale with them vanish; this module assumes that setting (``PLAYER_RAND`` etc. below are the values the
-goalie uses in its own predictions, not the server's noise).
+The goalie's client receives the server's noise factors and widens some of its own buffers with them, so
+it decides slightly differently with and without ``--deterministic``: ``world`` carries them
+(``W_PLAYER_RAND``, ``W_BALL_RAND``). The recording this module is checked against has them at 0.
 """
 
 from __future__ import annotations
@@ -53,7 +53,10 @@ W_GX, W_GY, W_GVX, W_GVY, W_GBODY, W_GSTAMINA, W_GEFFORT, W_GRECOVERY = range(9,
 #: The agent's fullstate flags: ``k`` (it sent a kick in the previous cycle), ``t`` (it is tackling); the
 #: goalie's own tackle freeze (cycles left); the server cycle.
 W_AGENT_KICKED, W_AGENT_TACKLING, W_GOALIE_FREEZE, W_CYCLE = range(17, 21)
-WORLD_SIZE = 21
+#: The server's player and ball noise factors, which the goalie's client also uses in its own predictions
+#: (0 under ``--deterministic``; 0.1 and 0.05 otherwise).
+W_PLAYER_RAND, W_BALL_RAND = range(21, 23)
+WORLD_SIZE = 23
 
 # --- Memory carried across cycles (and across episodes) -------------------------------------------
 #: The cycle after the last catch decision (the client stamps the catch with its next sensory update).
@@ -103,8 +106,6 @@ STAMINA_INC_MAX = 45.0
 EXTRA_STAMINA = 50.0
 #: librcsc's "safe" stamina floor: one above the recovery-decay threshold.
 SAFE_STAMINA = RECOVER_DEC_THR + 1.0
-PLAYER_RAND = 0.0
-BALL_RAND = 0.0
 TACKLE_DIST, TACKLE_WIDTH, TACKLE_EXPONENT, FOUL_EXPONENT = 2.0, 1.25, 6.0, 10.0
 KICK_POWER_RATE = 0.027
 BALL_SPEED_MAX = 3.0
@@ -189,9 +190,9 @@ def dash_rate(direction):
 
 
 @jit
-def turn_max(speed):
-    """The largest turn a full moment gives at ``speed``."""
-    return 180.0 * (1.0 - PLAYER_RAND) / (1.0 + INERTIA_MOMENT * speed)
+def turn_max(speed, player_rand=0.0):
+    """The largest turn a full moment gives at ``speed`` (the smallest under turn noise ``player_rand``)."""
+    return 180.0 * (1.0 - player_rand) / (1.0 + INERTIA_MOMENT * speed)
 
 
 @jit
@@ -246,8 +247,8 @@ def safe_power(power, stamina):
 G_PX, G_PY, G_VX, G_VY, G_TH, G_ST, G_EF, G_RC = range(8)
 G_BX, G_BY, G_UX, G_UY, G_QX, G_QY, G_WX, G_WY, G_PHI = range(8, 17)
 G_DB, G_AB, G_OPP_KICKABLE, G_SELF_KICKABLE, G_LAST_KICKER_ME, G_PLAY_ON = range(17, 23)
-G_N_OPP, G_N_SELF, G_OPP_TACKLING, G_CYCLE = range(23, 27)
-G_SIZE = 27
+G_N_OPP, G_N_SELF, G_OPP_TACKLING, G_CYCLE, G_PLAYER_RAND, G_BALL_RAND = range(23, 29)
+G_SIZE = 29
 
 
 @jit
@@ -270,6 +271,7 @@ def _world_model(world, memory):
     g[G_WX], g[G_WY] = -world[W_AVX], -world[W_AVY]
     g[G_PHI] = nrm(world[W_ABODY] + 180.0)
     g[G_CYCLE] = world[W_CYCLE]
+    g[G_PLAYER_RAND], g[G_BALL_RAND] = world[W_PLAYER_RAND], world[W_BALL_RAND]
     g[G_OPP_TACKLING] = world[W_AGENT_TACKLING]
     g[G_PLAY_ON] = 0.0 if memory[M_CATCH_MODE] else 1.0
     dx, dy = g[G_BX] - g[G_PX], g[G_BY] - g[G_PY]
@@ -445,7 +447,7 @@ def _one_step(g, infos, count):
     m1x, m1y = g[G_PX] + g[G_VX], g[G_PY] + g[G_VY]
     rx, ry = rel(b1x - m1x, b1y - m1y, g[G_TH])
     r = math.hypot(rx, ry)
-    if r <= c - 0.15 - speed * BALL_RAND:
+    if r <= c - 0.15 - speed * g[G_BALL_RAND]:
         ok = True
         if c == KICKABLE_AREA and r > 0.385:
             k = KICK_POWER_RATE * (1.0 - 0.25 * abs(th(rx, ry)) / 180.0 - 0.25 * (r - 0.385) / 0.7)
@@ -454,7 +456,7 @@ def _one_step(g, infos, count):
             st = stamina_wait(g[G_ST], g[G_EF], g[G_RC])[0]
             return _append(infos, count, 0.0, 1.0, 0.0, 0.0, 0.0, m1x, m1y, r, st)
     best = np.full(INFO_SIZE, np.nan)
-    s_b = max(c - 0.2 - speed * BALL_RAND, 0.665)
+    s_b = max(c - 0.2 - speed * g[G_BALL_RAND], 0.665)
     for k in range(8):
         direction = -180.0 + 45.0 * k
         for attempt in range(2):
@@ -660,7 +662,7 @@ def _short_steps(g, m_len, infos, count):
         if (c + n) ** 2 < (g[G_PX] - bx) ** 2 + (g[G_PY] - by) ** 2:
             continue
         best[:] = np.nan
-        s_b = max(c - 0.2 - math.hypot(g[G_BX] - bx, g[G_BY] - by) * BALL_RAND, 0.665)
+        s_b = max(c - 0.2 - math.hypot(g[G_BX] - bx, g[G_BY] - by) * g[G_BALL_RAND], 0.665)
         wide, tight = max(0.1, c - 0.4), c - 0.15
         _short_turn_dash(g, n, bx, by, c, False, wide, best, s_b)
         _short_turn_dash(g, n, bx, by, c, False, tight, best, s_b)
@@ -698,7 +700,7 @@ def _long_turns(g, n, bx, by, c):
     rest = 180.0 - abs(delta) if backward else abs(delta)
     turns, speed = 0, math.hypot(g[G_VX], g[G_VY])
     while rest > margin:
-        rest -= turn_max(speed)
+        rest -= turn_max(speed, g[G_PLAYER_RAND])
         speed *= PLAYER_DECAY
         turns += 1
     if turns > 0:
@@ -714,7 +716,7 @@ def _long_step(g, n, bx, by, c, infos, count):
         return count, False
     dashes = n - turns
     rx, ry = rel(bx - g[G_PX], by - g[G_PY], a)
-    e = math.hypot(g[G_BX] - bx, g[G_BY] - by) * BALL_RAND * 0.5
+    e = math.hypot(g[G_BX] - bx, g[G_BY] - by) * g[G_BALL_RAND] * 0.5
     target = rx + e
     f = (1.0 - PLAYER_DECAY**turns) / (1.0 - PLAYER_DECAY)
     ox, oy = rel(g[G_VX] * f, g[G_VY] * f, a)
@@ -732,12 +734,12 @@ def _long_step(g, n, bx, by, c, infos, count):
         ox, oy = ox + vx, oy + vy
         vx, vy = vx * PLAYER_DECAY, vy * PLAYER_DECAY
         st, ef, rc = stamina_dash(st, ef, rc, -power if backward else power)
-        if ox * (1.0 - 0.01 * PLAYER_RAND) + 0.1 > target:
+        if ox * (1.0 - 0.01 * g[G_PLAYER_RAND]) + 0.1 > target:
             success = overtaken = True
             break
     if not success:
         travel = math.hypot(ox, oy)
-        buf = 0.2 + travel * PLAYER_RAND * 0.5 + e
+        buf = 0.2 + travel * g[G_PLAYER_RAND] * 0.5 + e
         success = math.hypot(rx - ox, ry - oy) < max(c - 0.225, c - buf)
     if not success:
         return count, False
@@ -1300,7 +1302,8 @@ def _intercept(g, infos, count, save):
             phi = math.radians(th(fx - ix, fy - iy))
             # The ball's offset rotated by +phi (not -phi): the client's own sign.
             ry = (xx - ix) * math.sin(phi) + (xy - iy) * math.cos(phi)
-            if abs(ry) <= KICKABLE_AREA - 0.2:
+            noise = math.hypot(xx - g[G_BX], xy - g[G_BY]) * g[G_BALL_RAND]
+            if abs(ry) <= KICKABLE_AREA - noise - 0.2:
                 return _turn_to_point(g, fx, fy, 1)
     power, direction = row[I_POWER], row[I_DIR]
     if save and g[G_ST] - (power if power >= 0.0 else -2.0 * power) < SAFE_STAMINA:
@@ -1663,7 +1666,18 @@ def start_episode(memory: np.ndarray) -> None:
 
 
 def world_from_fields(
-    ball, agent, agent_body, goalie, goalie_body, stamina, effort, recovery, cycle, agent_kicked=0.0
+    ball,
+    agent,
+    agent_body,
+    goalie,
+    goalie_body,
+    stamina,
+    effort,
+    recovery,
+    cycle,
+    agent_kicked=0.0,
+    player_rand=0.0,
+    ball_rand=0.0,
 ) -> np.ndarray:
     """A ``world`` vector from named pieces (server frame): ball (x, y, vx, vy), agent and goalie (x, y, vx, vy)."""
     world = np.zeros(WORLD_SIZE)
@@ -1673,4 +1687,5 @@ def world_from_fields(
     world[W_GX : W_GX + 4] = goalie
     world[W_GBODY], world[W_GSTAMINA], world[W_GEFFORT], world[W_GRECOVERY] = goalie_body, stamina, effort, recovery
     world[W_CYCLE], world[W_AGENT_KICKED] = cycle, agent_kicked
+    world[W_PLAYER_RAND], world[W_BALL_RAND] = player_rand, ball_rand
     return world
