@@ -289,6 +289,24 @@ def test_random_states_give_legal_commands():
     assert {gl.TURN, gl.DASH, gl.CATCH, gl.TACKLE} <= kinds
 
 
+def test_side_step_near_the_target():
+    """Go to point with the target 0.8 m to the goalie's right (body along +y, at rest): within threshold + 1 it
+    side-steps. Worked by hand: dashing at -90 (rate 0.0024) with powers 100, 100, 56 ends 0.045 m from the
+    target in 3 steps; at -45 it drifts sideways and ends farther; so ``(dash 100 -90)``."""
+    g = gl._world_model(world(goalie=(-50.0, 0.0), theta=90.0), gl.new_memory())
+    assert gl._go_to_point(g, -49.2, 0.0, 0.5, 100.0, -1.0, 100, True, 15.0) == (True, gl.DASH, 100.0, -90.0)
+
+
+def test_target_behind_a_post_is_moved_beside_it():
+    """From (-52, 6.5), body +90, a target behind the post (-52.44, 7.07) is replaced by the point 0.66 m from the
+    post at right angles to the post's direction beta = 127.73 degrees, on the side away from the body:
+    post + polar(0.66, beta - 90)."""
+    g = gl._world_model(world(goalie=(-52.0, 6.5), theta=90.0), gl.new_memory())
+    beta = math.degrees(math.atan2(7.07 - 6.5, -52.44 + 52.0))
+    expected = (-52.44 + 0.66 * math.cos(math.radians(beta - 90)), 7.07 + 0.66 * math.sin(math.radians(beta - 90)))
+    assert gl._avoid_post(g, -53.0, 7.6) == pytest.approx(expected)
+
+
 # --- The server's catch (two_player) --------------------------------------------------------------------
 def test_server_catch_worked_example():
     """5.3 on the server, in its frame: goalie S(50, 0) body 180, ball S(49, -0.7) at rest, ``(catch 57.6119)``:
