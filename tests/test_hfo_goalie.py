@@ -349,6 +349,42 @@ def test_server_catch_recorded():
     assert len(jumps) == 6 and sum(j < 2e-4 for j in jumps) == 5
 
 
+def test_collision_after_a_recorded_catch():
+    """Cycle 415 of the recording: the goalie catches, the jump does not overlap the ball, the ball then moves by
+    its velocity into the goalie and the collision pushes the two apart to 0.385 m, the goalie off its landing
+    point by 0.18 m, the ball's velocity turned to -0.1 of its decayed value: as logged at cycle 416."""
+    trace = load()
+    now, after = (dict(zip(trace["rcg_states_fields"], trace["rcg_states"][str(c)])) for c in (415, 416))
+    dx, dy = now["ball_x"] - now["goalie_x"], now["ball_y"] - now["goalie_y"]
+    scale = (math.hypot(dx, dy) - tp.BALL_PLAYER_CONTACT) / math.hypot(dx, dy)
+    pos = np.array([
+        [now["ball_x"] + now["ball_vx"], now["ball_y"] + now["ball_vy"]],
+        [now["self_x"], now["self_y"]],  # the agent, 20 m away
+        [now["goalie_x"] + dx * scale, now["goalie_y"] + dy * scale],
+    ])  # fmt: skip
+    vel = np.array([[now["ball_vx"] * 0.94, now["ball_vy"] * 0.94], [0.0, 0.0], [0.0, 0.0]])
+    collided = np.zeros(3, dtype=bool)
+    tp.collide(pos, vel, collided)
+    assert collided.tolist() == [True, False, True]
+    np.testing.assert_allclose(pos[0], (after["ball_x"], after["ball_y"]), atol=5e-4)
+    np.testing.assert_allclose(pos[2], (after["goalie_x"], after["goalie_y"]), atol=5e-4)
+    np.testing.assert_allclose(vel[0], (after["ball_vx"], after["ball_vy"]), atol=1e-4)
+
+
+def test_collisions_between_three_bodies():
+    """Agent and goalie overlapping each other and the ball between them: each pass averages what the pairs ask
+    for, so the overlaps shrink pass by pass; after the server's 10 passes less than a millimetre is left, and
+    all three, having collided, move at -0.1 of their velocity."""
+    pos = np.array([[0.0, 0.0], [-0.2, 0.0], [0.25, 0.05]])
+    vel = np.ones((3, 2))
+    collided = np.zeros(3, dtype=bool)
+    tp.collide(pos, vel, collided)
+    assert collided.all() and np.allclose(vel, -0.1)
+    assert np.linalg.norm(pos[1] - pos[2]) > tp.PLAYER_PLAYER_CONTACT - 1e-3
+    for i in (1, 2):
+        assert np.linalg.norm(pos[0] - pos[i]) > tp.BALL_PLAYER_CONTACT - 1e-3
+
+
 # --- Replay of the real server ----------------------------------------------------------------------------
 #: Matching recorded commands (kind equal, arguments within the recording's rounding), overall and per kind;
 #: floors at the rates reached, so that a change cannot lower them unnoticed.

@@ -1,4 +1,4 @@
-"""Server rules that need the goalie on the pitch: the goalie's catch, and the ball-player collision after it.
+"""Server rules that need a second player on the pitch: the goalie's catch, and collisions between three bodies.
 
 rcssserver (the HFO fork, mhauskn/rcssserver) applies a goalie's ``(catch dir)`` when the command arrives,
 before the cycle's movement. In HFO mode the server's catch referee is off, so the goalie may catch anywhere
@@ -13,6 +13,8 @@ environment can call them per copy.
 from __future__ import annotations
 
 import math
+
+import numpy as np
 
 from pamdp.envs.hfo.dynamics import jit
 
@@ -70,3 +72,69 @@ def catch(goalie_x, goalie_y, body, direction, ban, ball_x, ball_y, ball_vx, bal
         ball_vx *= COLLISION_VELOCITY_FACTOR
         ball_vy *= COLLISION_VELOCITY_FACTOR
     return True, CATCH_BAN_CYCLE, goalie_x, goalie_y, body, ball_x, ball_y, ball_vx, ball_vy, collided
+
+
+#: Object-pair contact distances: ball-player and player-player.
+BALL_PLAYER_CONTACT = BALL_SIZE + PLAYER_SIZE
+PLAYER_PLAYER_CONTACT = 2.0 * PLAYER_SIZE
+MAX_COLLISION_PASSES = 10
+
+
+@jit
+def _separate(pos, acc, counts, i, j, contact):
+    """Add to the accumulators the positions of objects i and j pushed apart about their midpoint to just
+    beyond ``contact``."""
+    dx, dy = pos[j, 0] - pos[i, 0], pos[j, 1] - pos[i, 1]
+    d = math.sqrt(dx * dx + dy * dy)
+    # Coincident centres: the server draws a random direction; a fixed one here (never met in play).
+    ux, uy = (dx / d, dy / d) if d > 1e-10 else (1.0, 0.0)
+    mx, my = (pos[i, 0] + pos[j, 0]) / 2.0, (pos[i, 1] + pos[j, 1]) / 2.0
+    half = contact / 2.0 + SEPARATION_EPSILON
+    ox, oy = ux * half, uy * half
+    for _ in range(10):
+        if (2.0 * ox) ** 2 + (2.0 * oy) ** 2 >= contact * contact:
+            break
+        ox, oy = ox * 1.0001, oy * 1.0001
+    acc[i, 0] += mx - ox
+    acc[i, 1] += my - oy
+    acc[j, 0] += mx + ox
+    acc[j, 1] += my + oy
+    counts[i] += 1
+    counts[j] += 1
+
+
+@jit
+def collide(pos, vel, collided):
+    """rcssserver's collision resolution after a movement phase (or a catch), in place.
+
+    ``pos``, ``vel``: (K, 2) arrays, row 0 the ball, then the enabled players in the server's list order (the
+    agent, then the goalie). Each pass pushes apart every overlapping ball-player pair (0.385 m) and then every
+    overlapping pair of players (0.6 m), and moves each object that collided to the average of the positions its
+    pairs asked for; passes repeat while anything overlapped, at most 10. Every object that collided has its
+    velocity multiplied by -0.1 once; ``collided`` (bool, K) marks them.
+    """
+    k = pos.shape[0]
+    acc = np.empty((k, 2))
+    counts = np.empty(k)
+    for _ in range(MAX_COLLISION_PASSES):
+        acc[:] = 0.0
+        counts[:] = 0.0
+        for i in range(1, k):
+            dx, dy = pos[i, 0] - pos[0, 0], pos[i, 1] - pos[0, 1]
+            if dx * dx + dy * dy < BALL_PLAYER_CONTACT * BALL_PLAYER_CONTACT:
+                _separate(pos, acc, counts, 0, i, BALL_PLAYER_CONTACT)
+        for i in range(1, k):
+            for j in range(i + 1, k):
+                dx, dy = pos[j, 0] - pos[i, 0], pos[j, 1] - pos[i, 1]
+                if dx * dx + dy * dy < PLAYER_PLAYER_CONTACT * PLAYER_PLAYER_CONTACT:
+                    _separate(pos, acc, counts, i, j, PLAYER_PLAYER_CONTACT)
+        if not counts.any():
+            break
+        for i in range(k):
+            if counts[i] > 0:
+                pos[i, 0], pos[i, 1] = acc[i, 0] / counts[i], acc[i, 1] / counts[i]
+                collided[i] = True
+    for i in range(k):
+        if collided[i]:
+            vel[i, 0] *= COLLISION_VELOCITY_FACTOR
+            vel[i, 1] *= COLLISION_VELOCITY_FACTOR
