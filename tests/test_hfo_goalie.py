@@ -311,20 +311,23 @@ def test_target_behind_a_post_is_moved_beside_it():
 def test_server_catch_worked_example():
     """5.3 on the server, in its frame: goalie S(50, 0) body 180, ball S(49, -0.7) at rest, ``(catch 57.6119)``:
     the goalie jumps to S(49.31540, -0.47922) facing the ball; the double-precision squared distance lands
-    below 0.385**2, so the pair collides at once."""
-    ok, ban, gx, gy, body, bx, by, bvx, bvy, collided = tp.catch(50.0, 0.0, 180.0, 57.6119, 0, 49.0, -0.7, 0.0, 0.0)
-    assert ok and ban == tp.CATCH_BAN_CYCLE and collided
+    below 0.385**2, so the collision pass that follows pushes the pair apart."""
+    ok, ban, gx, gy, body = tp.catch(50.0, 0.0, 180.0, 57.6119, 0, 49.0, -0.7)
+    assert ok and ban == tp.CATCH_BAN_CYCLE
     assert (gx, gy) == pytest.approx((49.31540, -0.47922), abs=1e-5)
     assert body == pytest.approx(-145.008, abs=5e-4)
-    assert math.hypot(bx - gx, by - gy) > tp.BALL_SIZE + tp.PLAYER_SIZE
+    assert (49.0 - gx) ** 2 + (-0.7 - gy) ** 2 < tp.BALL_PLAYER_CONTACT**2
+    pos, vel, collided = np.array([[49.0, -0.7], [gx, gy]]), np.zeros((2, 2)), np.zeros(2, dtype=bool)
+    tp.collide(pos, vel, collided)
+    assert collided.all() and np.linalg.norm(pos[0] - pos[1]) > tp.BALL_PLAYER_CONTACT
 
 
 def test_server_catch_rectangle_and_ban():
     """Inside the 1.2 x 1.0 rectangle (inclusive) the catch works unless banned; outside it fails but still bans."""
     assert tp.catchable(0.0, 0.0, 0.0, 0.0, 1.2, 0.5) and not tp.catchable(0.0, 0.0, 0.0, 0.0, 1.21, 0.0)
     assert not tp.catchable(0.0, 0.0, 0.0, 0.0, -0.01, 0.0)
-    assert tp.catch(0.0, 0.0, 0.0, 0.0, 3, 1.0, 0.0, 0.0, 0.0)[:2] == (False, 3)
-    assert tp.catch(0.0, 0.0, 0.0, 0.0, 0, 1.3, 0.0, 0.0, 0.0)[:2] == (False, tp.CATCH_BAN_CYCLE)
+    assert tp.catch(0.0, 0.0, 0.0, 0.0, 3, 1.0, 0.0)[:2] == (False, 3)
+    assert tp.catch(0.0, 0.0, 0.0, 0.0, 0, 1.3, 0.0)[:2] == (False, tp.CATCH_BAN_CYCLE)
 
 
 def test_server_catch_recorded():
@@ -340,8 +343,9 @@ def test_server_catch_recorded():
             continue
         now = dict(zip(fields, trace["rcg_states"][str(c)]))
         after = dict(zip(fields, trace["rcg_states"][str(c + 1)]))
-        result = tp.catch(now["goalie_x"], now["goalie_y"], now["goalie_body_deg"], cmd[1], 0,
-                          now["ball_x"], now["ball_y"], now["ball_vx"], now["ball_vy"])  # fmt: skip
+        result = tp.catch(
+            now["goalie_x"], now["goalie_y"], now["goalie_body_deg"], cmd[1], 0, now["ball_x"], now["ball_y"]
+        )
         assert result[0]
         assert abs(gl.nrm(result[4] - after["goalie_body_deg"])) < 0.011
         if c + 1 not in resets:
@@ -355,12 +359,15 @@ def test_collision_after_a_recorded_catch():
     point by 0.18 m, the ball's velocity turned to -0.1 of its decayed value: as logged at cycle 416."""
     trace = load()
     now, after = (dict(zip(trace["rcg_states_fields"], trace["rcg_states"][str(c)])) for c in (415, 416))
-    dx, dy = now["ball_x"] - now["goalie_x"], now["ball_y"] - now["goalie_y"]
-    scale = (math.hypot(dx, dy) - tp.BALL_PLAYER_CONTACT) / math.hypot(dx, dy)
+    direction = recorded_command(trace["rcl_commands"]["415"][1])[1]
+    ok, _, gx, gy, _ = tp.catch(
+        now["goalie_x"], now["goalie_y"], now["goalie_body_deg"], direction, 0, now["ball_x"], now["ball_y"]
+    )
+    assert ok
     pos = np.array([
         [now["ball_x"] + now["ball_vx"], now["ball_y"] + now["ball_vy"]],
         [now["self_x"], now["self_y"]],  # the agent, 20 m away
-        [now["goalie_x"] + dx * scale, now["goalie_y"] + dy * scale],
+        [gx, gy],
     ])  # fmt: skip
     vel = np.array([[now["ball_vx"] * 0.94, now["ball_vy"] * 0.94], [0.0, 0.0], [0.0, 0.0]])
     collided = np.zeros(3, dtype=bool)

@@ -28,6 +28,10 @@ BALL_SIZE = 0.085
 COLLISION_VELOCITY_FACTOR = -0.1
 #: Added to each half of a resolved contact so that the pair ends strictly apart.
 SEPARATION_EPSILON = 1e-10
+#: Object-pair contact distances: ball-player and player-player.
+BALL_PLAYER_CONTACT = BALL_SIZE + PLAYER_SIZE
+PLAYER_PLAYER_CONTACT = 2.0 * PLAYER_SIZE
+MAX_COLLISION_PASSES = 10
 
 
 @jit
@@ -41,43 +45,23 @@ def catchable(goalie_x, goalie_y, body, direction, ball_x, ball_y):
 
 
 @jit
-def catch(goalie_x, goalie_y, body, direction, ban, ball_x, ball_y, ball_vx, ball_vy):
-    """The server's catch command (play_on, catch probability 1).
+def catch(goalie_x, goalie_y, body, direction, ban, ball_x, ball_y):
+    """The server's catch command (play_on, catch probability 1): ``(success, ban, goalie_x, goalie_y, body)``.
 
-    Returns ``(success, ban, goalie_x, goalie_y, body, ball_x, ball_y, ball_vx, ball_vy, collided)``: the new
-    ban counter (5 after any catch that is not refused by the ban itself), the goalie after its jump (velocity
-    0), and the ball after the immediate collision pass, which fires when the double-precision squared distance
-    lands below the touching distance squared.
+    The ban counter becomes 5 after any catch that the ban itself does not refuse. On success the goalie jumps
+    along the line to the ball until the two touch, faces the ball and stops (velocity 0); the ball keeps its
+    position and velocity. The server then resolves collisions at once (:func:`collide`): the jump lands the
+    pair exactly touching, and whether the double-precision distance falls below contact, turning the ball's
+    velocity to -0.1 of itself, is decided by the last bits of the arithmetic.
     """
     if ban > 0:
-        return False, ban, goalie_x, goalie_y, body, ball_x, ball_y, ball_vx, ball_vy, False
+        return False, ban, goalie_x, goalie_y, body
     if not catchable(goalie_x, goalie_y, body, direction, ball_x, ball_y):
-        return False, CATCH_BAN_CYCLE, goalie_x, goalie_y, body, ball_x, ball_y, ball_vx, ball_vy, False
+        return False, CATCH_BAN_CYCLE, goalie_x, goalie_y, body
     dx, dy = ball_x - goalie_x, ball_y - goalie_y
     dist = math.sqrt(dx * dx + dy * dy)
     scale = (dist - (BALL_SIZE + PLAYER_SIZE)) / dist
-    goalie_x += dx * scale
-    goalie_y += dy * scale
-    body = math.degrees(math.atan2(dy, dx))
-    touch = BALL_SIZE + PLAYER_SIZE
-    dx, dy = ball_x - goalie_x, ball_y - goalie_y
-    collided = dx * dx + dy * dy < touch * touch
-    if collided:
-        # Both moved apart symmetrically about their midpoint to half the touching distance each.
-        mx, my = (ball_x + goalie_x) / 2.0, (ball_y + goalie_y) / 2.0
-        d = math.sqrt(dx * dx + dy * dy)
-        half = touch / 2.0 + SEPARATION_EPSILON
-        ball_x, ball_y = mx + dx / d * half, my + dy / d * half
-        goalie_x, goalie_y = mx - dx / d * half, my - dy / d * half
-        ball_vx *= COLLISION_VELOCITY_FACTOR
-        ball_vy *= COLLISION_VELOCITY_FACTOR
-    return True, CATCH_BAN_CYCLE, goalie_x, goalie_y, body, ball_x, ball_y, ball_vx, ball_vy, collided
-
-
-#: Object-pair contact distances: ball-player and player-player.
-BALL_PLAYER_CONTACT = BALL_SIZE + PLAYER_SIZE
-PLAYER_PLAYER_CONTACT = 2.0 * PLAYER_SIZE
-MAX_COLLISION_PASSES = 10
+    return True, CATCH_BAN_CYCLE, goalie_x + dx * scale, goalie_y + dy * scale, math.degrees(math.atan2(dy, dx))
 
 
 @jit
