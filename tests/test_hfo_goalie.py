@@ -353,6 +353,18 @@ def test_server_catch_recorded():
     assert len(jumps) == 6 and sum(j < 2e-4 for j in jumps) == 5
 
 
+def test_server_tackle():
+    """Ball 1.3 m straight ahead (fail 0.65**6 = 0.0754): a draw below 0.9246 succeeds with the full tackle power
+    100 * 0.027 = 2.7 along the body; a draw above fails; a ball behind always fails; every tackle freezes the
+    goalie for 10 cycles except a successful foul while the agent is on the ball (exponent 10: fail 0.0135)."""
+    ok, freeze, ax, ay = tp.tackle(0.0, 0.0, 90.0, 0.0, False, 0.0, 1.3, 0.0, 0.0, 5.0, np.array([0.9, 0, 0]), 0.0)
+    assert ok and freeze == tp.TACKLE_CYCLES and (ax, ay) == pytest.approx((0.0, 2.7))
+    assert not tp.tackle(0.0, 0.0, 90.0, 0.0, False, 0.0, 1.3, 0.0, 0.0, 5.0, np.array([0.93, 0, 0]), 0.0)[0]
+    assert not tp.tackle(0.0, 0.0, 90.0, 0.0, False, 0.0, -0.5, 0.0, 0.0, 5.0, np.array([0.0, 0, 0]), 0.0)[0]
+    ok, freeze, ax, ay = tp.tackle(0.0, 0.0, 90.0, 90.0, True, 0.0, 1.3, 0.0, 0.0, 1.0, np.array([0.98, 0, 0]), 0.0)
+    assert ok and freeze == 0 and (ax, ay) == pytest.approx((-1.35, 0.0))
+
+
 def test_collision_after_a_recorded_catch():
     """Cycle 415 of the recording: the goalie catches, the jump does not overlap the ball, the ball then moves by
     its velocity into the goalie and the collision pushes the two apart to 0.385 m, the goalie off its landing

@@ -28,6 +28,11 @@ BALL_SIZE = 0.085
 COLLISION_VELOCITY_FACTOR = -0.1
 #: Added to each half of a resolved contact so that the pair ends strictly apart.
 SEPARATION_EPSILON = 1e-10
+TACKLE_DIST, TACKLE_WIDTH, TACKLE_EXPONENT, FOUL_EXPONENT = 2.0, 1.25, 6.0, 10.0
+TACKLE_POWER_RATE, MAX_TACKLE_POWER = 0.027, 100.0
+TACKLE_CYCLES = 10
+KICKABLE_AREA = 1.085
+BALL_SPEED_MAX, BALL_DECAY = 3.0, 0.94
 #: Object-pair contact distances: ball-player and player-player.
 BALL_PLAYER_CONTACT = BALL_SIZE + PLAYER_SIZE
 PLAYER_PLAYER_CONTACT = 2.0 * PLAYER_SIZE
@@ -62,6 +67,42 @@ def catch(goalie_x, goalie_y, body, direction, ban, ball_x, ball_y):
     dist = math.sqrt(dx * dx + dy * dy)
     scale = (dist - (BALL_SIZE + PLAYER_SIZE)) / dist
     return True, CATCH_BAN_CYCLE, goalie_x + dx * scale, goalie_y + dy * scale, math.degrees(math.atan2(dy, dx))
+
+
+@jit
+def tackle(goalie_x, goalie_y, body, direction, foul, ball_x, ball_y, ball_vx, ball_vy, agent_dist, draws, kick_rand):
+    """The server's tackle command: ``(success, freeze, ax, ay)``, the ball's acceleration on success.
+
+    Every tackle freezes the tackler for 10 cycles (a successful foul ends the freeze at once). The ball must lie
+    ahead of the body (no back tackles); a foul tackle (``foul``) counts as one only while the agent is within
+    its kickable distance of the ball (``agent_dist``), with the flatter exponent 10 instead of 6. Success is a
+    Bernoulli draw with probability 1 - f, f = (x/2)**e + (y/1.25)**e of the ball's body-frame offset, random
+    even under ``--deterministic``: ``draws`` are three U(0, 1) numbers from the caller's stream (the success
+    draw, then the noise length and direction, the noise scaled by ``kick_rand``, 0 under ``--deterministic``).
+    """
+    a = math.radians(body)
+    dx, dy = ball_x - goalie_x, ball_y - goalie_y
+    x = dx * math.cos(a) + dy * math.sin(a)
+    y = -dx * math.sin(a) + dy * math.cos(a)
+    if x <= 0.0:
+        return False, TACKLE_CYCLES, 0.0, 0.0
+    is_foul = foul and agent_dist <= KICKABLE_AREA
+    e = FOUL_EXPONENT if is_foul else TACKLE_EXPONENT
+    fail = (abs(x) / TACKLE_DIST) ** e + (abs(y) / TACKLE_WIDTH) ** e
+    if fail >= 1.0 or draws[0] >= 1.0 - fail:
+        return False, TACKLE_CYCLES, 0.0, 0.0
+    direction = min(max(direction, -180.0), 180.0)
+    gamma = math.atan2(y, x)
+    power = MAX_TACKLE_POWER * (1.0 - abs(direction) / 180.0) * TACKLE_POWER_RATE * (1.0 - 0.5 * abs(gamma) / math.pi)
+    phi = math.radians(body + direction)
+    ax, ay = power * math.cos(phi), power * math.sin(phi)
+    if kick_rand > 0.0:
+        pos_rate = 0.5 + 0.5 * (1.0 - fail)
+        speed_rate = 0.5 + 0.5 * math.hypot(ball_vx, ball_vy) / (BALL_SPEED_MAX * BALL_DECAY)
+        length = draws[1] * kick_rand * 2.0 * (pos_rate + speed_rate)
+        angle = (2.0 * draws[2] - 1.0) * math.pi
+        ax, ay = ax + length * math.cos(angle), ay + length * math.sin(angle)
+    return True, 0 if is_foul else TACKLE_CYCLES, ax, ay
 
 
 @jit
