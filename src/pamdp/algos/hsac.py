@@ -54,7 +54,6 @@ from pamdp.algos.offpolicy import (
     shared_setting,
     soft_updater,
 )
-from pamdp.algos.replay import ReplayBuffer, transition_fields
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
 from pamdp.distributions import MASKED, masked_logits
 from pamdp.policies import ACTIVATIONS, every_action_linear, mlp
@@ -298,14 +297,9 @@ class HybridSAC(Algorithm):
         self._actor_step = gradient_step(self.actor_optimizer, cfg.grad_clip)
         self._critic_step = gradient_step(self.critic_optimizer, cfg.grad_clip)
         self.param_sizes = torch.as_tensor(h.param_sizes, dtype=torch.float32, device=self.device)
-        fields = transition_fields(
-            self.obs_dim,
-            h.max_param_size,
-            masks=h.n_actions if cfg.action_mask else 0,
-            params=((h.total_param_size,), np.float32),  # every action's drawn parameters: what the critics saw
-        )
-        self.replay = ReplayBuffer(cfg.buffer_size, fields, self.device)
-        self.loop = OffPolicyLoop(cfg, h, self.replay)
+        # every action's drawn parameters: what the critics saw
+        self.loop = OffPolicyLoop(self, params=((h.total_param_size,), np.float32))
+        self.replay = self.loop.buffer
         self._soft_update = soft_updater([(self.critic_target, self.critic)])
 
     def _modules(self):
@@ -318,12 +312,6 @@ class HybridSAC(Algorithm):
 
     def _optimizers(self):
         return {"actor": self.actor_optimizer, "critic": self.critic_optimizer, "temperatures": self.alpha_optimizer}
-
-    def _extra_state(self, replay):
-        return {"loop": self.loop.state_dict(replay)}
-
-    def _load_extra_state(self, state):
-        self.loop.load_state_dict(state["loop"])
 
     @property
     def alphas(self) -> tuple[float, float]:
@@ -350,10 +338,8 @@ class HybridSAC(Algorithm):
         return a, x, {"params": self.actor.flat_params(x_all).cpu().numpy()}
 
     # -- learning --------------------------------------------------------------------------------
-    def _run_epoch(self) -> dict[str, float]:
-        stats = self.loop.run_epoch(self.vec_env, self._explore, self._update, self.num_timesteps, self.np_rng)
-        stats["train/alpha_d"], stats["train/alpha_c"] = self.alphas
-        return stats
+    def _epoch_stats(self, step: int) -> dict[str, float]:
+        return dict(zip(("train/alpha_d", "train/alpha_c"), self.alphas))
 
     def soft_value(self, dist: SquashedHybrid, critic: TwinQ, obs: torch.Tensor, alpha_d, alpha_c):
         """Per state and discrete action, ``min_i Q_i(s, x_all)_a - alpha_c log pi_c(x_a|s,a) - alpha_d log

@@ -60,7 +60,6 @@ from pamdp.algos.offpolicy import (
     soft_update,
     uniform_actions,
 )
-from pamdp.algos.replay import ReplayBuffer, transition_fields
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, at_least, interval, one_of, setting
 from pamdp.distributions import masked_logits
 from pamdp.policies import ACTIVATIONS, mlp
@@ -358,14 +357,9 @@ class HyAR(Algorithm):
         self.rep_optimizer = torch.optim.Adam(self.rep.parameters(), lr=cfg.vae_lr, fused=True)
         self.actor_optimizer = torch.optim.Adam(self.actor.net.parameters(), lr=cfg.actor_lr, fused=True)
         self.critic_optimizer = torch.optim.Adam(self.critic.parameters(), lr=cfg.critic_lr, fused=True)
-        fields = transition_fields(
-            self.obs_dim,
-            h.max_param_size,
-            masks=h.n_actions if cfg.action_mask else 0,
-            latent=((self.latent_size,), np.float32),  # the latent action that was decoded and executed
-        )
-        self.replay = ReplayBuffer(cfg.buffer_size, fields, self.device)
-        self.loop = OffPolicyLoop(cfg, h, self.replay)
+        # the latent action that was decoded and executed
+        self.loop = OffPolicyLoop(self, latent=((self.latent_size,), np.float32))
+        self.replay = self.loop.buffer
         self.pretrained = False  # the warm-up round of representation training is done
         self.n_updates = 0  # TD3 updates so far (the policy delay and the representation rounds count them)
         self.rl_start = 0  # the replay's insertion counter at the representation's pre-training (td3_replay)
@@ -382,16 +376,10 @@ class HyAR(Algorithm):
     def _optimizers(self):
         return {"rep": self.rep_optimizer, "actor": self.actor_optimizer, "critic": self.critic_optimizer}
 
-    def _extra_state(self, replay):
-        return {
-            "loop": self.loop.state_dict(replay),
-            "pretrained": self.pretrained,
-            "n_updates": self.n_updates,
-            "rl_start": self.rl_start,
-        }
+    def _extra_state(self):
+        return {"pretrained": self.pretrained, "n_updates": self.n_updates, "rl_start": self.rl_start}
 
     def _load_extra_state(self, state):
-        self.loop.load_state_dict(state["loop"])
         self.pretrained, self.n_updates = bool(state["pretrained"]), int(state["n_updates"])
         self.rl_start = int(state.get("rl_start", self.config.warmup_steps))  # checkpoints from before td3_replay
         if self.pretrained and len(self.replay) == 0:  # resumed without the replay: warm up again on new data
@@ -441,13 +429,12 @@ class HyAR(Algorithm):
         return linear_epsilon(step, cfg.epsilon_start, cfg.epsilon_end, cfg.epsilon_steps)
 
     # -- learning --------------------------------------------------------------------------------
-    def _run_epoch(self) -> dict[str, float]:
-        stats = self.loop.run_epoch(self.vec_env, self._explore, self._update, self.num_timesteps, self.np_rng)
-        stats["train/latent_box_width"] = float((self.actor.high - self.actor.low).mean())
-        step = self.num_timesteps + stats["steps"]
-        stats["train/epsilon"] = self.epsilon(step)
-        stats["train/noise_std"] = self.noise_std(step)
-        return stats
+    def _epoch_stats(self, step: int) -> dict[str, float]:
+        return {
+            "train/latent_box_width": float((self.actor.high - self.actor.low).mean()),
+            "train/epsilon": self.epsilon(step),
+            "train/noise_std": self.noise_std(step),
+        }
 
     def train_representation(self, updates: int) -> dict[str, float]:
         """``updates`` steps of the representation loss on replayed batches, then new latent bounds."""

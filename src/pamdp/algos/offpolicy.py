@@ -31,7 +31,7 @@ import torch
 from torch import nn
 
 from pamdp.algos.logger import EpisodeTracker
-from pamdp.algos.replay import ReplayBuffer
+from pamdp.algos.replay import ReplayBuffer, transition_fields
 from pamdp.algos.settings import NON_NEGATIVE, POSITIVE, at_least, interval, setting
 from pamdp.algos.subnormals import subnormals_flushed
 from pamdp.algos.vector_env import info_action_masks
@@ -316,35 +316,39 @@ def backprop_actor(
 
 
 class OffPolicyLoop:
-    """Collect-and-learn epochs for an off-policy algorithm (see the module docstring).
+    """Collect-and-learn epochs of an off-policy algorithm over its replay buffer (see the module docstring).
+
+    The loop receives the algorithm and reads from it what it needs: the settings (an :class:`OffPolicyConfig`
+    with ``learning_starts`` and ``flush_denormal``; the updates, not the env steps, flush subnormal floats to
+    zero), the env (``vec_env``), the random stream (``np_rng``), the device, and the two methods of the loop,
+    ``_explore`` (:data:`ActFn`) and ``_update`` (:data:`UpdateFn`). It builds the replay buffer, :attr:`buffer`,
+    with the fields every off-policy algorithm stores, the algorithm's ``fields`` and ``mc`` with ``mc_returns``.
 
     Args:
-        config: the algorithm's settings: an :class:`OffPolicyConfig` with ``learning_starts`` and
-            ``flush_denormal`` (the updates, not the env steps, flush subnormal floats to zero).
-        hybrid: the env's hybrid action space.
-        buffer: where transitions go; it needs the fields ``obs, a, x, reward, next_obs, terminated``, the
-            algorithm's extras, and ``mc`` when ``mc_returns``.
+        algo: the algorithm.
         mc_returns: compute Monte-Carlo returns (discounted by ``config.gamma``) when episodes end.
         tail_value: with ``mc_returns``, the value of a truncated episode's final observations
             ``(B, d)`` with their action masks (``(B, K)`` bool, or ``None``) ``-> (B,)``, which bootstraps its
             Monte-Carlo return; ``None`` treats the cut as an end.
+        fields: the algorithm's own fields, ``name=(shape, dtype)``.
 
     With the ``action_mask`` setting the loop reads the env's ``info["action_mask"]`` at every step, passes the
-    current state's to ``act`` and stores both states' in the buffer's ``mask`` and ``next_mask`` fields (build
-    it with ``transition_fields(..., masks=K)``).
+    current state's to ``_explore`` and stores both states' in the buffer's ``mask`` and ``next_mask`` fields.
+    Its checkpoint state (:meth:`state_dict`) is the buffer's and the update credit.
     """
 
     def __init__(
         self,
-        config: OffPolicyConfig,
-        hybrid,
-        buffer: ReplayBuffer,
+        algo,
         mc_returns: bool = False,
         tail_value: Callable[[np.ndarray, np.ndarray | None], np.ndarray] | None = None,
+        **fields,
     ):
-        self.config = config
-        self.hybrid = hybrid
-        self.buffer = buffer
+        cfg, hybrid = algo.config, algo.hybrid
+        self.algo, self.config, self.hybrid = algo, cfg, hybrid
+        masks = hybrid.n_actions if cfg.action_mask else 0
+        spec = transition_fields(algo.obs_dim, hybrid.max_param_size, mc_returns=mc_returns, masks=masks, **fields)
+        self.buffer = ReplayBuffer(cfg.buffer_size, spec, algo.device)
         self.mc_returns = mc_returns
         self.tail_value = tail_value
         self.update_credit = 0.0
@@ -367,12 +371,12 @@ class OffPolicyLoop:
             return None
         return info_action_masks(info, self.num_envs, self.hybrid.n_actions)
 
-    def run_epoch(
-        self, env, act: ActFn, update: UpdateFn, start_step: int, np_rng: np.random.Generator
-    ) -> dict[str, float]:
+    def run_epoch(self) -> dict[str, float]:
         """Collect at least ``config.epoch_steps`` valid transitions, updating as they arrive; returns the epoch's
-        stats. ``start_step`` is the number of samples collected before (``act`` gets the running count)."""
-        cfg = self.config
+        stats with the algorithm's ``_epoch_stats`` at its end (``_explore`` gets the running count of samples)."""
+        cfg, algo = self.config, self.algo
+        act, update, start_step, np_rng = algo._explore, algo._update, algo.num_timesteps, algo.np_rng
+        env, device = algo.vec_env, algo.device
         n_samples, learning_starts, updates_per_step = cfg.epoch_steps, cfg.learning_starts, cfg.updates_per_step
         if self.obs is None:
             self._start(env, np_rng)
@@ -382,7 +386,6 @@ class OffPolicyLoop:
         n_updates = n_valid = 0
         while n_valid < n_samples:
             obs = np.asarray(self.obs, dtype=np.float32)
-            device = self.buffer.device
             mask = None if self.masks is None else torch.from_numpy(self.masks).to(device)
             with torch.no_grad():  # the observations to the algorithm's device, the actions back
                 a, x, extras = act(torch.from_numpy(obs).to(device), start_step + n_valid, self.episode_start, mask)
@@ -430,6 +433,7 @@ class OffPolicyLoop:
         stats.update({f"train/action_freq_{k}": float(c) / n_valid for k, c in enumerate(counts)})
         stats.update(self.tracker.pop())
         stats["steps"] = n_valid
+        stats.update(algo._epoch_stats(start_step + n_valid))
         return stats
 
     def _finish_returns(self, counters, valid, reward, terminated, done, next_obs, next_masks) -> None:

@@ -16,8 +16,7 @@ import torch
 from pamdp.algos.logger import EpisodeTracker
 from pamdp.algos.settings import one_of, setting
 from pamdp.algos.vector_env import info_action_masks
-from pamdp.policies import PI_C_INPUTS, HybridPolicy
-from pamdp.spaces import HybridActionSpace
+from pamdp.policies import PI_C_INPUTS
 
 __all__ = [
     "pi_c_input_setting",
@@ -76,31 +75,35 @@ class Rollout:
 
     KEYS = ("obs", "a", "x", "reward", "terminated", "done", "valid", "next_obs", "t")
 
-    def __init__(self, action_mask: bool = False):
-        """``action_mask``: sample among the actions each state's ``info["action_mask"]`` allows, and record
-        those masks (the batch's ``"mask"``, bool ``(T, N, K)``) for the update's probabilities."""
-        self.action_mask = action_mask
+    def __init__(self, algo):
+        """``algo``: the algorithm, whose ``policy`` (a :class:`~pamdp.policies.HybridPolicy`) acts in its
+        ``vec_env`` on its device, from its random streams. With the ``action_mask`` setting the policy samples
+        among the actions each state's ``info["action_mask"]`` allows, and the batch records those masks
+        (``"mask"``, bool ``(T, N, K)``) for the update's probabilities."""
+        self.algo = algo
+        self.action_mask = algo.config.action_mask
         # (observation, autoreset pending, step within episode, allowed actions or None) of every copy between epochs
         self.state: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None] | None = None
         self.tracker: EpisodeTracker | None = None
 
-    def collect(
-        self,
-        env,
-        policy: HybridPolicy,
-        hybrid: HybridActionSpace,
-        n_samples: int,
-        np_rng: np.random.Generator,
-        torch_gen: torch.Generator,
-    ) -> dict[str, np.ndarray]:
-        """Step ``env`` with ``(a, x) ~ policy`` until ``n_samples`` valid samples; ``(T, N, ...)`` arrays of
+    def collect(self, n_samples: int) -> dict[str, np.ndarray]:
+        """Step the env with ``(a, x) ~ policy`` until ``n_samples`` valid samples; ``(T, N, ...)`` arrays of
         :attr:`KEYS` (``t``: the step within the episode; ``terminated`` and ``done`` are false when not valid),
         and ``mask`` with ``action_mask``.
 
-        The policy runs on ``torch_gen``'s device (the algorithm's) and the env on the CPU: a step moves the
-        observations there and the actions back, nothing else.
+        The policy runs on the algorithm's device and the env on the CPU: a step moves the observations there and
+        the actions back, nothing else.
         """
-        n, device = env.num_envs, torch_gen.device
+        algo = self.algo
+        env, policy, hybrid, np_rng, torch_gen, device = (
+            algo.vec_env,
+            algo.policy,
+            algo.hybrid,
+            algo.np_rng,
+            algo.torch_gen,
+            algo.device,
+        )
+        n = env.num_envs
         masks_of = lambda info: (  # noqa: E731
             info_action_masks(info, n, hybrid.n_actions) if self.action_mask else None
         )
@@ -193,10 +196,9 @@ def mask_tensor(data: dict[str, np.ndarray], device: torch.device | str = "cpu")
     return torch.as_tensor(data["mask"], device=device) if "mask" in data else None
 
 
-def network_values(value: torch.nn.Module, obs: np.ndarray) -> np.ndarray:
-    """A value network's ``V(s)`` of a batch of observations (computed on the network's device), as float64 for
-    GAE."""
-    device = next(value.parameters()).device
+def network_values(value: torch.nn.Module, obs: np.ndarray, device: torch.device) -> np.ndarray:
+    """A value network's ``V(s)`` of a batch of observations (computed on ``device``, the network's), as float64
+    for GAE."""
     with torch.no_grad():
         return value(torch.as_tensor(np.asarray(obs, dtype=np.float32), device=device)).double().cpu().numpy()
 

@@ -49,7 +49,6 @@ from pamdp.algos.offpolicy import (
     shared_setting,
     soft_updater,
 )
-from pamdp.algos.replay import ReplayBuffer, transition_fields
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, at_least, interval, one_of, setting
 from pamdp.distributions import masked_logits
 from pamdp.policies import ACTIVATIONS, mlp
@@ -172,15 +171,13 @@ class PADDPG(Algorithm):
         # fused: one kernel per step instead of a dozen foreach passes (benchmarks/offpolicy_speed.md).
         self.actor_optimizer = torch.optim.Adam(self.actor.parameters(), lr=cfg.actor_lr, betas=betas, fused=True)
         self.critic_optimizer = torch.optim.Adam(self.critic.parameters(), lr=cfg.critic_lr, betas=betas, fused=True)
-        fields = transition_fields(
-            self.obs_dim,
-            h.max_param_size,
-            mc_returns=cfg.beta > 0,  # the loop fills them only when asked to compute Monte-Carlo returns
-            masks=h.n_actions if cfg.action_mask else 0,
+        self.loop = OffPolicyLoop(
+            self,
+            mc_returns=cfg.beta > 0,
+            tail_value=self._target_value,
             out=((self.out_size,), np.float32),  # the output vector the critic sees (after exploration)
         )
-        self.replay = ReplayBuffer(cfg.buffer_size, fields, self.device)
-        self.loop = OffPolicyLoop(cfg, h, self.replay, mc_returns=cfg.beta > 0, tail_value=self._target_value)
+        self.replay = self.loop.buffer
         self._ou = OUNoise(cfg.ou_theta, cfg.ou_sigma)
 
     def _bind_networks(self) -> None:
@@ -199,12 +196,6 @@ class PADDPG(Algorithm):
 
     def _optimizers(self):
         return {"actor": self.actor_optimizer, "critic": self.critic_optimizer}
-
-    def _extra_state(self, replay):
-        return {"loop": self.loop.state_dict(replay)}
-
-    def _load_extra_state(self, state):
-        self.loop.load_state_dict(state["loop"])
 
     def _act(self, obs, deterministic, mask=None):
         out = self.actor(obs).clamp(-1.0, 1.0)
@@ -247,10 +238,8 @@ class PADDPG(Algorithm):
             o, mask = self._from_numpy(obs), None if mask is None else self._from_numpy(mask)
             return self.critic_target(o, self._masked(self.actor_target(o).clamp(-1.0, 1.0), mask)).cpu().numpy()
 
-    def _run_epoch(self) -> dict[str, float]:
-        stats = self.loop.run_epoch(self.vec_env, self._explore, self._update, self.num_timesteps, self.np_rng)
-        stats["train/epsilon"] = self.epsilon(self.num_timesteps + stats["steps"])
-        return stats
+    def _epoch_stats(self, step: int) -> dict[str, float]:
+        return {"train/epsilon": self.epsilon(step)}
 
     def _update(self) -> dict[str, float]:
         """One critic step on the mixed target and one actor step along the bounded ``dQ/dmu``, back-propagated

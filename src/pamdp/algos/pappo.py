@@ -181,7 +181,7 @@ class PAPPO(Algorithm):
         )
         self.value = ValueNetwork(self.obs_dim, cfg.vf_hidden_sizes)
         self.optimizer = torch.optim.Adam([*self.policy.parameters(), *self.value.parameters()], lr=cfg.lr)
-        self.rollout = Rollout(cfg.action_mask)  # a loaded model starts new episodes
+        self.loop = Rollout(self)  # a loaded model starts new episodes
 
     def _modules(self):
         return {"policy": self.policy, "value": self.value}
@@ -193,18 +193,16 @@ class PAPPO(Algorithm):
         return self.policy.act(obs, mask, deterministic, self.torch_gen)
 
     def _values(self, obs: np.ndarray, t: np.ndarray) -> np.ndarray:
-        return network_values(self.value, obs)
+        return network_values(self.value, obs, self.device)
 
     def _run_epoch(self) -> dict[str, float]:
         cfg = self.config
-        batch = self.rollout.collect(
-            self.vec_env, self.policy, self.hybrid, cfg.batch_size, self.np_rng, self.torch_gen
-        )
+        batch = self.loop.collect(cfg.batch_size)
         data, explained_var = advantage_batch(batch, self._values, cfg.gamma, cfg.gae_lambda, cfg.normalize_advantages)
         with subnormals_flushed(cfg.flush_denormal):
             returns = torch.as_tensor(data["returns"], dtype=torch.float32, device=self.device)
             stats = self._update(*update_tensors(data, self.device), returns, mask_tensor(data, self.device))
-        stats.update(self.rollout.epoch_stats(data["a"], self.hybrid.n_actions, explained_var))
+        stats.update(self.loop.epoch_stats(data["a"], self.hybrid.n_actions, explained_var))
         return stats
 
     def _update(self, obs, a, x, adv, returns, mask=None) -> dict[str, float]:

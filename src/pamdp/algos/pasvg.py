@@ -47,7 +47,6 @@ from pamdp.algos.offpolicy import (
     soft_updater,
     uniform_actions,
 )
-from pamdp.algos.replay import ReplayBuffer, transition_fields
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
 from pamdp.distributions import masked_logits
 from pamdp.policies import ACTIVATIONS, every_action_linear, mlp
@@ -370,16 +369,13 @@ class PASVG0(Algorithm):
             self.entropy_weight = EntropyWeight(cfg.entropy_coef)
             self.entropy_optimizer = torch.optim.Adam(self.entropy_weight.parameters(), lr=cfg.entropy_lr)
         K, m = h.n_actions, h.max_param_size
-        fields = transition_fields(
-            self.obs_dim,
-            m,
-            masks=K if cfg.action_mask else 0,
+        self.loop = OffPolicyLoop(
+            self,
             a_in=((K,), np.float32),  # the critic's action input: one-hot, or the soft sample
             eta_a=((K,), np.float32),
             eta_x=((m,), np.float32),
         )
-        self.replay = ReplayBuffer(cfg.buffer_size, fields, self.device)
-        self.loop = OffPolicyLoop(cfg, h, self.replay)
+        self.replay = self.loop.buffer
         self._bind_networks()
 
     def _bind_networks(self) -> None:
@@ -419,11 +415,10 @@ class PASVG0(Algorithm):
             optimizers["entropy_weight"] = self.entropy_optimizer
         return optimizers
 
-    def _extra_state(self, replay):
-        return {"loop": self.loop.state_dict(replay), "critic_updates": self.critic_updates}
+    def _extra_state(self):
+        return {"critic_updates": self.critic_updates}
 
     def _load_extra_state(self, state):
-        self.loop.load_state_dict(state["loop"])
         self.critic_updates = int(state.get("critic_updates", 0))  # absent from checkpoints before policy_delay
 
     def _noise(self, batch: int) -> tuple[torch.Tensor, torch.Tensor]:
@@ -450,9 +445,6 @@ class PASVG0(Algorithm):
             a_in = torch.where(flip[:, None], onehot, a_in)
             x = torch.where(flip[:, None], self.policy.params(obs, uniform, onehot, eta_x), x)
         return index, x, {"a_in": a_in.cpu().numpy(), "eta_a": eta_a.cpu().numpy(), "eta_x": eta_x.cpu().numpy()}
-
-    def _run_epoch(self) -> dict[str, float]:
-        return self.loop.run_epoch(self.vec_env, self._explore, self._update, self.num_timesteps, self.np_rng)
 
     def _target_q(self, obs: torch.Tensor, a: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
         """The target critic's ``Q'``; with ``twin_critics`` the smaller of the two target critics' values."""

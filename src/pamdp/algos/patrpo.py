@@ -172,7 +172,7 @@ class PATRPO(Algorithm):
             self.vf_optimizer = torch.optim.Adam(self.value.parameters(), lr=cfg.vf_lr)
         else:
             self.linear_baseline = LinearFeatureBaseline(self.obs_dim)
-        self.rollout = Rollout(cfg.action_mask)  # a loaded model starts new episodes
+        self.loop = Rollout(self)  # a loaded model starts new episodes
 
     def _modules(self):
         return {"policy": self.policy, **({"value": self.value} if self.config.baseline == "mlp" else {})}
@@ -180,7 +180,7 @@ class PATRPO(Algorithm):
     def _optimizers(self):
         return {"value": self.vf_optimizer} if self.config.baseline == "mlp" else {}
 
-    def _extra_state(self, replay):
+    def _extra_state(self):
         if self.config.baseline == "linear":
             return {"linear_baseline": torch.as_tensor(self.linear_baseline.coef)}
         return {}
@@ -195,14 +195,12 @@ class PATRPO(Algorithm):
     # -- one epoch -------------------------------------------------------------------------------
     def _run_epoch(self) -> dict[str, float]:
         cfg = self.config
-        batch = self.rollout.collect(
-            self.vec_env, self.policy, self.hybrid, cfg.batch_size, self.np_rng, self.torch_gen
-        )
+        batch = self.loop.collect(cfg.batch_size)
         data, explained_var = advantage_batch(batch, self._values, cfg.gamma, cfg.gae_lambda, cfg.normalize_advantages)
         with subnormals_flushed(cfg.flush_denormal):
             stats = self._update_policy(*update_tensors(data, self.device), mask_tensor(data, self.device))
             stats["losses/value_loss"] = self._fit_baseline(data["obs"], data["t"], data["returns"])
-        stats.update(self.rollout.epoch_stats(data["a"], self.hybrid.n_actions, explained_var))
+        stats.update(self.loop.epoch_stats(data["a"], self.hybrid.n_actions, explained_var))
         return stats
 
     def _update_policy(self, obs, a, x, adv, mask=None) -> dict[str, float]:
@@ -286,7 +284,7 @@ class PATRPO(Algorithm):
         """The baseline ``V(s)`` of observations at step ``t`` of their episodes."""
         if self.config.baseline == "linear":
             return self.linear_baseline.predict(obs, t)
-        return network_values(self.value, obs)
+        return network_values(self.value, obs, self.device)
 
     def _fit_baseline(self, obs: np.ndarray, t: np.ndarray, returns: np.ndarray) -> float:
         cfg = self.config

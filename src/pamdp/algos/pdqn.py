@@ -53,7 +53,6 @@ from pamdp.algos.offpolicy import (
     soft_update,
     uniform_actions,
 )
-from pamdp.algos.replay import ReplayBuffer, transition_fields
 from pamdp.algos.settings import (
     LAYERS,
     NON_NEGATIVE,
@@ -293,15 +292,13 @@ class PDQN(Algorithm):
         self.actor_optimizer = torch.optim.Adam(self.actor.parameters(), lr=cfg.actor_lr, fused=True)
         self.q_optimizer = torch.optim.Adam(self.q_net.parameters(), lr=cfg.q_lr, fused=True)
         self.blocks = torch.as_tensor(param_blocks(h), device=self.device)
-        fields = transition_fields(
-            self.obs_dim,
-            h.max_param_size,
+        self.loop = OffPolicyLoop(
+            self,
             mc_returns=cfg.beta > 0,
-            masks=h.n_actions if cfg.action_mask else 0,
+            tail_value=self._target_value,
             params=((h.total_param_size,), np.float32),  # every action's, after exploration: what Q learns on
         )
-        self.replay = ReplayBuffer(cfg.buffer_size, fields, self.device)
-        self.loop = OffPolicyLoop(cfg, h, self.replay, mc_returns=cfg.beta > 0, tail_value=self._target_value)
+        self.replay = self.loop.buffer
         self._ou = OUNoise(cfg.ou_theta, cfg.ou_sigma)
 
     def _modules(self):
@@ -309,12 +306,6 @@ class PDQN(Algorithm):
 
     def _optimizers(self):
         return {"actor": self.actor_optimizer, "q_net": self.q_optimizer}
-
-    def _extra_state(self, replay):
-        return {"loop": self.loop.state_dict(replay)}
-
-    def _load_extra_state(self, state):
-        self.loop.load_state_dict(state["loop"])
 
     # -- acting ----------------------------------------------------------------------------------
     def _act(self, obs, deterministic, mask=None):
@@ -361,10 +352,8 @@ class PDQN(Algorithm):
         return masked_logits(self.q_target(obs, self.actor_target(obs).clamp(-1.0, 1.0)), mask).max(-1).values
 
     # -- learning --------------------------------------------------------------------------------
-    def _run_epoch(self) -> dict[str, float]:
-        stats = self.loop.run_epoch(self.vec_env, self._explore, self._update, self.num_timesteps, self.np_rng)
-        stats["train/epsilon"] = self.epsilon(self.num_timesteps + stats["steps"])
-        return stats
+    def _epoch_stats(self, step: int) -> dict[str, float]:
+        return {"train/epsilon": self.epsilon(step)}
 
     def _update(self) -> dict[str, float]:
         """One TD step of the Q-network, one actor step along the bounded ``d sum_k Q_k / dx``, soft target updates."""
