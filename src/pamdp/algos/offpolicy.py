@@ -30,11 +30,10 @@ import numpy as np
 import torch
 from torch import nn
 
-from pamdp.algos.logger import EpisodeTracker
 from pamdp.algos.replay import ReplayBuffer, transition_fields
 from pamdp.algos.settings import NON_NEGATIVE, POSITIVE, at_least, interval, setting
 from pamdp.algos.subnormals import subnormals_flushed
-from pamdp.algos.vector_env import info_action_masks
+from pamdp.algos.vector_env import Step, VectorStepper
 from pamdp.distributions import masked_logits
 
 __all__ = [
@@ -352,102 +351,82 @@ class OffPolicyLoop:
         self.mc_returns = mc_returns
         self.tail_value = tail_value
         self.update_credit = 0.0
-        self.obs: np.ndarray | None = None  # the env's current observations; None until the first reset
-        self.masks: np.ndarray | None = None  # their allowed actions (N, K), with the action_mask setting
-
-    def _start(self, env, np_rng: np.random.Generator) -> None:
-        self.env = env
-        self.num_envs = env.num_envs
-        self.tracker = EpisodeTracker(self.num_envs)
-        self.prev_done = np.zeros(self.num_envs, dtype=bool)
-        self.episode_start = np.ones(self.num_envs, dtype=bool)
-        self._pending: list[tuple[list[int], list[float]]] = [([], []) for _ in range(self.num_envs)]
-        self.obs, info = env.reset(seed=int(np_rng.integers(2**31 - 1)))
-        self.masks = self._masks(info)
-
-    def _masks(self, info: dict) -> np.ndarray | None:
-        """The allowed actions of each copy's new observation, with the action_mask setting (else ``None``)."""
-        if not self.config.action_mask:
-            return None
-        return info_action_masks(info, self.num_envs, self.hybrid.n_actions)
+        self.stepper: VectorStepper | None = None  # the env's copies, from the first epoch on
 
     def run_epoch(self) -> dict[str, float]:
         """Collect at least ``config.epoch_steps`` valid transitions, updating as they arrive; returns the epoch's
         stats with the algorithm's ``_epoch_stats`` at its end (``_explore`` gets the running count of samples)."""
-        cfg, algo = self.config, self.algo
-        act, update, start_step, np_rng = algo._explore, algo._update, algo.num_timesteps, algo.np_rng
-        env, device = algo.vec_env, algo.device
-        n_samples, learning_starts, updates_per_step = cfg.epoch_steps, cfg.learning_starts, cfg.updates_per_step
-        if self.obs is None:
-            self._start(env, np_rng)
-        counts = np.zeros(self.hybrid.n_actions, dtype=np.int64)
+        cfg, algo, n_actions = self.config, self.algo, self.hybrid.n_actions
+        act, update, start_step, device = algo._explore, algo._update, algo.num_timesteps, algo.device
+        if self.stepper is None:
+            env = algo.vec_env
+            self.stepper = VectorStepper(env, n_actions, cfg.action_mask, int(algo.np_rng.integers(2**31 - 1)))
+            self.episode_start = np.ones(env.num_envs, dtype=bool)
+            self._pending: list[tuple[list[int], list[float]]] = [([], []) for _ in range(env.num_envs)]
+        stepper = self.stepper
+        counts = np.zeros(n_actions, dtype=np.int64)
         sums: dict[str, float] = {}
         reported: dict[str, int] = {}  # per key: the updates that computed it (some run every few updates only)
         n_updates = n_valid = 0
-        while n_valid < n_samples:
-            obs = np.asarray(self.obs, dtype=np.float32)
-            mask = None if self.masks is None else torch.from_numpy(self.masks).to(device)
+        while n_valid < cfg.epoch_steps:
+            obs = torch.from_numpy(np.asarray(stepper.obs, dtype=np.float32))
+            mask = None if stepper.masks is None else torch.from_numpy(stepper.masks).to(device)
             with torch.no_grad():  # the observations to the algorithm's device, the actions back
-                a, x, extras = act(torch.from_numpy(obs).to(device), start_step + n_valid, self.episode_start, mask)
+                a, x, extras = act(obs.to(device), start_step + n_valid, self.episode_start, mask)
             a, x = a.cpu().numpy(), x.cpu().numpy()
-            next_obs, reward, terminated, truncated, info = self.env.step(self.hybrid.to_env_batch(a, x))
-            next_masks = self._masks(info)
-            valid = ~self.prev_done
-            done = (terminated | truncated) & valid
-            self.tracker.step(np.asarray(reward, dtype=np.float64), done, valid, info)
-            if valid.any():
-                row = {
-                    "obs": obs[valid],
-                    "a": a[valid],
-                    "x": x[valid],
-                    "reward": (np.asarray(reward, dtype=np.float64) * cfg.reward_scale).astype(np.float32)[valid],
-                    "next_obs": np.asarray(next_obs, dtype=np.float32)[valid],
-                    "terminated": (terminated & valid)[valid],
-                    **{k: v[valid] for k, v in extras.items()},
-                }
-                if self.mc_returns:
-                    row["mc"] = np.full(int(valid.sum()), np.nan, dtype=np.float32)
-                if next_masks is not None:
-                    row["mask"], row["next_mask"] = self.masks[valid], next_masks[valid]
-                counters = self.buffer.add(**row)
-                if self.mc_returns:
-                    self._finish_returns(counters, valid, reward, terminated, done, next_obs, next_masks)
-                counts += np.bincount(a[valid], minlength=self.hybrid.n_actions)
-                n = int(valid.sum())
-                n_valid += n
-                if len(self.buffer) >= learning_starts:
-                    self.update_credit += updates_per_step * n
-                    with subnormals_flushed(cfg.flush_denormal):
-                        while self.update_credit >= 1.0:
-                            self.update_credit -= 1.0
-                            for k, v in update().items():
-                                sums[k] = sums.get(k, 0.0) + v
-                                reported[k] = reported.get(k, 0) + 1
-                            n_updates += 1
+            step = stepper.step(self.hybrid.to_env_batch(a, x))
+            valid = step.valid
             self.episode_start = ~valid
-            self.prev_done = done
-            self.obs, self.masks = next_obs, next_masks
+            if not valid.any():
+                continue
+            row = {
+                "obs": obs.numpy()[valid],
+                "a": a[valid],
+                "x": x[valid],
+                "reward": (np.asarray(step.reward, dtype=np.float64) * cfg.reward_scale).astype(np.float32)[valid],
+                "next_obs": np.asarray(step.next_obs, dtype=np.float32)[valid],
+                "terminated": step.terminated[valid],
+                **{k: v[valid] for k, v in extras.items()},
+            }
+            if self.mc_returns:
+                row["mc"] = np.full(int(valid.sum()), np.nan, dtype=np.float32)
+            if step.masks is not None:
+                row["mask"], row["next_mask"] = step.masks[valid], step.next_masks[valid]
+            counters = self.buffer.add(**row)
+            if self.mc_returns:
+                self._finish_returns(counters, step)
+            counts += np.bincount(a[valid], minlength=n_actions)
+            n = int(valid.sum())
+            n_valid += n
+            if len(self.buffer) >= cfg.learning_starts:
+                self.update_credit += cfg.updates_per_step * n
+                with subnormals_flushed(cfg.flush_denormal):
+                    while self.update_credit >= 1.0:
+                        self.update_credit -= 1.0
+                        for k, v in update().items():
+                            sums[k] = sums.get(k, 0.0) + v
+                            reported[k] = reported.get(k, 0) + 1
+                        n_updates += 1
         stats = {k: v / reported[k] for k, v in sums.items()}
         stats["train/updates"] = float(n_updates)
         stats["train/buffer_size"] = float(len(self.buffer))
         stats.update({f"train/action_freq_{k}": float(c) / n_valid for k, c in enumerate(counts)})
-        stats.update(self.tracker.pop())
+        stats.update(stepper.episodes.pop())
         stats["steps"] = n_valid
         stats.update(algo._epoch_stats(start_step + n_valid))
         return stats
 
-    def _finish_returns(self, counters, valid, reward, terminated, done, next_obs, next_masks) -> None:
+    def _finish_returns(self, counters: np.ndarray, step: Step) -> None:
         """Queue this step's transitions per env copy; write their Monte-Carlo returns when episodes end."""
-        ended = np.flatnonzero(done)
-        tails = np.zeros(self.num_envs)
-        cut = [i for i in ended if not terminated[i]]
+        ended = step.ended
+        tails = np.zeros(len(step.done))
+        cut = [i for i in ended if not step.terminated[i]]
         if cut and self.tail_value is not None:
-            tails[cut] = self.tail_value(
-                np.asarray(next_obs, dtype=np.float32)[cut], None if next_masks is None else next_masks[cut]
-            )
-        for c, i in zip(counters, np.flatnonzero(valid)):
+            masks = None if step.next_masks is None else step.next_masks[cut]
+            tails[cut] = self.tail_value(np.asarray(step.next_obs, dtype=np.float32)[cut], masks)
+        for c, i in zip(counters, np.flatnonzero(step.valid)):
             self._pending[i][0].append(int(c))
-            self._pending[i][1].append(float(reward[i]) * self.config.reward_scale)  # on the critics' scale
+            self._pending[i][1].append(float(step.reward[i]) * self.config.reward_scale)  # on the critics' scale
         for i in ended:
             stored, rewards = self._pending[i]
             returns = discounted_returns(np.asarray(rewards), self.config.gamma, float(tails[i]))

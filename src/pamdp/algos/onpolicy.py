@@ -13,9 +13,8 @@ from collections.abc import Callable
 import numpy as np
 import torch
 
-from pamdp.algos.logger import EpisodeTracker
 from pamdp.algos.settings import one_of, setting
-from pamdp.algos.vector_env import info_action_masks
+from pamdp.algos.vector_env import VectorStepper
 from pamdp.policies import PI_C_INPUTS
 
 __all__ = [
@@ -82,9 +81,7 @@ class Rollout:
         (``"mask"``, bool ``(T, N, K)``) for the update's probabilities."""
         self.algo = algo
         self.action_mask = algo.config.action_mask
-        # (observation, autoreset pending, step within episode, allowed actions or None) of every copy between epochs
-        self.state: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None] | None = None
-        self.tracker: EpisodeTracker | None = None
+        self.stepper: VectorStepper | None = None  # the env's copies, from the first epoch on
 
     def collect(self, n_samples: int) -> dict[str, np.ndarray]:
         """Step the env with ``(a, x) ~ policy`` until ``n_samples`` valid samples; ``(T, N, ...)`` arrays of
@@ -95,44 +92,28 @@ class Rollout:
         the actions back, nothing else.
         """
         algo = self.algo
-        env, policy, hybrid, np_rng, torch_gen, device = (
-            algo.vec_env,
-            algo.policy,
-            algo.hybrid,
-            algo.np_rng,
-            algo.torch_gen,
-            algo.device,
-        )
-        n = env.num_envs
-        masks_of = lambda info: (  # noqa: E731
-            info_action_masks(info, n, hybrid.n_actions) if self.action_mask else None
-        )
-        if self.state is None:
-            obs, info = env.reset(seed=int(np_rng.integers(2**31 - 1)))
-            self.state = (obs, np.zeros(n, dtype=bool), np.zeros(n, dtype=np.int64), masks_of(info))
-            self.tracker = EpisodeTracker(n)
-        obs, prev_done, t_ep, masks = self.state
+        if self.stepper is None:
+            env = algo.vec_env
+            seed = int(algo.np_rng.integers(2**31 - 1))
+            self.stepper = VectorStepper(env, algo.hybrid.n_actions, self.action_mask, seed)
+            self.t_ep = np.zeros(env.num_envs, dtype=np.int64)
+        stepper, device = self.stepper, algo.device
         rows: dict[str, list] = {k: [] for k in self.KEYS + (("mask",) if self.action_mask else ())}
         n_valid = 0
         while n_valid < n_samples:
             with torch.no_grad():
-                mask = None if masks is None else torch.from_numpy(masks).to(device)
-                obs_t = torch.as_tensor(np.asarray(obs, dtype=np.float32), device=device)
-                a, x = policy.act(obs_t, mask, False, torch_gen)
+                mask = None if stepper.masks is None else torch.from_numpy(stepper.masks).to(device)
+                obs_t = torch.as_tensor(np.asarray(stepper.obs, dtype=np.float32), device=device)
+                a, x = algo.policy.act(obs_t, mask, False, algo.torch_gen)
             a, x = a.cpu().numpy(), x.cpu().numpy()
-            next_obs, reward, terminated, truncated, info = env.step(hybrid.to_env_batch(a, x))
-            valid = ~prev_done
-            done = (terminated | truncated) & valid
-            row = (obs, a, x, reward, terminated & valid, done, valid, next_obs, t_ep)
+            step = stepper.step(algo.hybrid.to_env_batch(a, x))
+            row = (step.obs, a, x, step.reward, step.terminated, step.done, step.valid, step.next_obs, self.t_ep)
             for k, v in zip(self.KEYS, row):
                 rows[k].append(np.array(v))
-            if masks is not None:
-                rows["mask"].append(masks)
-            self.tracker.step(np.asarray(reward, dtype=np.float64), done, valid, info)
-            n_valid += int(valid.sum())
-            t_ep = np.where(valid, t_ep + 1, 0)
-            prev_done, obs, masks = done, next_obs, masks_of(info)
-        self.state = (obs, prev_done, t_ep, masks)
+            if step.masks is not None:
+                rows["mask"].append(step.masks)
+            n_valid += int(step.valid.sum())
+            self.t_ep = np.where(step.valid, self.t_ep + 1, 0)
         return {k: np.stack(v) for k, v in rows.items()}
 
     def epoch_stats(self, a: np.ndarray, n_actions: int, explained_var: float) -> dict[str, float]:
@@ -141,7 +122,7 @@ class Rollout:
         freq = np.bincount(a, minlength=n_actions) / len(a)
         stats = {"train/explained_variance": explained_var}
         stats.update({f"train/action_freq_{k}": float(f) for k, f in enumerate(freq)})
-        stats.update(self.tracker.pop())
+        stats.update(self.stepper.episodes.pop())
         stats["steps"] = len(a)
         return stats
 
