@@ -238,9 +238,10 @@ def test_td3_critic_loss_by_hand_and_the_policy_delay():
     m.n_updates = 10  # the next update (11) is odd: critics only
     with torch.no_grad():
         latent, _ = m.relabel(b)
-        q1n, q2n = m.critic_target(b["next_obs"], m.actor_target.to_latent(m.actor_target(b["next_obs"])))
+        latent_next = m.actor_target.to_latent(m.actor_target(b["next_obs"]))
+        q1n, q2n = (q.squeeze(-1) for q in m.critic_target(b["next_obs"], latent_next))
         y = b["reward"] + m.config.gamma * (~b["terminated"]).float() * torch.minimum(q1n, q2n)
-        q1, q2 = m.critic(b["obs"], latent)
+        q1, q2 = (q.squeeze(-1) for q in m.critic(b["obs"], latent))
         expected = ((q1 - y) ** 2).mean() + ((q2 - y) ** 2).mean()
     actor_before = [p.clone() for p in m.actor.parameters()]
     target_before = [p.clone() for p in m.critic_target.parameters()]

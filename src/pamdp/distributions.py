@@ -24,6 +24,8 @@ import torch.nn.functional as F
 __all__ = [
     "HybridDistribution",
     "KL_ESTIMATORS",
+    "LOG_STD_MIN",
+    "LOG_STD_MAX",
     "MASKED",
     "draw_action",
     "draw_params",
@@ -36,6 +38,10 @@ _LOG_2PI = math.log(2.0 * math.pi)
 # What a masked action's logit (or Q-value) becomes: finite, so that softmax gives it probability 0 exactly and
 # p * log p stays 0 (not 0 * -inf = NaN), and far below any logit or return the networks produce.
 MASKED = -1e9
+LOG_STD_MIN, LOG_STD_MAX = -5.0, 2.0
+"""The range a learned log standard deviation is clamped to where a network or a free parameter outputs it (the
+off-policy policies and HyAR's encoder), as Spinning Up's and SAC's reference code clamp theirs: wide enough for
+any useful noise, narrow enough that ``exp`` neither vanishes nor explodes."""
 
 
 def masked_logits(logits: torch.Tensor, mask: torch.Tensor | None) -> torch.Tensor:

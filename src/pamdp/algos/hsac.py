@@ -49,23 +49,23 @@ from pamdp.algos.base import Algorithm
 from pamdp.algos.offpolicy import (
     OffPolicyConfig,
     OffPolicyLoop,
+    TwinQ,
     gradient_step,
     optimizer_step,
     shared_setting,
     soft_updater,
 )
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
-from pamdp.distributions import MASKED, masked_logits
+from pamdp.distributions import LOG_STD_MAX, LOG_STD_MIN, MASKED, masked_logits
 from pamdp.policies import ACTIVATIONS, every_action_linear, mlp
 from pamdp.spaces import HybridActionSpace
 
 if TYPE_CHECKING:
     from typing_extensions import Self
 
-__all__ = ["HybridSAC", "HybridSACConfig", "SquashedHybrid", "HybridSACActor", "TwinQ", "temperature_gradient"]
+__all__ = ["HybridSAC", "HybridSACConfig", "SquashedHybrid", "HybridSACActor", "temperature_gradient"]
 
 FORMS = ("flat", "hierarchical")
-LOG_STD_MIN, LOG_STD_MAX = -5.0, 2.0
 _LOG_2PI = math.log(2.0 * math.pi)
 
 
@@ -245,20 +245,6 @@ class HybridSACActor(nn.Module):
         return x.reshape(x.shape[0], -1)[:, self.flat_index]
 
 
-class TwinQ(nn.Module):
-    """Two critics ``Q_i(s, x_all)``, each with K outputs: ``Q_i(s, a, x_all)`` for every discrete action ``a``."""
-
-    def __init__(self, obs_dim: int, hybrid: HybridActionSpace, hidden_sizes, activation: str):
-        super().__init__()
-        size = obs_dim + hybrid.total_param_size
-        self.q1 = mlp(size, hidden_sizes, hybrid.n_actions, activation)
-        self.q2 = mlp(size, hidden_sizes, hybrid.n_actions, activation)
-
-    def forward(self, obs: torch.Tensor, params: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
-        inp = torch.cat([obs, params], dim=-1)
-        return self.q1(inp), self.q2(inp)
-
-
 class Temperatures(nn.Module):
     """The log-temperatures ``log alpha_d`` and ``log alpha_c`` of the two entropy terms."""
 
@@ -287,7 +273,8 @@ class HybridSAC(Algorithm):
     def _build(self) -> None:
         cfg, h = self.config, self.hybrid
         self.actor = HybridSACActor(self.obs_dim, h, cfg.form, cfg.hidden_sizes, cfg.activation)
-        self.critic = TwinQ(self.obs_dim, h, cfg.hidden_sizes, cfg.activation)
+        # Q_i(s, x_all) with one output per discrete action, Q_i(s, a, x_all)
+        self.critic = TwinQ(self.obs_dim + h.total_param_size, h.n_actions, cfg.hidden_sizes, cfg.activation)
         self.critic_target = copy.deepcopy(self.critic).requires_grad_(False)
         self.temperatures = Temperatures(cfg.init_alpha_d, cfg.init_alpha_c)
         self.actor_optimizer = torch.optim.Adam(self.actor.parameters(), lr=cfg.actor_lr, fused=True)

@@ -53,6 +53,7 @@ from pamdp.algos.base import Algorithm
 from pamdp.algos.offpolicy import (
     OffPolicyConfig,
     OffPolicyLoop,
+    TwinQ,
     backprop_actor,
     clipped_step,
     linear_epsilon,
@@ -61,7 +62,7 @@ from pamdp.algos.offpolicy import (
     uniform_actions,
 )
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, at_least, interval, one_of, setting
-from pamdp.distributions import masked_logits
+from pamdp.distributions import LOG_STD_MAX, LOG_STD_MIN, masked_logits
 from pamdp.policies import ACTIVATIONS, mlp
 from pamdp.spaces import HybridActionSpace
 
@@ -247,7 +248,7 @@ class ActionRepresentation(nn.Module):
         """Mean and log-std of ``q(z | x, s, e_a)``."""
         out = self.encoder(torch.cat([obs, x * self.mask[a], self.embedding[a]], dim=-1))
         mean, log_std = out.split(self.latent_dim, dim=-1)
-        return mean, log_std.clamp(-5.0, 2.0)
+        return mean, log_std.clamp(LOG_STD_MIN, LOG_STD_MAX)
 
     def _trunk(self, obs: torch.Tensor, a: torch.Tensor, z: torch.Tensor) -> torch.Tensor:
         return self.act(self.decoder(torch.cat([obs, z, self.embedding[a]], dim=-1)))
@@ -324,19 +325,6 @@ class LatentActor(nn.Module):
         return self.low + (u + 1.0) * 0.5 * (self.high - self.low)
 
 
-class TwinCritic(nn.Module):
-    """TD3's two critics ``Q_1, Q_2(s, e, z)`` on the latent action."""
-
-    def __init__(self, obs_dim: int, size: int, hidden_sizes, activation: str):
-        super().__init__()
-        self.q1 = mlp(obs_dim + size, hidden_sizes, 1, activation)
-        self.q2 = mlp(obs_dim + size, hidden_sizes, 1, activation)
-
-    def forward(self, obs: torch.Tensor, latent: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
-        inp = torch.cat([obs, latent], dim=-1)
-        return self.q1(inp).squeeze(-1), self.q2(inp).squeeze(-1)
-
-
 class HyAR(Algorithm):
     """HyAR-TD3 (Li et al. 2022): TD3 in a learned hybrid action representation. See :class:`HyARConfig`."""
 
@@ -351,7 +339,7 @@ class HyAR(Algorithm):
         )
         squash = cfg.bound == "squash"
         self.actor = LatentActor(self.obs_dim, self.latent_size, cfg.hidden_sizes, cfg.activation, squash)
-        self.critic = TwinCritic(self.obs_dim, self.latent_size, cfg.hidden_sizes, cfg.activation)
+        self.critic = TwinQ(self.obs_dim + self.latent_size, 1, cfg.hidden_sizes, cfg.activation)  # Q_i(s, e, z)
         self.actor_target = copy.deepcopy(self.actor).requires_grad_(False)
         self.critic_target = copy.deepcopy(self.critic).requires_grad_(False)
         self.rep_optimizer = torch.optim.Adam(self.rep.parameters(), lr=cfg.vae_lr, fused=True)
@@ -527,9 +515,9 @@ class HyAR(Algorithm):
             noise = torch.randn(u_next.shape, generator=self.torch_gen, device=self.device) * cfg.target_noise
             u_next = (u_next + noise.clamp(-cfg.target_noise_clip, cfg.target_noise_clip)).clamp(-1.0, 1.0)
             latent_next = self.rep.snap(self.actor_target.to_latent(u_next), b.get("next_mask"))
-            q1_next, q2_next = self.critic_target(next_obs, latent_next)
+            q1_next, q2_next = (q.squeeze(-1) for q in self.critic_target(next_obs, latent_next))
             y = b["reward"] + cfg.gamma * (~b["terminated"]).float() * torch.minimum(q1_next, q2_next)
-        q1, q2 = self.critic(obs, latent)
+        q1, q2 = (q.squeeze(-1) for q in self.critic(obs, latent))
         critic_loss = F.mse_loss(q1, y) + F.mse_loss(q2, y)
         self.critic_optimizer.zero_grad(set_to_none=True)
         critic_loss.backward()

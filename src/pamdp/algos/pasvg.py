@@ -48,7 +48,7 @@ from pamdp.algos.offpolicy import (
     uniform_actions,
 )
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
-from pamdp.distributions import masked_logits
+from pamdp.distributions import LOG_STD_MAX, LOG_STD_MIN, masked_logits
 from pamdp.policies import ACTIVATIONS, every_action_linear, mlp
 from pamdp.spaces import HybridActionSpace
 
@@ -56,8 +56,6 @@ if TYPE_CHECKING:
     from typing_extensions import Self
 
 __all__ = ["PASVG0", "PASVG0Config", "GumbelHybridPolicy", "expected_q", "gumbel_noise", "gumbel_softmax_sample"]
-
-LOG_STD_MIN, LOG_STD_MAX = -5.0, 2.0
 
 
 @dataclasses.dataclass(frozen=True)
