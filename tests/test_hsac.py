@@ -13,7 +13,8 @@ from gymnasium import spaces
 from torch.distributions import Normal, TanhTransform, TransformedDistribution
 
 from pamdp import HybridSAC
-from pamdp.algos.hsac import HybridSACActor, HybridSACConfig, SquashedHybrid, temperature_gradient
+from pamdp.algos.hsac import HybridSACActor, HybridSACConfig, SquashedHybrid
+from pamdp.algos.offpolicy import temperature_gradient
 from pamdp.spaces import HybridActionSpace
 
 SMALL = HybridSACConfig(

@@ -49,11 +49,13 @@ from pamdp.algos.base import Algorithm
 from pamdp.algos.offpolicy import (
     OffPolicyConfig,
     OffPolicyLoop,
+    Temperatures,
     TwinQ,
     gradient_step,
     optimizer_step,
     shared_setting,
     soft_updater,
+    temperature_gradient,
 )
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
 from pamdp.distributions import LOG_STD_MAX, LOG_STD_MIN, MASKED, masked_logits
@@ -63,7 +65,7 @@ from pamdp.spaces import HybridActionSpace
 if TYPE_CHECKING:
     from typing_extensions import Self
 
-__all__ = ["HybridSAC", "HybridSACConfig", "SquashedHybrid", "HybridSACActor", "temperature_gradient"]
+__all__ = ["HybridSAC", "HybridSACConfig", "SquashedHybrid", "HybridSACActor"]
 
 FORMS = ("flat", "hierarchical")
 _LOG_2PI = math.log(2.0 * math.pi)
@@ -245,25 +247,6 @@ class HybridSACActor(nn.Module):
         return x.reshape(x.shape[0], -1)[:, self.flat_index]
 
 
-class Temperatures(nn.Module):
-    """The log-temperatures ``log alpha_d`` and ``log alpha_c`` of the two entropy terms."""
-
-    def __init__(self, alpha_d: float, alpha_c: float):
-        super().__init__()
-        self.log_alpha_d = nn.Parameter(torch.tensor(math.log(alpha_d)))
-        self.log_alpha_c = nn.Parameter(torch.tensor(math.log(alpha_c)))
-
-
-def temperature_gradient(entropy: torch.Tensor, target: torch.Tensor | float) -> torch.Tensor:
-    """The gradient in ``log alpha`` of SAC's temperature loss ``mean(log alpha * (H - target))``, the entropy
-    estimates ``H`` held fixed: ``mean(H - target)``.
-
-    Descent lowers the temperature of a policy more random than its target, raises it for one less random, and
-    leaves it where the entropy meets the target.
-    """
-    return (entropy - target).mean()
-
-
 class HybridSAC(Algorithm):
     """Hybrid SAC (Delalleau et al. 2019), flat or hierarchical (``form``). See the module docstring."""
 
@@ -276,7 +259,7 @@ class HybridSAC(Algorithm):
         # Q_i(s, x_all) with one output per discrete action, Q_i(s, a, x_all)
         self.critic = TwinQ(self.obs_dim + h.total_param_size, h.n_actions, cfg.hidden_sizes, cfg.activation)
         self.critic_target = copy.deepcopy(self.critic).requires_grad_(False)
-        self.temperatures = Temperatures(cfg.init_alpha_d, cfg.init_alpha_c)
+        self.temperatures = Temperatures(alpha_d=cfg.init_alpha_d, alpha_c=cfg.init_alpha_c)
         self.actor_optimizer = torch.optim.Adam(self.actor.parameters(), lr=cfg.actor_lr, fused=True)
         self.critic_optimizer = torch.optim.Adam(self.critic.parameters(), lr=cfg.critic_lr, fused=True)
         self.alpha_optimizer = torch.optim.Adam(self.temperatures.parameters(), lr=cfg.alpha_lr, fused=True)

@@ -24,6 +24,7 @@ three ways of keeping them in ``[-1, 1]`` (spec "PADDPG") are :data:`BOUNDS`, ap
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Callable, Sequence
 
 import numpy as np
@@ -42,6 +43,8 @@ __all__ = [
     "shared_setting",
     "OffPolicyLoop",
     "TwinQ",
+    "Temperatures",
+    "temperature_gradient",
     "OUNoise",
     "soft_update",
     "soft_updater",
@@ -153,6 +156,28 @@ class TwinQ(nn.Module):
     def forward(self, obs: torch.Tensor, action: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
         inp = torch.cat([obs, action], dim=-1)
         return self.q1(inp), self.q2(inp)
+
+
+class Temperatures(nn.Module):
+    """Entropy temperatures ``alpha = exp(log alpha)``, one parameter ``log_<name>`` per keyword (its initial
+    ``alpha``), tuned by SAC's rule (Haarnoja et al. 2018, "Soft Actor-Critic Algorithms and Applications"):
+    descent along :func:`temperature_gradient`. PASVG(0) has one, for ``pi_d``; Hybrid SAC one per part."""
+
+    def __init__(self, **initial: float):
+        super().__init__()
+        for name, alpha in initial.items():
+            self.register_parameter(f"log_{name}", nn.Parameter(torch.tensor(math.log(alpha), dtype=torch.float32)))
+
+
+def temperature_gradient(entropy: torch.Tensor, target: torch.Tensor | float) -> torch.Tensor:
+    """The gradient in ``log alpha`` of SAC's temperature loss ``mean(log alpha * (H - target))``, the entropy
+    estimates ``H`` held fixed: ``mean(H - target)``.
+
+    Descent lowers the temperature of a policy more random than its target, raises it for one less random, and
+    leaves it where the entropy meets the target, so the policy keeps exploring about as much as asked however
+    the critic's values scale.
+    """
+    return (entropy - target).mean()
 
 
 class OUNoise:

@@ -41,10 +41,13 @@ from pamdp.algos.dense import Dense
 from pamdp.algos.offpolicy import (
     OffPolicyConfig,
     OffPolicyLoop,
+    Temperatures,
     clipped_step,
     gradient_step,
+    optimizer_step,
     shared_setting,
     soft_updater,
+    temperature_gradient,
     uniform_actions,
 )
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
@@ -298,22 +301,6 @@ def every_action_q(*critics: Critic) -> Callable:
     return q_all
 
 
-class EntropyWeight(nn.Module):
-    """The weight ``alpha = exp(log_alpha)`` of ``pi_d``'s entropy, tuned towards a target entropy (SAC's rule).
-
-    Its loss ``log_alpha * (H - target)`` lowers the weight while ``pi_d``'s entropy ``H`` is above the target
-    and raises it below, so the discrete policy keeps exploring about as much as asked, however the critic's
-    values scale.
-    """
-
-    def __init__(self, initial: float):
-        super().__init__()
-        self.log_alpha = nn.Parameter(torch.tensor(math.log(initial), dtype=torch.float32))
-
-    def forward(self) -> torch.Tensor:
-        return self.log_alpha.exp()
-
-
 class Critic(nn.Module):
     """``Q(s, a, x)`` with the discrete action as a one-hot (or soft sample) ``a``."""
 
@@ -364,7 +351,7 @@ class PASVG0(Algorithm):
                     f"PASVG0Config.target_entropy = {cfg.target_entropy!r}; expected at most ln K = "
                     f"{math.log(h.n_actions):.4f} nats for this env's K = {h.n_actions} actions"
                 )
-            self.entropy_weight = EntropyWeight(cfg.entropy_coef)
+            self.entropy_weight = Temperatures(alpha=cfg.entropy_coef)  # pi_d's, tuned by SAC's rule
             self.entropy_optimizer = torch.optim.Adam(self.entropy_weight.parameters(), lr=cfg.entropy_lr)
         K, m = h.n_actions, h.max_param_size
         self.loop = OffPolicyLoop(
@@ -500,7 +487,7 @@ class PASVG0(Algorithm):
             )
             q_pi = self.critic(obs, a, x)
         entropy = -(logits.softmax(-1) * logits.log_softmax(-1)).sum(-1).mean()
-        alpha = cfg.entropy_coef if self.entropy_weight is None else float(self.entropy_weight().detach())
+        alpha = cfg.entropy_coef if self.entropy_weight is None else float(self.entropy_weight.log_alpha.detach().exp())
         actor_loss = -q_pi.mean() - alpha * entropy
         # The policy loss differentiates Q in (a, x) only: asking for the policy's gradients alone skips the
         # critic's weight gradients, which backward() would compute and the critic must not receive.
@@ -509,10 +496,9 @@ class PASVG0(Algorithm):
             p.grad = g
         clipped_step(self.policy_optimizer, self.policy_params, cfg.grad_clip)
         if self.entropy_weight is not None:
-            alpha_loss = self.entropy_weight.log_alpha * (float(entropy.detach()) - cfg.target_entropy)
-            self.entropy_optimizer.zero_grad(set_to_none=True)
-            alpha_loss.backward()
-            self.entropy_optimizer.step()
+            # in double, as the loss log_alpha * (float(H) - target) it replaced: the same step
+            gradient = temperature_gradient(entropy.detach().double(), cfg.target_entropy).float()
+            optimizer_step(self.entropy_optimizer, [gradient])
         self._soft_update(cfg.tau)
         return self._policy_stats(actor_loss.detach(), q_pi, entropy.detach(), alpha)
 
