@@ -13,8 +13,9 @@ from gymnasium import spaces
 from torch.distributions import Normal, TanhTransform, TransformedDistribution
 
 from pamdp import HybridSAC
-from pamdp.algos.hsac import HybridSACActor, HybridSACConfig, SquashedHybrid
+from pamdp.algos.hsac import HybridSACActor, HybridSACConfig
 from pamdp.algos.offpolicy import temperature_gradient
+from pamdp.distributions import SquashedHybrid
 from pamdp.spaces import HybridActionSpace
 
 SMALL = HybridSACConfig(

@@ -58,17 +58,16 @@ from pamdp.algos.offpolicy import (
     temperature_gradient,
 )
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
-from pamdp.distributions import LOG_STD_MAX, LOG_STD_MIN, MASKED, masked_logits
+from pamdp.distributions import LOG_STD_MAX, LOG_STD_MIN, MASKED, SquashedHybrid, masked_logits
 from pamdp.policies import ACTIVATIONS, every_action_linear, mlp
 from pamdp.spaces import HybridActionSpace
 
 if TYPE_CHECKING:
     from typing_extensions import Self
 
-__all__ = ["HybridSAC", "HybridSACConfig", "SquashedHybrid", "HybridSACActor"]
+__all__ = ["HybridSAC", "HybridSACConfig", "HybridSACActor"]
 
 FORMS = ("flat", "hierarchical")
-_LOG_2PI = math.log(2.0 * math.pi)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -138,62 +137,6 @@ class HybridSACConfig(OffPolicyConfig, AlgoConfig):
                 tau=0.01,
             ),
         }
-
-
-@dataclasses.dataclass
-class SquashedHybrid:
-    """A batch of hybrid distributions with tanh-squashed Gaussian parameters, every action's at once.
-
-    Attributes:
-        logits: ``(B, K)`` logits of ``pi_d``, masked actions already at :data:`~pamdp.distributions.MASKED`.
-        mean: ``(B, K, m)`` means of the pre-squash Gaussians ``u``, per action and padded parameter.
-        log_std: ``(B, K, m)`` their log standard deviations.
-        param_mask: ``(K, m)`` float, 1 where action ``a`` uses padded parameter ``i``.
-    """
-
-    logits: torch.Tensor
-    mean: torch.Tensor
-    log_std: torch.Tensor
-    param_mask: torch.Tensor
-
-    @property
-    def log_probs_d(self) -> torch.Tensor:
-        """``(B, K)`` normalised ``log pi_d(a | s)``."""
-        return F.log_softmax(self.logits, dim=-1)
-
-    @property
-    def probs_d(self) -> torch.Tensor:
-        return F.softmax(self.logits, dim=-1)
-
-    def entropy_d(self) -> torch.Tensor:
-        """``(B,)`` the entropy of ``pi_d`` (masked actions contribute nothing)."""
-        return -(self.probs_d * self.log_probs_d).sum(-1)
-
-    def rsample(self, generator: torch.Generator | None = None) -> tuple[torch.Tensor, torch.Tensor]:
-        """Reparameterised pre-squash ``u`` and parameters ``x = tanh(u)`` of every action, ``(B, K, m)`` each;
-        unused entries are zero."""
-        noise = torch.randn(self.mean.shape, generator=generator, dtype=self.mean.dtype, device=self.mean.device)
-        u = (self.mean + self.log_std.exp() * noise) * self.param_mask
-        return u, torch.tanh(u)
-
-    def log_prob_c(self, u: torch.Tensor) -> torch.Tensor:
-        """``(B, K)``: ``log pi_c(tanh(u_a) | s, a)`` for every action, over its own ``m_a`` parameters only.
-
-        ``log(1 - tanh(u)^2) = 2 (log 2 - u - softplus(-2 u))``, which stays finite where ``tanh(u)`` rounds to 1.
-        """
-        z = (u - self.mean) * torch.exp(-self.log_std)
-        gaussian = -0.5 * z.pow(2) - self.log_std - 0.5 * _LOG_2PI
-        log_det = 2.0 * (math.log(2.0) - u - F.softplus(-2.0 * u))
-        return ((gaussian - log_det) * self.param_mask).sum(-1)
-
-    def sample_discrete(self, generator: torch.Generator | None = None) -> torch.Tensor:
-        """``(B,)`` actions drawn from ``pi_d``."""
-        return torch.multinomial(self.probs_d, 1, generator=generator).squeeze(-1)
-
-    def mode(self) -> tuple[torch.Tensor, torch.Tensor]:
-        """The greedy action: ``argmax_a pi_d(a | s)`` and ``tanh`` of its Gaussian's mean, ``(B,)`` and ``(B, m)``."""
-        a = self.logits.argmax(-1)
-        return a, torch.tanh(self.mean[torch.arange(len(a), device=a.device), a]) * self.param_mask[a]
 
 
 class HybridSACActor(nn.Module):
