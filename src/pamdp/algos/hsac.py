@@ -59,7 +59,7 @@ from pamdp.algos.offpolicy import (
 )
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
 from pamdp.distributions import LOG_STD_MAX, LOG_STD_MIN, MASKED, SquashedHybrid, masked_logits
-from pamdp.policies import ACTIVATIONS, every_action_linear, mlp
+from pamdp.policies import ACTIVATIONS, every_action_mlp, hierarchical_mlps, mlp, small_init_
 from pamdp.spaces import HybridActionSpace
 
 if TYPE_CHECKING:
@@ -158,16 +158,11 @@ class HybridSACActor(nn.Module):
         self.total = total = hybrid.total_param_size
         # the all-actions vector's entries in the flattened padded (K * m) layout
         self.register_buffer("flat_index", torch.tensor(np.flatnonzero(mask), dtype=torch.long))
-        if form == "flat":
+        if form == "flat":  # starts near uniform, centred, with unit noise, as the hierarchical form does
             self.net = mlp(obs_dim, hidden_sizes, self.n_actions + 2 * total, activation)
-            heads = [self.net[-1]]
+            small_init_(self.net[-1])
         else:
-            self.pi_d = mlp(obs_dim, hidden_sizes, self.n_actions, activation)
-            self.pi_c = mlp(obs_dim + self.n_actions, hidden_sizes, 2 * self.m, activation)
-            heads = [self.pi_d[-1], self.pi_c[-1]]
-        for head in heads:  # start near uniform, centred, with unit noise (as HybridPolicy does)
-            nn.init.uniform_(head.weight, -3e-3, 3e-3)
-            nn.init.zeros_(head.bias)
+            self.pi_d, self.pi_c = hierarchical_mlps(obs_dim, self.n_actions, hidden_sizes, activation, 2 * self.m)
 
     def _padded(self, flat: torch.Tensor) -> torch.Tensor:
         """``(B, sum_a m_a)`` all-actions values as ``(B, K, m)``, zero where unused."""
@@ -178,9 +173,7 @@ class HybridSACActor(nn.Module):
             logits, means, log_stds = self.net(obs).split([self.n_actions, self.total, self.total], dim=-1)
             mean, log_std = self._padded(means), self._padded(log_stds)
         else:
-            first = self.pi_c[0]  # pi_c of every one-hot, without building the B * K inputs
-            every = self.pi_c[1:](every_action_linear(obs, first.weight, first.bias))
-            mean, log_std = every.split(self.m, dim=-1)
+            mean, log_std = every_action_mlp(self.pi_c, obs).split(self.m, dim=-1)
             logits = self.pi_d(obs)
         log_std = log_std.clamp(LOG_STD_MIN, LOG_STD_MAX)
         return SquashedHybrid(masked_logits(logits, mask), mean, log_std, self.param_mask)

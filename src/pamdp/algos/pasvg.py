@@ -52,7 +52,7 @@ from pamdp.algos.offpolicy import (
 )
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
 from pamdp.distributions import LOG_STD_MAX, LOG_STD_MIN, masked_logits
-from pamdp.policies import ACTIVATIONS, every_action_linear, mlp
+from pamdp.policies import ACTIVATIONS, every_action_linear, every_action_mlp, hierarchical_mlps, mlp
 from pamdp.spaces import HybridActionSpace
 
 if TYPE_CHECKING:
@@ -207,14 +207,9 @@ class GumbelHybridPolicy(nn.Module):
     def __init__(self, obs_dim: int, hybrid: HybridActionSpace, hidden_sizes, activation: str, init_log_std: float):
         super().__init__()
         self.n_actions, self.param_size = hybrid.n_actions, hybrid.max_param_size
-        self.pi_d = mlp(obs_dim, hidden_sizes, self.n_actions, activation)
-        self.pi_c = mlp(obs_dim + self.n_actions, hidden_sizes, self.param_size, activation)
+        self.pi_d, self.pi_c = hierarchical_mlps(obs_dim, self.n_actions, hidden_sizes, activation, self.param_size)
         self.log_std = nn.Parameter(torch.full((self.n_actions, self.param_size), float(init_log_std)))
         self.register_buffer("mask", torch.tensor(hybrid.param_mask, dtype=torch.float32))
-        # Small final layers start pi_d near uniform and pi_c near the centre of the parameter box.
-        for head in (self.pi_d[-1], self.pi_c[-1]):
-            nn.init.uniform_(head.weight, -3e-3, 3e-3)
-            nn.init.zeros_(head.bias)
 
     def std(self) -> torch.Tensor:
         """The parameter noise's std per action and parameter, ``(K, m)``."""
@@ -249,8 +244,7 @@ class GumbelHybridPolicy(nn.Module):
         batch, K = len(obs), self.n_actions
         onehots = torch.eye(K, dtype=obs.dtype, device=obs.device).expand(batch, K, K)
         obs_k = obs.unsqueeze(-2).expand(batch, K, obs.shape[-1])
-        first = self.pi_c[0]  # pi_c of every one-hot without building the B * K inputs (as params would)
-        means = self.pi_c[1:](every_action_linear(obs, first.weight, first.bias))
+        means = every_action_mlp(self.pi_c, obs)  # without building the B * K inputs (as params would)
         return obs_k, onehots, torch.tanh(means + self.std() * eta_x.unsqueeze(-2)) * self.mask
 
     def forward(
