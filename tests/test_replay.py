@@ -8,7 +8,8 @@ import pytest
 import torch
 from torch import nn
 
-from pamdp.algos.offpolicy import clipped_step, discounted_returns, linear_epsilon, mixed_target, soft_update
+from pamdp.algos.offpolicy import discounted_returns, linear_epsilon, mixed_target, soft_update
+from pamdp.algos.optim import descend
 from pamdp.algos.replay import ReplayBuffer
 
 FIELDS = {"obs": ((2,), np.float32), "a": ((), np.int64), "eta": ((3,), np.float32)}
@@ -141,11 +142,12 @@ def test_linear_epsilon_endpoints():
 
 
 @pytest.mark.parametrize("max_norm, expected_norm", [(0.0, 5.0), (1.0, 1.0), (10.0, 5.0)])
-def test_clipped_step_clips_the_gradient_norm_before_stepping(max_norm, expected_norm):
+def test_descend_clips_the_gradient_norm_before_stepping(max_norm, expected_norm):
     w = nn.Parameter(torch.zeros(2))
-    w.grad = torch.tensor([3.0, 4.0])  # norm 5
-    clipped_step(torch.optim.SGD([w], lr=1.0), [w], max_norm)
+    loss = -(w * torch.tensor([3.0, 4.0])).sum()  # gradient norm 5
+    norm = descend(torch.optim.SGD([w], lr=1.0), loss, [w], max_norm)
     assert float(w.detach().norm()) == pytest.approx(expected_norm)
+    assert norm is None if max_norm == 0 else float(norm) == pytest.approx(5.0)
 
 
 def _algorithm(config, env, explore, update) -> SimpleNamespace:

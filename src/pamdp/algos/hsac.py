@@ -51,12 +51,11 @@ from pamdp.algos.offpolicy import (
     OffPolicyLoop,
     Temperatures,
     TwinQ,
-    gradient_step,
-    optimizer_step,
     shared_setting,
     soft_updater,
     temperature_gradient,
 )
+from pamdp.algos.optim import apply_gradients, descend
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
 from pamdp.distributions import LOG_STD_MAX, LOG_STD_MIN, MASKED, SquashedHybrid, masked_logits
 from pamdp.policies import ACTIVATIONS, every_action_mlp, hierarchical_mlps, mlp, small_init_
@@ -200,8 +199,6 @@ class HybridSAC(Algorithm):
         self.critic_optimizer = torch.optim.Adam(self.critic.parameters(), lr=cfg.critic_lr, fused=True)
         self.alpha_optimizer = torch.optim.Adam(self.temperatures.parameters(), lr=cfg.alpha_lr, fused=True)
         self._actor_params, self._critic_params = list(self.actor.parameters()), list(self.critic.parameters())
-        self._actor_step = gradient_step(self.actor_optimizer, cfg.grad_clip)
-        self._critic_step = gradient_step(self.critic_optimizer, cfg.grad_clip)
         self.param_sizes = torch.as_tensor(h.param_sizes, dtype=torch.float32, device=self.device)
         # every action's drawn parameters: what the critics saw
         self.loop = OffPolicyLoop(self, params=((h.total_param_size,), np.float32))
@@ -269,9 +266,8 @@ class HybridSAC(Algorithm):
 
     def temperature_step(self, entropy_d, target_d, entropy_c, target_c) -> None:
         """One Adam step of each log-temperature along :func:`temperature_gradient` of its part's entropy."""
-        optimizer_step(
-            self.alpha_optimizer, [temperature_gradient(entropy_d, target_d), temperature_gradient(entropy_c, target_c)]
-        )
+        gradients = [temperature_gradient(entropy_d, target_d), temperature_gradient(entropy_c, target_c)]
+        apply_gradients(self.alpha_optimizer, gradients)
 
     def _update(self) -> dict[str, float]:
         """One soft Q step of both critics, one policy step, one step of each temperature, the target update."""
@@ -284,13 +280,13 @@ class HybridSAC(Algorithm):
         a = b["a"][:, None]
         q1, q2 = (q.gather(1, a).squeeze(1) for q in self.critic(obs, b["params"]))
         critic_loss = F.mse_loss(q1, y) + F.mse_loss(q2, y)
-        self._critic_step(torch.autograd.grad(critic_loss, self._critic_params))
+        descend(self.critic_optimizer, critic_loss, self._critic_params, cfg.grad_clip)
 
         dist = self.actor(obs, mask)
         soft_q, log_pc = self.soft_value(dist, self.critic, obs, alpha_d, alpha_c)
         p = dist.probs_d
         actor_loss = -(p * soft_q).sum(-1).mean()
-        self._actor_step(torch.autograd.grad(actor_loss, self._actor_params))  # the critics' weights: no gradient
+        descend(self.actor_optimizer, actor_loss, self._actor_params, cfg.grad_clip)  # the critics' get none
 
         with torch.no_grad():
             entropy_d = dist.entropy_d()

@@ -55,12 +55,12 @@ from pamdp.algos.offpolicy import (
     OffPolicyLoop,
     TwinQ,
     backprop_actor,
-    clipped_step,
     linear_epsilon,
     shared_setting,
     soft_update,
     uniform_actions,
 )
+from pamdp.algos.optim import apply_gradients, descend
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, at_least, interval, one_of, setting
 from pamdp.distributions import LOG_STD_MAX, LOG_STD_MIN, masked_logits
 from pamdp.policies import ACTIVATIONS, mlp
@@ -342,9 +342,11 @@ class HyAR(Algorithm):
         self.critic = TwinQ(self.obs_dim + self.latent_size, 1, cfg.hidden_sizes, cfg.activation)  # Q_i(s, e, z)
         self.actor_target = copy.deepcopy(self.actor).requires_grad_(False)
         self.critic_target = copy.deepcopy(self.critic).requires_grad_(False)
-        self.rep_optimizer = torch.optim.Adam(self.rep.parameters(), lr=cfg.vae_lr, fused=True)
-        self.actor_optimizer = torch.optim.Adam(self.actor.net.parameters(), lr=cfg.actor_lr, fused=True)
-        self.critic_optimizer = torch.optim.Adam(self.critic.parameters(), lr=cfg.critic_lr, fused=True)
+        self._rep_params, self._actor_params = list(self.rep.parameters()), list(self.actor.net.parameters())
+        self._critic_params = list(self.critic.parameters())
+        self.rep_optimizer = torch.optim.Adam(self._rep_params, lr=cfg.vae_lr, fused=True)
+        self.actor_optimizer = torch.optim.Adam(self._actor_params, lr=cfg.actor_lr, fused=True)
+        self.critic_optimizer = torch.optim.Adam(self._critic_params, lr=cfg.critic_lr, fused=True)
         # the latent action that was decoded and executed
         self.loop = OffPolicyLoop(self, latent=((self.latent_size,), np.float32))
         self.replay = self.loop.buffer
@@ -434,9 +436,7 @@ class HyAR(Algorithm):
                 loss, terms = self.rep.loss(
                     b["obs"], b["a"], b["x"], b["next_obs"], cfg.kl_weight, cfg.dynamics_weight, self.torch_gen
                 )
-                self.rep_optimizer.zero_grad(set_to_none=True)
-                loss.backward()
-                self.rep_optimizer.step()
+                descend(self.rep_optimizer, loss, self._rep_params)
                 for k, v in terms.items():
                     sums[k] += v
         self.update_bounds(remap=self.config.lsc_remap and self.pretrained)
@@ -519,9 +519,7 @@ class HyAR(Algorithm):
             y = b["reward"] + cfg.gamma * (~b["terminated"]).float() * torch.minimum(q1_next, q2_next)
         q1, q2 = (q.squeeze(-1) for q in self.critic(obs, latent))
         critic_loss = F.mse_loss(q1, y) + F.mse_loss(q2, y)
-        self.critic_optimizer.zero_grad(set_to_none=True)
-        critic_loss.backward()
-        clipped_step(self.critic_optimizer, self.critic.parameters(), cfg.grad_clip)
+        descend(self.critic_optimizer, critic_loss, self._critic_params, cfg.grad_clip)
         stats.update(
             {
                 "losses/critic_loss": float(critic_loss.detach()),
@@ -530,9 +528,9 @@ class HyAR(Algorithm):
             }
         )
         if self.n_updates % cfg.policy_delay == 0:
-            self.actor_optimizer.zero_grad(set_to_none=True)
-            _, q_mu = backprop_actor(self.actor, self._q1, obs, "invert" if cfg.bound == "invert" else "none")
-            clipped_step(self.actor_optimizer, self.actor.net.parameters(), cfg.grad_clip)
+            bound = "invert" if cfg.bound == "invert" else "none"
+            _, q_mu, grads = backprop_actor(self.actor, self._q1, obs, bound, self._actor_params)
+            apply_gradients(self.actor_optimizer, grads, cfg.grad_clip)
             soft_update(self.critic_target, self.critic, cfg.tau)
             soft_update(self.actor_target.net, self.actor.net, cfg.tau)
             stats["losses/actor_loss"] = float(-q_mu.mean())

@@ -48,10 +48,6 @@ __all__ = [
     "OUNoise",
     "soft_update",
     "soft_updater",
-    "clipped_step",
-    "clip_grads",
-    "optimizer_step",
-    "gradient_step",
     "linear_epsilon",
     "uniform_actions",
     "mixed_target",
@@ -200,76 +196,6 @@ class OUNoise:
         return self.state
 
 
-def clipped_step(optimizer: torch.optim.Optimizer, params, max_norm: float) -> None:
-    """One optimizer step, the gradient's total norm first clipped to ``max_norm`` (0: no clipping)."""
-    if max_norm > 0:
-        nn.utils.clip_grad_norm_(params, max_norm)
-    optimizer.step()
-
-
-def clip_grads(grads: Sequence[torch.Tensor], max_norm: float) -> None:
-    """``nn.utils.clip_grad_norm_`` on gradient tensors themselves (0: no clipping), in place."""
-    if max_norm <= 0:
-        return
-    total = torch.linalg.vector_norm(torch.stack(torch._foreach_norm(list(grads))))
-    torch._foreach_mul_(list(grads), (max_norm / (total + 1e-6)).clamp(max=1.0))
-
-
-def optimizer_step(optimizer: torch.optim.Optimizer, grads: Sequence[torch.Tensor]) -> None:
-    """``optimizer.step()`` with ``grads``, in the order of its one parameter group.
-
-    A fused ``Adam`` whose state exists gets one ``torch._fused_adam_`` call, the kernel its own ``step`` ends
-    in, without the Python bookkeeping around it; any other optimizer gets the gradients as ``.grad`` and its
-    own ``step``.
-    """
-    group = optimizer.param_groups[0]
-    params = group["params"]
-    state = optimizer.state
-    fast = (
-        len(optimizer.param_groups) == 1
-        and group.get("fused")
-        and not (group["amsgrad"] or group["maximize"] or group["capturable"] or group["differentiable"])
-        and not group.get("decoupled_weight_decay", False)
-        and all(p in state for p in params)
-    )
-    if not fast:
-        for p, g in zip(params, grads, strict=True):
-            p.grad = g
-        optimizer.step()
-        return
-    steps = [state[p]["step"] for p in params]
-    torch._foreach_add_(steps, 1)
-    beta1, beta2 = group["betas"]
-    torch._fused_adam_(
-        params,
-        list(grads),
-        [state[p]["exp_avg"] for p in params],
-        [state[p]["exp_avg_sq"] for p in params],
-        [],
-        steps,
-        amsgrad=False,
-        lr=float(group["lr"]),
-        beta1=float(beta1),
-        beta2=float(beta2),
-        weight_decay=float(group["weight_decay"]),
-        eps=float(group["eps"]),
-        maximize=False,
-        grad_scale=None,
-        found_inf=None,
-    )
-
-
-def gradient_step(optimizer: torch.optim.Optimizer, max_norm: float) -> Callable[[Sequence[torch.Tensor]], None]:
-    """A step of ``optimizer`` on hand-computed gradients: their total norm clipped to ``max_norm`` (0: none),
-    then :func:`optimizer_step`."""
-
-    def step(grads: Sequence[torch.Tensor]) -> None:
-        clip_grads(grads, max_norm)
-        optimizer_step(optimizer, grads)
-
-    return step
-
-
 def linear_epsilon(step: int, start: float, end: float, steps: int) -> float:
     """An exploration rate falling linearly from ``start`` to ``end`` over ``steps`` samples, then held."""
     return start + min(step / steps, 1.0) * (end - start)
@@ -341,18 +267,20 @@ def backprop_actor(
     critic: Callable[[torch.Tensor, torch.Tensor], torch.Tensor],
     obs: torch.Tensor,
     bound: str,
-) -> tuple[torch.Tensor, torch.Tensor]:
-    """Back-propagate ``-mean_s Q(s, mu(s))`` into the actor, with ``dQ/dmu`` edited by ``bound`` on the way.
+    params: Sequence[torch.Tensor],
+) -> tuple[torch.Tensor, torch.Tensor, tuple[torch.Tensor, ...]]:
+    """Back-propagate ``-mean_s Q(s, mu(s))`` into the actor's ``params``, with ``dQ/dmu`` edited by ``bound`` on
+    the way (for :func:`~pamdp.algos.optim.apply_gradients`).
 
     ``Q`` is summed over its last axis if it has one (P-DQN's K values). The critic's weights get no gradient.
-    Returns the actor's outputs and ``Q(s, mu(s))``, detached.
+    Returns the actor's outputs and ``Q(s, mu(s))``, detached, and the gradients in ``params``.
     """
     out = actor(obs)
     p = out.detach().requires_grad_(True)
     q = critic(obs, p)
     (dq_dp,) = torch.autograd.grad(q.sum(), p)  # per-sample dQ/dp, the ascent direction
-    out.backward(-bounded(dq_dp, p.detach(), bound) / len(out))  # descend on -mean Q over the batch
-    return out.detach(), q.detach()
+    grads = torch.autograd.grad(out, params, -bounded(dq_dp, p.detach(), bound) / len(out))  # descend on -mean Q
+    return out.detach(), q.detach(), grads
 
 
 class OffPolicyLoop:

@@ -43,12 +43,12 @@ from pamdp.algos.offpolicy import (
     OffPolicyLoop,
     OUNoise,
     bounded,
-    gradient_step,
     linear_epsilon,
     mixed_target,
     shared_setting,
     soft_updater,
 )
+from pamdp.algos.optim import apply_gradients
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, at_least, interval, one_of, setting
 from pamdp.distributions import masked_logits
 from pamdp.policies import ACTIVATIONS, mlp
@@ -259,7 +259,7 @@ class PADDPG(Algorithm):
             q, cache = critic.forward_cached(torch.cat([obs, b["out"]], dim=-1))
             q = q.squeeze(-1)
             error = q - y
-            gradient_step(self.critic_optimizer, cfg.grad_clip)(critic.backward(cache, error * (2.0 / batch))[0])
+            apply_gradients(self.critic_optimizer, critic.backward(cache, error * (2.0 / batch))[0], cfg.grad_clip)
             # actor: ascend on Q(s, mu(s)) with the critic just updated, dQ/dmu edited at the bounds
             out, actor_cache = actor.forward_cached(obs)
             q_mu, q_cache = critic.forward_cached(torch.cat([obs, self._masked(out, b.get("mask"))], dim=-1))
@@ -268,7 +268,7 @@ class PADDPG(Algorithm):
             if "mask" in b:  # a forbidden action's score is held at -1: no gradient reaches it
                 k = self.hybrid.n_actions
                 dq_dp = torch.cat([dq_dp[:, :k] * b["mask"], dq_dp[:, k:]], dim=-1)
-            gradient_step(self.actor_optimizer, cfg.grad_clip)(actor.backward(actor_cache, -dq_dp / batch)[0])
+            apply_gradients(self.actor_optimizer, actor.backward(actor_cache, -dq_dp / batch)[0], cfg.grad_clip)
             self._soft_update(cfg.tau)
         return {
             "losses/critic_loss": float(error.square().mean()),

@@ -41,6 +41,7 @@ from pamdp.algos.onpolicy import (
     pi_c_input_setting,
     update_tensors,
 )
+from pamdp.algos.optim import descend
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
 from pamdp.algos.subnormals import subnormals_flushed
 from pamdp.distributions import HybridDistribution, kl_divergence
@@ -229,11 +230,7 @@ class PAPPO(Algorithm):
                 loss, parts = ppo_loss(
                     dist, self.value(obs[idx]), a[idx], x[idx], old_logp[idx], adv[idx], returns[idx], cfg
                 )
-                self.optimizer.zero_grad()
-                loss.backward()
-                grad_norm = torch.nn.utils.clip_grad_norm_(params, cfg.max_grad_norm)
-                self.optimizer.step()
-                parts["train/grad_norm"] = grad_norm
+                parts["train/grad_norm"] = descend(self.optimizer, loss, params, cfg.max_grad_norm)
                 for k, v in parts.items():
                     sums[k] = sums.get(k, 0.0) + float(v)
                 updates += 1

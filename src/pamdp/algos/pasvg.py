@@ -42,14 +42,12 @@ from pamdp.algos.offpolicy import (
     OffPolicyConfig,
     OffPolicyLoop,
     Temperatures,
-    clipped_step,
-    gradient_step,
-    optimizer_step,
     shared_setting,
     soft_updater,
     temperature_gradient,
     uniform_actions,
 )
+from pamdp.algos.optim import apply_gradients, descend
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
 from pamdp.distributions import LOG_STD_MAX, LOG_STD_MIN, masked_logits
 from pamdp.policies import ACTIVATIONS, every_action_linear, every_action_mlp, hierarchical_mlps, mlp
@@ -458,9 +456,7 @@ class PASVG0(Algorithm):
         critic_loss = F.mse_loss(q, y)
         if self.critic2 is not None:
             critic_loss = critic_loss + F.mse_loss(self.critic2(obs, b["a_in"], b["x"]), y)
-        self.critic_optimizer.zero_grad(set_to_none=True)
-        critic_loss.backward()
-        clipped_step(self.critic_optimizer, self.critic_params, cfg.grad_clip)
+        descend(self.critic_optimizer, critic_loss, self.critic_params, cfg.grad_clip)
         self.critic_updates += 1
         stats = {"losses/critic_loss": float(critic_loss.detach()), "train/q_mean": float(q.detach().mean())}
         if self.critic_updates % cfg.policy_delay == 0:
@@ -485,14 +481,11 @@ class PASVG0(Algorithm):
         actor_loss = -q_pi.mean() - alpha * entropy
         # The policy loss differentiates Q in (a, x) only: asking for the policy's gradients alone skips the
         # critic's weight gradients, which backward() would compute and the critic must not receive.
-        grads = torch.autograd.grad(actor_loss, self.policy_params)
-        for p, g in zip(self.policy_params, grads):
-            p.grad = g
-        clipped_step(self.policy_optimizer, self.policy_params, cfg.grad_clip)
+        descend(self.policy_optimizer, actor_loss, self.policy_params, cfg.grad_clip)
         if self.entropy_weight is not None:
             # in double, as the loss log_alpha * (float(H) - target) it replaced: the same step
             gradient = temperature_gradient(entropy.detach().double(), cfg.target_entropy).float()
-            optimizer_step(self.entropy_optimizer, [gradient])
+            apply_gradients(self.entropy_optimizer, [gradient])
         self._soft_update(cfg.tau)
         return self._policy_stats(actor_loss.detach(), q_pi, entropy.detach(), alpha)
 
@@ -521,7 +514,7 @@ class PASVG0(Algorithm):
         q, cache = critic.forward_cached(torch.cat([obs, b["a_in"], b["x"]], dim=-1))
         q = q.squeeze(-1)
         error = q - y
-        gradient_step(self.critic_optimizer, cfg.grad_clip)(critic.backward(cache, error * (2.0 / batch))[0])
+        apply_gradients(self.critic_optimizer, critic.backward(cache, error * (2.0 / batch))[0], cfg.grad_clip)
         self.critic_updates += 1
 
         # policy: descend on -mean Q(s, a, x) - alpha * mean H(pi_d), with the recorded noise
@@ -556,7 +549,7 @@ class PASVG0(Algorithm):
             d_table = F.one_hot(index, K).to(d_u.dtype).t() @ (d_u * eta_x * std)
             inside = (policy.log_std >= LOG_STD_MIN) & (policy.log_std <= LOG_STD_MAX)
             grads.insert(0, d_table * inside)
-        gradient_step(self.policy_optimizer, cfg.grad_clip)(grads)
+        apply_gradients(self.policy_optimizer, grads, cfg.grad_clip)
         self._soft_update(cfg.tau)
         q_pi = q_pi.squeeze(-1)
         entropy = entropy.mean()

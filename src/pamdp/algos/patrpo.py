@@ -38,6 +38,7 @@ from pamdp.algos.onpolicy import (
     pi_c_input_setting,
     update_tensors,
 )
+from pamdp.algos.optim import descend
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, at_least, interval, one_of, setting
 from pamdp.algos.subnormals import subnormals_flushed
 from pamdp.algos.trpo import (
@@ -169,7 +170,8 @@ class PATRPO(Algorithm):
         )
         if cfg.baseline == "mlp":
             self.value = ValueNetwork(self.obs_dim, cfg.vf_hidden_sizes)
-            self.vf_optimizer = torch.optim.Adam(self.value.parameters(), lr=cfg.vf_lr)
+            self._vf_params = list(self.value.parameters())
+            self.vf_optimizer = torch.optim.Adam(self._vf_params, lr=cfg.vf_lr)
         else:
             self.linear_baseline = LinearFeatureBaseline(self.obs_dim)
         self.loop = Rollout(self)  # a loaded model starts new episodes
@@ -297,8 +299,6 @@ class PATRPO(Algorithm):
             for start in range(0, n, cfg.vf_batch_size):
                 idx = perm[start : start + cfg.vf_batch_size]
                 loss = (self.value(obs_t[idx]) - ret_t[idx]).pow(2).mean()
-                self.vf_optimizer.zero_grad()
-                loss.backward()
-                self.vf_optimizer.step()
+                descend(self.vf_optimizer, loss, self._vf_params)
         with torch.no_grad():
             return float((self.value(obs_t) - ret_t).pow(2).mean())

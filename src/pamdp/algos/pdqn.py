@@ -46,13 +46,13 @@ from pamdp.algos.offpolicy import (
     OffPolicyLoop,
     OUNoise,
     backprop_actor,
-    clipped_step,
     linear_epsilon,
     mixed_target,
     shared_setting,
     soft_update,
     uniform_actions,
 )
+from pamdp.algos.optim import apply_gradients, descend
 from pamdp.algos.settings import (
     LAYERS,
     NON_NEGATIVE,
@@ -289,8 +289,9 @@ class PDQN(Algorithm):
         self.q_net = QNetwork(self.obs_dim, h, cfg.hidden_sizes, cfg.activation, cfg.multi_pass)
         self.actor_target = copy.deepcopy(self.actor).requires_grad_(False)
         self.q_target = copy.deepcopy(self.q_net).requires_grad_(False)
-        self.actor_optimizer = torch.optim.Adam(self.actor.parameters(), lr=cfg.actor_lr, fused=True)
-        self.q_optimizer = torch.optim.Adam(self.q_net.parameters(), lr=cfg.q_lr, fused=True)
+        self._actor_params, self._q_params = list(self.actor.parameters()), list(self.q_net.parameters())
+        self.actor_optimizer = torch.optim.Adam(self._actor_params, lr=cfg.actor_lr, fused=True)
+        self.q_optimizer = torch.optim.Adam(self._q_params, lr=cfg.q_lr, fused=True)
         self.blocks = torch.as_tensor(param_blocks(h), device=self.device)
         self.loop = OffPolicyLoop(
             self,
@@ -367,13 +368,9 @@ class PDQN(Algorithm):
                 y = mixed_target(y, b["mc"], cfg.beta)
         q = self.q_net(obs, b["params"]).gather(1, b["a"][:, None]).squeeze(1)
         q_loss = F.mse_loss(q, y)
-        self.q_optimizer.zero_grad(set_to_none=True)
-        q_loss.backward()
-        clipped_step(self.q_optimizer, self.q_net.parameters(), cfg.grad_clip)
-
-        self.actor_optimizer.zero_grad(set_to_none=True)
-        x, q_x = backprop_actor(self.actor, self.q_net, obs, cfg.bound)
-        clipped_step(self.actor_optimizer, self.actor.parameters(), cfg.grad_clip)
+        descend(self.q_optimizer, q_loss, self._q_params, cfg.grad_clip)
+        x, q_x, grads = backprop_actor(self.actor, self.q_net, obs, cfg.bound, self._actor_params)
+        apply_gradients(self.actor_optimizer, grads, cfg.grad_clip)
 
         soft_update(self.q_target, self.q_net, cfg.tau_q)
         soft_update(self.actor_target, self.actor, cfg.tau_actor)
