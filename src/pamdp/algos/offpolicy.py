@@ -1,5 +1,6 @@
 """What the off-policy algorithms share: their loop settings, the collect-and-learn loop over a replay buffer,
-target networks, and the bounded-gradient tricks of deterministic actors.
+target networks, twin critics, the entropy temperature rule, and the bounded-gradient tricks of deterministic
+actors.
 
 :class:`OffPolicyConfig` declares the settings of the loop and the replay once; an algorithm's config inherits
 it beside :class:`~pamdp.algos.settings.AlgoConfig`. :class:`OffPolicyLoop` reads them: it steps the batched
@@ -18,7 +19,8 @@ buffer's ``"mc"`` field when its episode ends (``NaN`` until then), for PADDPG's
 rewards and these returns are the env's rewards times ``reward_scale``, the scale the critics learn on.
 
 The actors of PADDPG, P-DQN and HyAR output bounded values trained along ``dQ/d output``; Hausknecht & Stone's
-three ways of keeping them in ``[-1, 1]`` (spec "PADDPG") are :data:`BOUNDS`, applied by :func:`backprop_actor`.
+three ways of keeping them in ``[-1, 1]`` ("Deep Reinforcement Learning in Parameterized Action Space", ICLR 2016,
+section "Bounded parameter space learning") are :data:`BOUNDS`, applied by :func:`backprop_actor`.
 """
 
 from __future__ import annotations

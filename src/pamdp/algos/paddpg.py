@@ -5,7 +5,8 @@ The actor ``mu(s)`` outputs one vector: K action scores and the parameters of *e
 own parameters; the critic ``Q(s, mu(s))`` sees the whole vector, so the actor is trained by DDPG's
 deterministic policy gradient ``dQ/dmu * dmu/dtheta`` through all of it.
 
-Bounded outputs (``bound``, the three options Hausknecht & Stone compared; spec "PADDPG"):
+Bounded outputs (``bound``, the three options Hausknecht & Stone compare in their section on bounded parameter
+space learning):
 
 - ``invert`` (the default, theirs): with ``g = dQ/dp`` at the actor's output, scale ``g`` by
   ``(p_max - p) / (p_max - p_min)`` where it would increase ``p`` and by ``(p - p_min) / (p_max - p_min)``
