@@ -22,6 +22,7 @@ import torch
 import torch.nn.functional as F
 
 __all__ = [
+    "Categorical",
     "HybridDistribution",
     "KL_ESTIMATORS",
     "LOG_STD_MIN",
@@ -82,26 +83,16 @@ def draw_params(
 
 
 @dataclass
-class HybridDistribution:
-    """A batch of hybrid action distributions.
+class Categorical:
+    """``pi_d(a | s)``, the categorical part of a hybrid distribution, and what both hybrid distributions below
+    compute from it alone.
 
     Attributes:
-        logits: ``(B, K)`` unnormalised log-probabilities of ``pi_d``.
-        means: ``(B, K, m)`` parameter means of ``pi_c(. | s, a)`` for every action ``a``.
-        log_std: ``(K, m)`` or ``(B, K, m)`` log standard deviations of ``pi_c``.
-        mask: ``(K, m)`` boolean, which padded entries each action uses.
+        logits: ``(B, K)`` unnormalised log-probabilities of ``pi_d`` (masked actions at :data:`MASKED`).
     """
 
     logits: torch.Tensor
-    means: torch.Tensor
-    log_std: torch.Tensor
-    mask: torch.Tensor
 
-    def __post_init__(self):
-        self.log_std = self.log_std.expand_as(self.means)
-        self.mask = self.mask.to(self.means.dtype)
-
-    # -- pieces ------------------------------------------------------------------------------
     @property
     def log_probs_d(self) -> torch.Tensor:
         """``(B, K)`` normalised ``log pi_d(a | s)``."""
@@ -111,6 +102,31 @@ class HybridDistribution:
     def probs_d(self) -> torch.Tensor:
         return F.softmax(self.logits, dim=-1)
 
+    def entropy_d(self) -> torch.Tensor:
+        """``(B,)`` the entropy of ``pi_d`` (masked actions contribute nothing)."""
+        return -(self.probs_d * self.log_probs_d).sum(-1)
+
+
+@dataclass
+class HybridDistribution(Categorical):
+    """A batch of hybrid action distributions with Gaussian parameters (PATRPO's and PAPPO's).
+
+    Attributes:
+        logits: ``(B, K)`` unnormalised log-probabilities of ``pi_d``.
+        means: ``(B, K, m)`` parameter means of ``pi_c(. | s, a)`` for every action ``a``.
+        log_std: ``(K, m)`` or ``(B, K, m)`` log standard deviations of ``pi_c``.
+        mask: ``(K, m)`` boolean, which padded entries each action uses.
+    """
+
+    means: torch.Tensor
+    log_std: torch.Tensor
+    mask: torch.Tensor
+
+    def __post_init__(self):
+        self.log_std = self.log_std.expand_as(self.means)
+        self.mask = self.mask.to(self.means.dtype)
+
+    # -- pieces ------------------------------------------------------------------------------
     def _at(self, tensor: torch.Tensor, a: torch.Tensor) -> torch.Tensor:
         """Select action ``a``'s row of a ``(B, K, m)`` tensor: ``(B, m)``."""
         return tensor.gather(1, a.long().view(-1, 1, 1).expand(-1, 1, tensor.shape[-1])).squeeze(1)
@@ -141,7 +157,7 @@ class HybridDistribution:
 
     def entropy(self) -> torch.Tensor:
         """Exact joint entropy by the chain rule: ``H(pi_d) + sum_a pi_d(a) H(pi_c(. | s, a))``."""
-        p, logp = self.probs_d, self.log_probs_d
+        p, logp = self.probs_d, self.log_probs_d  # p once: its gradient gathers both terms', as it always did
         return -(p * logp).sum(-1) + (p * self.entropy_c()).sum(-1)
 
     # -- divergences -------------------------------------------------------------------------
@@ -205,7 +221,7 @@ class HybridDistribution:
 
 
 @dataclass
-class SquashedHybrid:
+class SquashedHybrid(Categorical):
     """A batch of hybrid distributions with tanh-squashed Gaussian parameters, every action's at once: Hybrid
     SAC's policy (Delalleau et al. 2019), ``x = tanh(u)``, ``u ~ N(mean, exp(log_std))``, so that
 
@@ -221,23 +237,9 @@ class SquashedHybrid:
         param_mask: ``(K, m)`` float, 1 where action ``a`` uses padded parameter ``i``.
     """
 
-    logits: torch.Tensor
     mean: torch.Tensor
     log_std: torch.Tensor
     param_mask: torch.Tensor
-
-    @property
-    def log_probs_d(self) -> torch.Tensor:
-        """``(B, K)`` normalised ``log pi_d(a | s)``."""
-        return F.log_softmax(self.logits, dim=-1)
-
-    @property
-    def probs_d(self) -> torch.Tensor:
-        return F.softmax(self.logits, dim=-1)
-
-    def entropy_d(self) -> torch.Tensor:
-        """``(B,)`` the entropy of ``pi_d`` (masked actions contribute nothing)."""
-        return -(self.probs_d * self.log_probs_d).sum(-1)
 
     def rsample(self, generator: torch.Generator | None = None) -> tuple[torch.Tensor, torch.Tensor]:
         """Reparameterised pre-squash ``u`` and parameters ``x = tanh(u)`` of every action, ``(B, K, m)`` each;
@@ -258,7 +260,7 @@ class SquashedHybrid:
 
     def sample_discrete(self, generator: torch.Generator | None = None) -> torch.Tensor:
         """``(B,)`` actions drawn from ``pi_d``."""
-        return torch.multinomial(self.probs_d, 1, generator=generator).squeeze(-1)
+        return draw_action(self.logits, False, generator)
 
     def mode(self) -> tuple[torch.Tensor, torch.Tensor]:
         """The greedy action: ``argmax_a pi_d(a | s)`` and ``tanh`` of its Gaussian's mean, ``(B,)`` and ``(B, m)``."""

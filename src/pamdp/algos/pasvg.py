@@ -213,22 +213,6 @@ class GumbelHybridPolicy(nn.Module):
         """The parameter noise's std per action and parameter, ``(K, m)``."""
         return self.log_std.clamp(LOG_STD_MIN, LOG_STD_MAX).exp()
 
-    def sample(
-        self,
-        obs: torch.Tensor,
-        eta_a: torch.Tensor,
-        eta_x: torch.Tensor,
-        temperature: float,
-        hard: bool,
-        mask: torch.Tensor | None = None,
-    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
-        """``(logits, index, a, x)`` for the noise ``(eta_a, eta_x)``: ``pi_d``'s logits (restricted to the actions
-        ``mask`` allows), the action, the critic's action input ``a`` and the parameters ``x``, so an update runs
-        ``pi_d`` once."""
-        logits = masked_logits(self.pi_d(obs), mask)
-        index, a = gumbel_softmax_sample(logits, eta_a, temperature, hard)
-        return logits, index, a, self.params(obs, index, a, eta_x)
-
     def params(self, obs: torch.Tensor, index: torch.Tensor, a: torch.Tensor, eta_x: torch.Tensor) -> torch.Tensor:
         """``x = g(s, a, eta_x)``: ``pi_c``'s parameters for action ``a`` (one-hot or soft; ``index`` its argmax)."""
         return torch.tanh(self.pi_c(torch.cat([obs, a], dim=-1)) + self.std()[index] * eta_x) * self.mask[index]
@@ -253,9 +237,13 @@ class GumbelHybridPolicy(nn.Module):
         temperature: float,
         hard: bool,
         mask: torch.Tensor | None = None,
-    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
-        """``(index, a, x)`` for the noise ``(eta_a, eta_x)``; ``a`` is the critic's action input."""
-        return self.sample(obs, eta_a, eta_x, temperature, hard, mask)[1:]
+    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
+        """``(logits, index, a, x)`` for the noise ``(eta_a, eta_x)``: ``pi_d``'s logits (restricted to the actions
+        ``mask`` allows), the action, the critic's action input ``a`` and the parameters ``x``, so an update runs
+        ``pi_d`` once."""
+        logits = masked_logits(self.pi_d(obs), mask)
+        index, a = gumbel_softmax_sample(logits, eta_a, temperature, hard)
+        return logits, index, a, self.params(obs, index, a, eta_x)
 
     def mode(self, obs: torch.Tensor, mask: torch.Tensor | None = None) -> tuple[torch.Tensor, torch.Tensor]:
         """The greedy action: the most probable (allowed) discrete action and its mean parameters."""
@@ -406,13 +394,13 @@ class PASVG0(Algorithm):
     def _act(self, obs, deterministic, mask=None):
         if deterministic:
             return self.policy.mode(obs, mask)
-        index, _, x = self.policy(obs, *self._noise(len(obs)), self.config.temperature, True, mask)
+        _, index, _, x = self.policy(obs, *self._noise(len(obs)), self.config.temperature, True, mask)
         return index, x
 
     def _explore(self, obs: torch.Tensor, step: int, episode_start: np.ndarray, mask: torch.Tensor | None):
         cfg = self.config
         eta_a, eta_x = self._noise(len(obs))
-        index, a_in, x = self.policy(obs, eta_a, eta_x, cfg.temperature, cfg.straight_through, mask)
+        _, index, a_in, x = self.policy(obs, eta_a, eta_x, cfg.temperature, cfg.straight_through, mask)
         if cfg.explore_epsilon > 0:  # drawn only when on, so that the paper's preset keeps its random stream
             n, K = len(obs), self.hybrid.n_actions
             flip = torch.rand(n, generator=self.torch_gen, device=self.device) < cfg.explore_epsilon
@@ -440,7 +428,7 @@ class PASVG0(Algorithm):
             critics = (self.critic_target,) if self.critic2 is None else (self.critic_target, self.critic2_target)
             _, q_next = expected_q(self.policy_target, every_action_q(*critics), next_obs, eta_x, mask)
         else:
-            _, a_next, x_next = self.policy_target(next_obs, eta_a, eta_x, cfg.temperature, cfg.straight_through, mask)
+            *_, a_next, x_next = self.policy_target(next_obs, eta_a, eta_x, cfg.temperature, cfg.straight_through, mask)
             q_next = self._target_q(next_obs, a_next, x_next)
         return b["reward"] + cfg.gamma * (~b["terminated"]).float() * q_next
 
@@ -472,9 +460,7 @@ class PASVG0(Algorithm):
         if cfg.discrete_gradient == "expected":
             logits, q_pi = expected_q(self.policy, every_action_q(self.critic), obs, b["eta_x"], mask)
         else:
-            logits, _, a, x = self.policy.sample(
-                obs, b["eta_a"], b["eta_x"], cfg.temperature, cfg.straight_through, mask
-            )
+            logits, _, a, x = self.policy(obs, b["eta_a"], b["eta_x"], cfg.temperature, cfg.straight_through, mask)
             q_pi = self.critic(obs, a, x)
         entropy = -(logits.softmax(-1) * logits.log_softmax(-1)).sum(-1).mean()
         alpha = cfg.entropy_coef if self.entropy_weight is None else float(self.entropy_weight.log_alpha.detach().exp())
