@@ -4,9 +4,9 @@ The public API is Stable-Baselines3's, which users know: ``Algo(env, config)``, 
 ``.predict(obs, deterministic=True)``, ``.save(path)``, ``Algo.load(path)``. An algorithm subclasses
 :class:`Algorithm` (one level of inheritance) and provides ``_build`` (networks and optimisers),
 ``_act`` (actions for a batch of observations), ``_modules``/``_optimizers`` (what a checkpoint holds) and its
-family's loop, :attr:`Algorithm.loop`: an off-policy algorithm's :class:`~pamdp.algos.offpolicy.OffPolicyLoop`
-runs its epochs (the algorithm gives it ``_explore`` and ``_update``), an on-policy one's
-:class:`~pamdp.algos.onpolicy.Rollout` collects the samples its ``_run_epoch`` learns from. Its settings are an
+family's loop, :attr:`Algorithm.loop`, which runs its epochs: an off-policy algorithm's
+:class:`~pamdp.algos.offpolicy.OffPolicyLoop` (the algorithm gives it ``_explore`` and ``_update``), an on-policy
+one's :class:`~pamdp.algos.onpolicy.Rollout` (``_values`` and ``_learn``). Its settings are an
 :class:`~pamdp.algos.settings.AlgoConfig`; checkpoints are written by :mod:`pamdp.algos.checkpoints`.
 """
 

@@ -14,6 +14,7 @@ import numpy as np
 import torch
 
 from pamdp.algos.settings import one_of, setting
+from pamdp.algos.subnormals import subnormals_flushed
 from pamdp.algos.vector_env import VectorStepper
 from pamdp.policies import PI_C_INPUTS
 
@@ -116,11 +117,19 @@ class Rollout:
             self.t_ep = np.where(step.valid, self.t_ep + 1, 0)
         return {k: np.stack(v) for k, v in rows.items()}
 
-    def epoch_stats(self, a: np.ndarray, n_actions: int, explained_var: float) -> dict[str, float]:
-        """The baseline's explained variance, the discrete actions' frequencies, the episodes completed since
-        the last call, and ``steps``."""
-        freq = np.bincount(a, minlength=n_actions) / len(a)
-        stats = {"train/explained_variance": explained_var}
+    def run_epoch(self) -> dict[str, float]:
+        """One epoch: :meth:`collect` ``batch_size`` samples, their :func:`advantage_batch` from the algorithm's
+        baseline (``_values(obs, t)``), then its ``_learn`` of the batch (subnormals flushed with
+        ``flush_denormal``). Returns ``_learn``'s stats with the baseline's explained variance, the discrete
+        actions' frequencies, the episodes completed in the epoch, and ``steps``."""
+        algo, cfg = self.algo, self.algo.config
+        batch = self.collect(cfg.batch_size)
+        data, explained_var = advantage_batch(batch, algo._values, cfg.gamma, cfg.gae_lambda, cfg.normalize_advantages)
+        with subnormals_flushed(cfg.flush_denormal):
+            stats = algo._learn(data)
+        a = data["a"]
+        freq = np.bincount(a, minlength=algo.hybrid.n_actions) / len(a)
+        stats["train/explained_variance"] = explained_var
         stats.update({f"train/action_freq_{k}": float(f) for k, f in enumerate(freq)})
         stats.update(self.stepper.episodes.pop())
         stats["steps"] = len(a)

@@ -35,7 +35,6 @@ import torch
 from pamdp.algos.base import Algorithm
 from pamdp.algos.onpolicy import (
     Rollout,
-    advantage_batch,
     mask_tensor,
     network_values,
     pi_c_input_setting,
@@ -43,7 +42,6 @@ from pamdp.algos.onpolicy import (
 )
 from pamdp.algos.optim import descend
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
-from pamdp.algos.subnormals import subnormals_flushed
 from pamdp.distributions import HybridDistribution, kl_divergence
 from pamdp.policies import ACTIVATIONS, HybridPolicy, ValueNetwork
 
@@ -196,15 +194,10 @@ class PAPPO(Algorithm):
     def _values(self, obs: np.ndarray, t: np.ndarray) -> np.ndarray:
         return network_values(self.value, obs, self.device)
 
-    def _run_epoch(self) -> dict[str, float]:
-        cfg = self.config
-        batch = self.loop.collect(cfg.batch_size)
-        data, explained_var = advantage_batch(batch, self._values, cfg.gamma, cfg.gae_lambda, cfg.normalize_advantages)
-        with subnormals_flushed(cfg.flush_denormal):
-            returns = torch.as_tensor(data["returns"], dtype=torch.float32, device=self.device)
-            stats = self._update(*update_tensors(data, self.device), returns, mask_tensor(data, self.device))
-        stats.update(self.loop.epoch_stats(data["a"], self.hybrid.n_actions, explained_var))
-        return stats
+    def _learn(self, data: dict[str, np.ndarray]) -> dict[str, float]:
+        """:meth:`_update` on an :func:`~pamdp.algos.onpolicy.advantage_batch` (the epoch: Rollout.run_epoch)."""
+        returns = torch.as_tensor(data["returns"], dtype=torch.float32, device=self.device)
+        return self._update(*update_tensors(data, self.device), returns, mask_tensor(data, self.device))
 
     def _update(self, obs, a, x, adv, returns, mask=None) -> dict[str, float]:
         """``n_epochs`` passes of minibatch Adam steps on the joint loss, stopped early by ``target_kl``; ``mask``:

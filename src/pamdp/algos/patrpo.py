@@ -32,7 +32,6 @@ from pamdp.algos.base import Algorithm
 from pamdp.algos.onpolicy import (
     LinearFeatureBaseline,
     Rollout,
-    advantage_batch,
     mask_tensor,
     network_values,
     pi_c_input_setting,
@@ -40,7 +39,6 @@ from pamdp.algos.onpolicy import (
 )
 from pamdp.algos.optim import descend
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, at_least, interval, one_of, setting
-from pamdp.algos.subnormals import subnormals_flushed
 from pamdp.algos.trpo import (
     FisherVectorProduct,
     backtracking_line_search,
@@ -194,15 +192,11 @@ class PATRPO(Algorithm):
     def _act(self, obs, deterministic, mask=None):
         return self.policy.act(obs, mask, deterministic, self.torch_gen)
 
-    # -- one epoch -------------------------------------------------------------------------------
-    def _run_epoch(self) -> dict[str, float]:
-        cfg = self.config
-        batch = self.loop.collect(cfg.batch_size)
-        data, explained_var = advantage_batch(batch, self._values, cfg.gamma, cfg.gae_lambda, cfg.normalize_advantages)
-        with subnormals_flushed(cfg.flush_denormal):
-            stats = self._update_policy(*update_tensors(data, self.device), mask_tensor(data, self.device))
-            stats["losses/value_loss"] = self._fit_baseline(data["obs"], data["t"], data["returns"])
-        stats.update(self.loop.epoch_stats(data["a"], self.hybrid.n_actions, explained_var))
+    # -- one epoch (the rollout and the advantages: Rollout.run_epoch) ------------------------------
+    def _learn(self, data: dict[str, np.ndarray]) -> dict[str, float]:
+        """The policy's step on an :func:`~pamdp.algos.onpolicy.advantage_batch`, then the baseline's fit."""
+        stats = self._update_policy(*update_tensors(data, self.device), mask_tensor(data, self.device))
+        stats["losses/value_loss"] = self._fit_baseline(data["obs"], data["t"], data["returns"])
         return stats
 
     def _update_policy(self, obs, a, x, adv, mask=None) -> dict[str, float]:
