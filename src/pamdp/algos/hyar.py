@@ -57,7 +57,7 @@ from pamdp.algos.offpolicy import (
     backprop_actor,
     linear_epsilon,
     shared_setting,
-    soft_update,
+    soft_updater,
     uniform_actions,
 )
 from pamdp.algos.optim import apply_gradients, descend
@@ -347,6 +347,7 @@ class HyAR(Algorithm):
         self.rep_optimizer = torch.optim.Adam(self._rep_params, lr=cfg.vae_lr, fused=True)
         self.actor_optimizer = torch.optim.Adam(self._actor_params, lr=cfg.actor_lr, fused=True)
         self.critic_optimizer = torch.optim.Adam(self._critic_params, lr=cfg.critic_lr, fused=True)
+        self._soft_update = soft_updater([(self.critic_target, self.critic), (self.actor_target.net, self.actor.net)])
         # the latent action that was decoded and executed
         self.loop = OffPolicyLoop(self, latent=((self.latent_size,), np.float32))
         self.replay = self.loop.buffer
@@ -531,7 +532,6 @@ class HyAR(Algorithm):
             bound = "invert" if cfg.bound == "invert" else "none"
             _, q_mu, grads = backprop_actor(self.actor, self._q1, obs, bound, self._actor_params)
             apply_gradients(self.actor_optimizer, grads, cfg.grad_clip)
-            soft_update(self.critic_target, self.critic, cfg.tau)
-            soft_update(self.actor_target.net, self.actor.net, cfg.tau)
+            self._soft_update(cfg.tau)
             stats["losses/actor_loss"] = float(-q_mu.mean())
         return stats

@@ -123,15 +123,10 @@ ActFn = Callable[
 UpdateFn = Callable[[], dict[str, float]]
 
 
-def soft_update(target: nn.Module, source: nn.Module, tau: float) -> None:
-    """Polyak averaging of target networks, as DDPG: ``theta' <- tau * theta + (1 - tau) * theta'``."""
-    with torch.no_grad():  # one foreach call, not a Python loop of a kernel per tensor
-        torch._foreach_lerp_(list(target.parameters()), list(source.parameters()), tau)
-
-
 def soft_updater(pairs: Sequence[tuple[nn.Module, nn.Module]]) -> Callable[[float], None]:
-    """:func:`soft_update` of every ``(target, source)`` pair in one foreach call, the parameter lists gathered
-    once (a module's ``parameters()`` walk costs more than the update itself at these sizes)."""
+    """Polyak averaging of target networks, as DDPG's, ``theta' <- tau * theta + (1 - tau) * theta'``, for every
+    ``(target, source)`` pair in one foreach call (not a kernel per tensor), the parameter lists gathered once (a
+    module's ``parameters()`` walk costs more than the update itself at these sizes)."""
     targets = [p for target, _ in pairs for p in target.parameters()]
     sources = [p for _, source in pairs for p in source.parameters()]
 
@@ -176,6 +171,11 @@ def temperature_gradient(entropy: torch.Tensor, target: torch.Tensor | float) ->
     the critic's values scale.
     """
     return (entropy - target).mean()
+
+
+def soft_update(target: nn.Module, source: nn.Module, tau: float) -> None:
+    """One :func:`soft_updater` step of one pair."""
+    soft_updater([(target, source)])(tau)
 
 
 class OUNoise:

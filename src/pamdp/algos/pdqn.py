@@ -49,7 +49,7 @@ from pamdp.algos.offpolicy import (
     linear_epsilon,
     mixed_target,
     shared_setting,
-    soft_update,
+    soft_updater,
     uniform_actions,
 )
 from pamdp.algos.optim import apply_gradients, descend
@@ -292,6 +292,8 @@ class PDQN(Algorithm):
         self._actor_params, self._q_params = list(self.actor.parameters()), list(self.q_net.parameters())
         self.actor_optimizer = torch.optim.Adam(self._actor_params, lr=cfg.actor_lr, fused=True)
         self.q_optimizer = torch.optim.Adam(self._q_params, lr=cfg.q_lr, fused=True)
+        self._soft_update_q = soft_updater([(self.q_target, self.q_net)])
+        self._soft_update_actor = soft_updater([(self.actor_target, self.actor)])
         self.blocks = torch.as_tensor(param_blocks(h), device=self.device)
         self.loop = OffPolicyLoop(
             self,
@@ -372,8 +374,8 @@ class PDQN(Algorithm):
         x, q_x, grads = backprop_actor(self.actor, self.q_net, obs, cfg.bound, self._actor_params)
         apply_gradients(self.actor_optimizer, grads, cfg.grad_clip)
 
-        soft_update(self.q_target, self.q_net, cfg.tau_q)
-        soft_update(self.actor_target, self.actor, cfg.tau_actor)
+        self._soft_update_q(cfg.tau_q)
+        self._soft_update_actor(cfg.tau_actor)
         return {
             "losses/critic_loss": float(q_loss.detach()),
             "losses/actor_loss": float(-q_x.sum(-1).mean()),
