@@ -2,13 +2,12 @@
 
 from __future__ import annotations
 
-from types import SimpleNamespace
-
 import gymnasium
 import numpy as np
 import pytest
 import torch
 from gymnasium import spaces
+from loop_stub import stub_algorithm
 
 from pamdp import PATRPO
 from pamdp.algos.logger import EpisodeTracker
@@ -16,7 +15,6 @@ from pamdp.algos.offpolicy import OffPolicyLoop
 from pamdp.algos.paddpg import PADDPGConfig
 from pamdp.algos.patrpo import PATRPOConfig
 from pamdp.evaluation import evaluate
-from pamdp.spaces import HybridActionSpace
 
 
 def test_tracker_by_hand_with_successes_and_an_autoreset_step():
@@ -114,23 +112,12 @@ def coins(n: int) -> Outcomes:
 def test_off_policy_epoch_reports_the_success_rate_the_env_saw():
     env = coins(8)
     env.reset(seed=0)
-    hybrid = HybridActionSpace.from_gym(env.single_action_space)
 
     def act(obs, step, episode_start, mask):
         return torch.zeros(len(obs), dtype=torch.int64), torch.zeros(len(obs), 1), {}
 
-    algo = SimpleNamespace(  # what the loop reads of an algorithm
-        config=PADDPGConfig(epoch_steps=600, learning_starts=10**9, buffer_size=10_000),
-        hybrid=hybrid,
-        obs_dim=2,
-        device=torch.device("cpu"),
-        vec_env=env,
-        np_rng=np.random.default_rng(0),
-        num_timesteps=0,
-        _explore=act,
-        _update=dict,
-        _epoch_stats=lambda step: {},
-    )
+    config = PADDPGConfig(epoch_steps=600, learning_starts=10**9, buffer_size=10_000)
+    algo = stub_algorithm(config, env, act, dict)
     stats = OffPolicyLoop(algo).run_epoch()
     rate, steps = env.expected()
     assert stats["charts/episodes"] == len(env.lengths) >= 100

@@ -1,11 +1,11 @@
 """The replay buffer (wrap-around, contents, checkpoints) and the shared off-policy loop."""
 
 import time
-from types import SimpleNamespace
 
 import numpy as np
 import pytest
 import torch
+from loop_stub import stub_algorithm
 from torch import nn
 
 from pamdp.algos.offpolicy import discounted_returns, linear_epsilon, mixed_target, soft_update
@@ -150,24 +150,6 @@ def test_descend_clips_the_gradient_norm_before_stepping(max_norm, expected_norm
     assert norm is None if max_norm == 0 else float(norm) == pytest.approx(5.0)
 
 
-def _algorithm(config, env, explore, update) -> SimpleNamespace:
-    """What an :class:`~pamdp.algos.offpolicy.OffPolicyLoop` reads of an algorithm, around fixed functions."""
-    from pamdp.spaces import HybridActionSpace
-
-    return SimpleNamespace(
-        config=config,
-        hybrid=HybridActionSpace.from_gym(env.single_action_space),
-        obs_dim=env.single_observation_space.shape[0],
-        device=torch.device("cpu"),
-        vec_env=env,
-        np_rng=np.random.default_rng(0),
-        num_timesteps=0,
-        _explore=explore,
-        _update=update,
-        _epoch_stats=lambda step: {},
-    )
-
-
 def test_epoch_stats_average_each_figure_over_the_updates_that_computed_it():
     """A figure computed every third update (a delayed actor step) is the mean of those steps, not diluted."""
     from pamdp.algos.offpolicy import OffPolicyLoop
@@ -188,7 +170,7 @@ def test_epoch_stats_average_each_figure_over_the_updates_that_computed_it():
         i = calls[-1]
         return {"every": float(i), **({"third": float(10 * i)} if i % 3 == 0 else {})}
 
-    algo = _algorithm(PADDPGConfig(epoch_steps=40, learning_starts=0, buffer_size=1000), env, act, update)
+    algo = stub_algorithm(PADDPGConfig(epoch_steps=40, learning_starts=0, buffer_size=1000), env, act, update)
     stats = OffPolicyLoop(algo).run_epoch()
     assert stats["train/updates"] == len(calls) >= 40
     assert stats["every"] == pytest.approx(np.mean(calls))
@@ -212,7 +194,7 @@ def test_reward_scale_scales_what_the_critics_learn_from_and_nothing_the_user_se
             return torch.zeros(n, dtype=torch.long), torch.full((n, hybrid.max_param_size), 0.2), {}
 
         config = PADDPGConfig(epoch_steps=200, learning_starts=10**6, reward_scale=scale, buffer_size=1000)
-        loop = OffPolicyLoop(_algorithm(config, env, act, lambda: {}), mc_returns=True)
+        loop = OffPolicyLoop(stub_algorithm(config, env, act, lambda: {}), mc_returns=True)
         stats = loop.run_epoch()
         buffer = loop.buffer
         n = len(buffer)
