@@ -11,7 +11,8 @@ from torch import nn
 
 from pamdp import PADDPG, PASVG0
 from pamdp.algos.dense import Dense
-from pamdp.algos.offpolicy import backprop_actor, clip_grads, optimizer_step
+from pamdp.algos.offpolicy import backprop_actor
+from pamdp.algos.optim import clip_grads, optimizer_step
 from pamdp.algos.paddpg import PADDPGConfig
 from pamdp.algos.pasvg import PASVG0Config
 from pamdp.policies import mlp
@@ -107,7 +108,12 @@ def _autograd_update(model):
     (q - y).square().mean().backward()
     nn.utils.clip_grad_norm_(model.critic.parameters(), cfg.grad_clip)
     model.critic_optimizer.step()
-    backprop_actor(lambda o: model._masked(model.actor(o), batch.get("mask")), model.critic, obs, cfg.bound)
+    params = list(model.actor.parameters())
+    _, _, grads = backprop_actor(
+        lambda o: model._masked(model.actor(o), batch.get("mask")), model.critic, obs, cfg.bound, params
+    )
+    for p, g in zip(params, grads):
+        p.grad = g
     nn.utils.clip_grad_norm_(model.actor.parameters(), cfg.grad_clip)
     model.actor_optimizer.step()
     with torch.no_grad():

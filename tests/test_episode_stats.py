@@ -7,15 +7,14 @@ import numpy as np
 import pytest
 import torch
 from gymnasium import spaces
+from loop_stub import stub_algorithm
 
 from pamdp import PATRPO
 from pamdp.algos.logger import EpisodeTracker
 from pamdp.algos.offpolicy import OffPolicyLoop
 from pamdp.algos.paddpg import PADDPGConfig
 from pamdp.algos.patrpo import PATRPOConfig
-from pamdp.algos.replay import ReplayBuffer
 from pamdp.evaluation import evaluate
-from pamdp.spaces import HybridActionSpace
 
 
 def test_tracker_by_hand_with_successes_and_an_autoreset_step():
@@ -113,15 +112,13 @@ def coins(n: int) -> Outcomes:
 def test_off_policy_epoch_reports_the_success_rate_the_env_saw():
     env = coins(8)
     env.reset(seed=0)
-    hybrid = HybridActionSpace.from_gym(env.single_action_space)
-    fields = {"obs": ((2,), np.float32), "a": ((), np.int64), "x": ((1,), np.float32), "reward": ((), np.float32)}
-    fields |= {"next_obs": ((2,), np.float32), "terminated": ((), np.bool_)}
-    loop = OffPolicyLoop(PADDPGConfig(epoch_steps=600, learning_starts=10**9), hybrid, ReplayBuffer(10_000, fields))
 
     def act(obs, step, episode_start, mask):
         return torch.zeros(len(obs), dtype=torch.int64), torch.zeros(len(obs), 1), {}
 
-    stats = loop.run_epoch(env, act, dict, 0, np.random.default_rng(0))
+    config = PADDPGConfig(epoch_steps=600, learning_starts=10**9, buffer_size=10_000)
+    algo = stub_algorithm(config, env, act, dict)
+    stats = OffPolicyLoop(algo).run_epoch()
     rate, steps = env.expected()
     assert stats["charts/episodes"] == len(env.lengths) >= 100
     assert 0 < sum(s is None for s in env.reports) < len(env.reports)  # truncated episodes, not counted

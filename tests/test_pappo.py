@@ -124,7 +124,7 @@ def test_entropy_parts_add_up_to_the_chain_rule_entropy():
 
 def test_update_improves_the_surrogate_and_target_kl_stops_it_early():
     model = PAPPO("pamdp/Platform-v0", SMALL)
-    batch = model.rollout.collect(model.vec_env, model.policy, model.hybrid, 500, model.np_rng, model.torch_gen)
+    batch = model.loop.collect(500)
     valid = batch["valid"].reshape(-1)
     obs = model._obs_tensor(batch["obs"].reshape(-1, model.obs_dim)[valid])
     a, x = torch.as_tensor(batch["a"].reshape(-1)[valid]), torch.as_tensor(batch["x"].reshape(-1, 1)[valid])

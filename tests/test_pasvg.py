@@ -79,7 +79,7 @@ def test_reparameterised_gradient_matches_finite_differences(hard):
     eta_x = torch.randn(6, 2, generator=gen, dtype=torch.float64)
 
     def objective():
-        _, a, x = policy(obs, eta_a, eta_x, 0.8, hard)
+        *_, a, x = policy(obs, eta_a, eta_x, 0.8, hard)
         return toy_critic(obs, a, x).mean()
 
     params = dict(policy.named_parameters())
@@ -109,7 +109,7 @@ def test_expected_value_is_the_mean_over_gumbel_samples_and_its_gradient_is_exac
     n = 200_000
     with torch.no_grad():
         obs_n, eta_x_n = obs.repeat(n, 1), eta_x.repeat(n, 1)
-        _, a, x = policy(obs_n, gumbel_noise((3 * n, 3), gen).double(), eta_x_n, 1.0, True)
+        *_, a, x = policy(obs_n, gumbel_noise((3 * n, 3), gen).double(), eta_x_n, 1.0, True)
         q = toy_critic(obs_n, a, x).reshape(n, 3)
     np.testing.assert_allclose(value.detach(), q.mean(0), atol=4 * float(q.std(0).max()) / n**0.5)
 
@@ -148,7 +148,7 @@ def test_expected_td_target_averages_the_target_policys_actions():
 def test_parameters_stay_in_bounds_and_unused_ones_are_zero():
     policy = GumbelHybridPolicy(4, HYBRID, (8,), "relu", init_log_std=1.5)
     gen = torch.Generator().manual_seed(0)
-    index, _, x = policy(
+    _, index, _, x = policy(
         torch.randn(500, 4, generator=gen), gumbel_noise((500, 3), gen), torch.randn(500, 2) * 5, 1.0, True
     )
     assert x.abs().max() <= 1.0
@@ -174,7 +174,7 @@ def test_epoch_stores_valid_transitions_with_their_noise_and_learns():
     fresh.learn(100, progress_bar=False)
     k = len(fresh.replay)
     with torch.no_grad():
-        index, _, x = fresh.policy(
+        _, index, _, x = fresh.policy(
             fresh.replay.data["obs"][:k],
             fresh.replay.data["eta_a"][:k],
             fresh.replay.data["eta_x"][:k],

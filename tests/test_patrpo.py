@@ -85,7 +85,7 @@ def float64_batch(model: PATRPO, n: int) -> tuple[torch.Tensor, ...]:
     """``n`` samples of ``model``'s policy with their advantages, as the policy update takes them, after which
     the policy computes in float64: so that its conjugate gradients converge to rounding."""
     cfg = model.config
-    batch = model.rollout.collect(model.vec_env, model.policy, model.hybrid, n, model.np_rng, model.torch_gen)
+    batch = model.loop.collect(n)
     model.policy.double()
     data, _ = advantage_batch(batch, model._values, cfg.gamma, cfg.gae_lambda, True)
     return tuple(t.double() if t.is_floating_point() else t for t in update_tensors(data))

@@ -5,9 +5,11 @@ import time
 import numpy as np
 import pytest
 import torch
+from loop_stub import stub_algorithm
 from torch import nn
 
-from pamdp.algos.offpolicy import clipped_step, discounted_returns, linear_epsilon, mixed_target, soft_update
+from pamdp.algos.offpolicy import discounted_returns, linear_epsilon, mixed_target, soft_update
+from pamdp.algos.optim import descend
 from pamdp.algos.replay import ReplayBuffer
 
 FIELDS = {"obs": ((2,), np.float32), "a": ((), np.int64), "eta": ((3,), np.float32)}
@@ -140,11 +142,12 @@ def test_linear_epsilon_endpoints():
 
 
 @pytest.mark.parametrize("max_norm, expected_norm", [(0.0, 5.0), (1.0, 1.0), (10.0, 5.0)])
-def test_clipped_step_clips_the_gradient_norm_before_stepping(max_norm, expected_norm):
+def test_descend_clips_the_gradient_norm_before_stepping(max_norm, expected_norm):
     w = nn.Parameter(torch.zeros(2))
-    w.grad = torch.tensor([3.0, 4.0])  # norm 5
-    clipped_step(torch.optim.SGD([w], lr=1.0), [w], max_norm)
+    loss = -(w * torch.tensor([3.0, 4.0])).sum()  # gradient norm 5
+    norm = descend(torch.optim.SGD([w], lr=1.0), loss, [w], max_norm)
     assert float(w.detach().norm()) == pytest.approx(expected_norm)
+    assert norm is None if max_norm == 0 else float(norm) == pytest.approx(5.0)
 
 
 def test_epoch_stats_average_each_figure_over_the_updates_that_computed_it():
@@ -156,16 +159,6 @@ def test_epoch_stats_average_each_figure_over_the_updates_that_computed_it():
 
     env = make_vector_env("pamdp/Platform-v0", 4)
     hybrid = HybridActionSpace.from_gym(env.single_action_space)
-    fields = {
-        "obs": ((env.single_observation_space.shape[0],), np.float32),
-        "a": ((), np.int64),
-        "x": ((hybrid.max_param_size,), np.float32),
-        "reward": ((), np.float32),
-        "next_obs": ((env.single_observation_space.shape[0],), np.float32),
-        "terminated": ((), np.bool_),
-    }
-    config = PADDPGConfig(epoch_steps=40, learning_starts=0)
-    loop = OffPolicyLoop(config, hybrid, ReplayBuffer(1000, fields))
     calls = []
 
     def act(obs, step, episode_start, mask):
@@ -177,8 +170,8 @@ def test_epoch_stats_average_each_figure_over_the_updates_that_computed_it():
         i = calls[-1]
         return {"every": float(i), **({"third": float(10 * i)} if i % 3 == 0 else {})}
 
-    rng = np.random.default_rng(0)
-    stats = loop.run_epoch(env, act, update, 0, rng)
+    algo = stub_algorithm(PADDPGConfig(epoch_steps=40, learning_starts=0, buffer_size=1000), env, act, update)
+    stats = OffPolicyLoop(algo).run_epoch()
     assert stats["train/updates"] == len(calls) >= 40
     assert stats["every"] == pytest.approx(np.mean(calls))
     assert stats["third"] == pytest.approx(np.mean([10 * i for i in calls if i % 3 == 0]))
@@ -195,26 +188,15 @@ def test_reward_scale_scales_what_the_critics_learn_from_and_nothing_the_user_se
     def run(scale):
         env = make_vector_env("pamdp/Platform-v0", 4)
         hybrid = HybridActionSpace.from_gym(env.single_action_space)
-        d = env.single_observation_space.shape[0]
-        fields = {
-            "obs": ((d,), np.float32),
-            "a": ((), np.int64),
-            "x": ((hybrid.max_param_size,), np.float32),
-            "reward": ((), np.float32),
-            "next_obs": ((d,), np.float32),
-            "terminated": ((), np.bool_),
-            "mc": ((), np.float32),
-        }
-        buffer = ReplayBuffer(1000, fields)
-        loop = OffPolicyLoop(
-            PADDPGConfig(epoch_steps=200, learning_starts=10**6, reward_scale=scale), hybrid, buffer, True
-        )
 
         def act(obs, step, episode_start, mask):  # run right at speed 0.6: episodes of several steps, rewards > 0
             n = len(obs)
             return torch.zeros(n, dtype=torch.long), torch.full((n, hybrid.max_param_size), 0.2), {}
 
-        stats = loop.run_epoch(env, act, lambda: {}, 0, np.random.default_rng(0))
+        config = PADDPGConfig(epoch_steps=200, learning_starts=10**6, reward_scale=scale, buffer_size=1000)
+        loop = OffPolicyLoop(stub_algorithm(config, env, act, lambda: {}), mc_returns=True)
+        stats = loop.run_epoch()
+        buffer = loop.buffer
         n = len(buffer)
         return stats, {k: buffer.data[k][:n].numpy() for k in ("reward", "mc")}
 

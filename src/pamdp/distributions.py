@@ -22,9 +22,13 @@ import torch
 import torch.nn.functional as F
 
 __all__ = [
+    "Categorical",
     "HybridDistribution",
     "KL_ESTIMATORS",
+    "LOG_STD_MIN",
+    "LOG_STD_MAX",
     "MASKED",
+    "SquashedHybrid",
     "draw_action",
     "draw_params",
     "kl_divergence",
@@ -36,6 +40,10 @@ _LOG_2PI = math.log(2.0 * math.pi)
 # What a masked action's logit (or Q-value) becomes: finite, so that softmax gives it probability 0 exactly and
 # p * log p stays 0 (not 0 * -inf = NaN), and far below any logit or return the networks produce.
 MASKED = -1e9
+LOG_STD_MIN, LOG_STD_MAX = -5.0, 2.0
+"""The range a learned log standard deviation is clamped to where a network or a free parameter outputs it (the
+off-policy policies and HyAR's encoder), as Spinning Up's and SAC's reference code clamp theirs: wide enough for
+any useful noise, narrow enough that ``exp`` neither vanishes nor explodes."""
 
 
 def masked_logits(logits: torch.Tensor, mask: torch.Tensor | None) -> torch.Tensor:
@@ -75,26 +83,16 @@ def draw_params(
 
 
 @dataclass
-class HybridDistribution:
-    """A batch of hybrid action distributions.
+class Categorical:
+    """``pi_d(a | s)``, the categorical part of a hybrid distribution, and what both hybrid distributions below
+    compute from it alone.
 
     Attributes:
-        logits: ``(B, K)`` unnormalised log-probabilities of ``pi_d``.
-        means: ``(B, K, m)`` parameter means of ``pi_c(. | s, a)`` for every action ``a``.
-        log_std: ``(K, m)`` or ``(B, K, m)`` log standard deviations of ``pi_c``.
-        mask: ``(K, m)`` boolean, which padded entries each action uses.
+        logits: ``(B, K)`` unnormalised log-probabilities of ``pi_d`` (masked actions at :data:`MASKED`).
     """
 
     logits: torch.Tensor
-    means: torch.Tensor
-    log_std: torch.Tensor
-    mask: torch.Tensor
 
-    def __post_init__(self):
-        self.log_std = self.log_std.expand_as(self.means)
-        self.mask = self.mask.to(self.means.dtype)
-
-    # -- pieces ------------------------------------------------------------------------------
     @property
     def log_probs_d(self) -> torch.Tensor:
         """``(B, K)`` normalised ``log pi_d(a | s)``."""
@@ -104,6 +102,31 @@ class HybridDistribution:
     def probs_d(self) -> torch.Tensor:
         return F.softmax(self.logits, dim=-1)
 
+    def entropy_d(self) -> torch.Tensor:
+        """``(B,)`` the entropy of ``pi_d`` (masked actions contribute nothing)."""
+        return -(self.probs_d * self.log_probs_d).sum(-1)
+
+
+@dataclass
+class HybridDistribution(Categorical):
+    """A batch of hybrid action distributions with Gaussian parameters (PATRPO's and PAPPO's).
+
+    Attributes:
+        logits: ``(B, K)`` unnormalised log-probabilities of ``pi_d``.
+        means: ``(B, K, m)`` parameter means of ``pi_c(. | s, a)`` for every action ``a``.
+        log_std: ``(K, m)`` or ``(B, K, m)`` log standard deviations of ``pi_c``.
+        mask: ``(K, m)`` boolean, which padded entries each action uses.
+    """
+
+    means: torch.Tensor
+    log_std: torch.Tensor
+    mask: torch.Tensor
+
+    def __post_init__(self):
+        self.log_std = self.log_std.expand_as(self.means)
+        self.mask = self.mask.to(self.means.dtype)
+
+    # -- pieces ------------------------------------------------------------------------------
     def _at(self, tensor: torch.Tensor, a: torch.Tensor) -> torch.Tensor:
         """Select action ``a``'s row of a ``(B, K, m)`` tensor: ``(B, m)``."""
         return tensor.gather(1, a.long().view(-1, 1, 1).expand(-1, 1, tensor.shape[-1])).squeeze(1)
@@ -134,7 +157,7 @@ class HybridDistribution:
 
     def entropy(self) -> torch.Tensor:
         """Exact joint entropy by the chain rule: ``H(pi_d) + sum_a pi_d(a) H(pi_c(. | s, a))``."""
-        p, logp = self.probs_d, self.log_probs_d
+        p, logp = self.probs_d, self.log_probs_d  # p once: its gradient gathers both terms', as it always did
         return -(p * logp).sum(-1) + (p * self.entropy_c()).sum(-1)
 
     # -- divergences -------------------------------------------------------------------------
@@ -195,6 +218,54 @@ class HybridDistribution:
         """A sub-batch (the state dimension only)."""
         log_std = self.log_std[index]
         return HybridDistribution(self.logits[index], self.means[index], log_std, self.mask)
+
+
+@dataclass
+class SquashedHybrid(Categorical):
+    """A batch of hybrid distributions with tanh-squashed Gaussian parameters, every action's at once: Hybrid
+    SAC's policy (Delalleau et al. 2019), ``x = tanh(u)``, ``u ~ N(mean, exp(log_std))``, so that
+
+        log pi_c(x | s, a) = sum_i [ log N(u_i; mean_i, sigma_i) - log(1 - tanh(u_i)^2) ]
+
+    over the ``m_a`` parameters of action ``a`` (the change of variables of SAC's squashed Gaussian, Haarnoja et
+    al. 2018, appendix C).
+
+    Attributes:
+        logits: ``(B, K)`` logits of ``pi_d``, masked actions already at :data:`~pamdp.distributions.MASKED`.
+        mean: ``(B, K, m)`` means of the pre-squash Gaussians ``u``, per action and padded parameter.
+        log_std: ``(B, K, m)`` their log standard deviations.
+        param_mask: ``(K, m)`` float, 1 where action ``a`` uses padded parameter ``i``.
+    """
+
+    mean: torch.Tensor
+    log_std: torch.Tensor
+    param_mask: torch.Tensor
+
+    def rsample(self, generator: torch.Generator | None = None) -> tuple[torch.Tensor, torch.Tensor]:
+        """Reparameterised pre-squash ``u`` and parameters ``x = tanh(u)`` of every action, ``(B, K, m)`` each;
+        unused entries are zero."""
+        noise = torch.randn(self.mean.shape, generator=generator, dtype=self.mean.dtype, device=self.mean.device)
+        u = (self.mean + self.log_std.exp() * noise) * self.param_mask
+        return u, torch.tanh(u)
+
+    def log_prob_c(self, u: torch.Tensor) -> torch.Tensor:
+        """``(B, K)``: ``log pi_c(tanh(u_a) | s, a)`` for every action, over its own ``m_a`` parameters only.
+
+        ``log(1 - tanh(u)^2) = 2 (log 2 - u - softplus(-2 u))``, which stays finite where ``tanh(u)`` rounds to 1.
+        """
+        z = (u - self.mean) * torch.exp(-self.log_std)
+        gaussian = -0.5 * z.pow(2) - self.log_std - 0.5 * _LOG_2PI
+        log_det = 2.0 * (math.log(2.0) - u - F.softplus(-2.0 * u))
+        return ((gaussian - log_det) * self.param_mask).sum(-1)
+
+    def sample_discrete(self, generator: torch.Generator | None = None) -> torch.Tensor:
+        """``(B,)`` actions drawn from ``pi_d``."""
+        return draw_action(self.logits, False, generator)
+
+    def mode(self) -> tuple[torch.Tensor, torch.Tensor]:
+        """The greedy action: ``argmax_a pi_d(a | s)`` and ``tanh`` of its Gaussian's mean, ``(B,)`` and ``(B, m)``."""
+        a = self.logits.argmax(-1)
+        return a, torch.tanh(self.mean[torch.arange(len(a), device=a.device), a]) * self.param_mask[a]
 
 
 def kl_divergence(

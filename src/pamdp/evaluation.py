@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from pamdp.algos.logger import success_summary, successes
-from pamdp.algos.vector_env import info_action_masks, make_vector_env
+from pamdp.algos.logger import success_summary
+from pamdp.algos.vector_env import VectorStepper, make_vector_env
 
 __all__ = ["evaluate"]
 
@@ -42,28 +42,18 @@ def evaluate(
     returns: list[float] = []
     lengths: list[int] = []
     succeeded: list[bool | None] = []
-    ep_return, ep_length = np.zeros(num_envs), np.zeros(num_envs, dtype=np.int64)
     done_count = np.zeros(num_envs, dtype=np.int64)
-    prev_done = np.zeros(num_envs, dtype=bool)
-    obs, info = env.reset(seed=seed)
-    masked = model.config.action_mask  # the env's info["action_mask"], as in training
+    # the env's info["action_mask"], as in training
+    stepper = VectorStepper(env, model.hybrid.n_actions, model.config.action_mask, seed)
     try:
         while np.any(done_count < quota):
-            mask = info_action_masks(info, num_envs, model.hybrid.n_actions) if masked else None
-            action = model.predict(obs, deterministic=deterministic, action_mask=mask)
-            obs, reward, terminated, truncated, info = env.step(action)
-            valid = ~prev_done
-            ep_return += np.where(valid, reward, 0.0)
-            ep_length += valid
-            done = (terminated | truncated) & valid
-            for i, success in zip(np.flatnonzero(done), successes(info, done)):
+            step = stepper.step(model.predict(stepper.obs, deterministic=deterministic, action_mask=stepper.masks))
+            for i, ret, length, success in zip(step.ended, step.returns, step.lengths, step.successes):
                 if done_count[i] < quota[i]:
-                    returns.append(float(ep_return[i]))
-                    lengths.append(int(ep_length[i]))
+                    returns.append(float(ret))
+                    lengths.append(int(length))
                     succeeded.append(success)
                     done_count[i] += 1
-            ep_return[done], ep_length[done] = 0.0, 0
-            prev_done = done
     finally:
         env.close()
     result = {

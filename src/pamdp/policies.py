@@ -28,7 +28,10 @@ __all__ = [
     "PI_C_INPUTS",
     "EVERY_ACTION_ROWS",
     "mlp",
+    "small_init_",
+    "hierarchical_mlps",
     "every_action_linear",
+    "every_action_mlp",
     "in_chunks",
     "LinearizedMLP",
     "HybridPolicy",
@@ -63,6 +66,37 @@ def mlp(
     return nn.Sequential(*layers)
 
 
+def small_init_(*layers: nn.Linear) -> None:
+    """Draw final layers' weights in ``[-3e-3, 3e-3]`` with zero biases, so that a policy starts near uniform over
+    the discrete actions and near the centre of the parameter box, as rllab's and Spinning Up's policies do."""
+    for layer in layers:
+        nn.init.uniform_(layer.weight, -3e-3, 3e-3)
+        nn.init.zeros_(layer.bias)
+
+
+def hierarchical_mlps(
+    obs_dim: int,
+    n_actions: int,
+    hidden_sizes: Sequence[int],
+    activation: str,
+    pi_c_size: int,
+    pi_c_input: str = "onehot",
+    tanh: bool = False,
+) -> tuple[nn.Sequential, nn.Sequential]:
+    """The hierarchical policy's two networks (Wei, Wicke & Luke 2018): ``pi_d = mlp(s)`` with K logits and
+    ``pi_c = mlp([s, onehot(a)])`` (``pi_c_input="state"``: ``mlp(s)``) with ``pi_c_size`` outputs, a Tanh after
+    them with ``tanh``; both final layers small (:func:`small_init_`). The heads on them are each method's:
+    PATRPO's and PAPPO's Gaussian (:class:`HybridPolicy`), PASVG(0)'s Gumbel-Softmax and Tanh-squashed noise,
+    Hybrid SAC's squashed Gaussian with a learned log-std per state."""
+    if pi_c_input not in PI_C_INPUTS:
+        raise ValueError(f"unknown pi_c_input {pi_c_input!r}; expected one of {', '.join(PI_C_INPUTS)}")
+    pi_d = mlp(obs_dim, hidden_sizes, n_actions, activation)
+    pi_c_in = obs_dim + n_actions if pi_c_input == "onehot" else obs_dim
+    pi_c = mlp(pi_c_in, hidden_sizes, pi_c_size, activation, nn.Tanh if tanh else None)
+    small_init_(pi_d[-1], pi_c[-2] if tanh else pi_c[-1])
+    return pi_d, pi_c
+
+
 def every_action_linear(
     obs: torch.Tensor, weight: torch.Tensor, bias: torch.Tensor | None, a: torch.Tensor | None = None
 ) -> torch.Tensor:
@@ -78,6 +112,13 @@ def every_action_linear(
     state = F.linear(obs, weight[:, :d], bias)
     columns = weight[:, d:].T.contiguous()  # else the sum takes the transpose's layout and the next layer copies it
     return state.unsqueeze(-2) + columns if a is None else state + columns[a]
+
+
+def every_action_mlp(net: nn.Sequential, obs: torch.Tensor, a: torch.Tensor | None = None) -> torch.Tensor:
+    """An :func:`mlp` on ``[s, onehot(k)]`` for every action ``k``, ``(B, K, out)``, or for ``k = a``, ``(B, out)``:
+    its first layer by :func:`every_action_linear`, without building the one-hot inputs."""
+    first = net[0]
+    return net[1:](every_action_linear(obs, first.weight, first.bias, a))
 
 
 def in_chunks(fn: Callable[..., torch.Tensor], n_actions: int, *batches: torch.Tensor) -> torch.Tensor:
@@ -175,23 +216,16 @@ class HybridPolicy(nn.Module):
         pi_c_input: str = "onehot",
     ):
         super().__init__()
-        if pi_c_input not in PI_C_INPUTS:
-            raise ValueError(f"unknown pi_c_input {pi_c_input!r}; expected one of {', '.join(PI_C_INPUTS)}")
         self.obs_dim = int(obs_dim)
         self.n_actions = action_space.n_actions
         self.param_size = action_space.max_param_size
         self.onehot_input = pi_c_input == "onehot"
-        self.pi_d = mlp(self.obs_dim, hidden_sizes, self.n_actions, activation)
-        if self.onehot_input:
-            self.pi_c = mlp(self.obs_dim + self.n_actions, hidden_sizes, self.param_size, activation, nn.Tanh)
-        else:
-            self.pi_c = mlp(self.obs_dim, hidden_sizes, self.n_actions * self.param_size, activation, nn.Tanh)
+        size = self.param_size if self.onehot_input else self.n_actions * self.param_size
+        self.pi_d, self.pi_c = hierarchical_mlps(
+            self.obs_dim, self.n_actions, hidden_sizes, activation, size, pi_c_input, tanh=True
+        )
         self.log_std = nn.Parameter(torch.full((self.n_actions, self.param_size), float(init_log_std)))
         self.register_buffer("mask", torch.tensor(action_space.param_mask))
-        # Small final layers start both policies near uniform / centred, as rllab and Spinning Up do.
-        for head in (self.pi_d[-1], self.pi_c[-2]):
-            nn.init.uniform_(head.weight, -3e-3, 3e-3)
-            nn.init.zeros_(head.bias)
 
     def _blocks(self, out: torch.Tensor) -> torch.Tensor:
         """A state-input ``pi_c``'s outputs ``(..., K * m)`` as every action's mean ``(..., K, m)``."""
@@ -202,8 +236,7 @@ class HybridPolicy(nn.Module):
         ``pi_c`` of every one-hot in one pass (its first layer by :func:`every_action_linear`)."""
         if not self.onehot_input:
             return self._blocks(self.pi_c(obs))
-        first = self.pi_c[0]
-        return in_chunks(lambda o: self.pi_c[1:](every_action_linear(o, first.weight, first.bias)), self.n_actions, obs)
+        return in_chunks(lambda o: every_action_mlp(self.pi_c, o), self.n_actions, obs)
 
     def forward(self, obs: torch.Tensor, action_mask: torch.Tensor | None = None) -> HybridDistribution:
         """The distribution at ``obs`` ``(B, obs_dim)``, with ``pi_c`` evaluated for every action in one pass;
@@ -222,8 +255,7 @@ class HybridPolicy(nn.Module):
         the chosen action only: acting needs no other action's mean."""
         a = draw_action(masked_logits(self.pi_d(obs), action_mask), deterministic, generator)
         if self.onehot_input:
-            first = self.pi_c[0]
-            mu = self.pi_c[1:](every_action_linear(obs, first.weight, first.bias, a))
+            mu = every_action_mlp(self.pi_c, obs, a)
         else:
             mu = self._blocks(self.pi_c(obs))[torch.arange(len(a)), a]
         return a, draw_params(mu, self.log_std[a], self.mask[a], deterministic, generator)

@@ -3,8 +3,10 @@
 The public API is Stable-Baselines3's, which users know: ``Algo(env, config)``, ``.learn(total_timesteps)``,
 ``.predict(obs, deterministic=True)``, ``.save(path)``, ``Algo.load(path)``. An algorithm subclasses
 :class:`Algorithm` (one level of inheritance) and provides ``_build`` (networks and optimisers),
-``_run_epoch`` (collect and learn from one epoch of samples), ``_act`` (actions for a batch of
-observations) and ``_modules``/``_optimizers`` (what a checkpoint holds). Its settings are an
+``_act`` (actions for a batch of observations), ``_modules``/``_optimizers`` (what a checkpoint holds) and its
+family's loop, :attr:`Algorithm.loop`, which runs its epochs: an off-policy algorithm's
+:class:`~pamdp.algos.offpolicy.OffPolicyLoop` (the algorithm gives it ``_explore`` and ``_update``), an on-policy
+one's :class:`~pamdp.algos.onpolicy.Rollout` (``_values`` and ``_learn``). Its settings are an
 :class:`~pamdp.algos.settings.AlgoConfig`; checkpoints are written by :mod:`pamdp.algos.checkpoints`.
 """
 
@@ -78,6 +80,8 @@ class Algorithm:
     """Base class of pamdp's algorithms; see the module docstring for what a subclass provides."""
 
     config_class: ClassVar[type[AlgoConfig]] = AlgoConfig
+    loop = None
+    """The family's loop, built by ``_build``; a loop with a ``state_dict`` (the replay) is saved with the model."""
 
     def __init__(self, env, config: AlgoConfig | dict | None = None, env_kwargs: dict | None = None):
         """``config``: the algorithm's config, or a dict of settings over the defaults (``{"delta": 0.01}``); ``None``:
@@ -129,8 +133,13 @@ class Algorithm:
         raise NotImplementedError
 
     def _run_epoch(self) -> dict[str, float]:
-        """Collect one epoch of samples and learn from them; returns statistics including ``"steps"``."""
-        raise NotImplementedError
+        """Collect one epoch of samples and learn from them; returns statistics including ``"steps"``. By default
+        the family loop's epoch."""
+        return self.loop.run_epoch()
+
+    def _epoch_stats(self, step: int) -> dict[str, float]:
+        """The algorithm's own figures at the end of an epoch, after ``step`` samples (a schedule's value)."""
+        return {}
 
     def _act(
         self, obs: torch.Tensor, deterministic: bool, mask: torch.Tensor | None = None
@@ -145,8 +154,8 @@ class Algorithm:
     def _optimizers(self) -> dict[str, torch.optim.Optimizer]:
         return {}
 
-    def _extra_state(self, replay: bool) -> dict:
-        """What a checkpoint holds besides modules and optimisers; ``replay``: the replay buffer's contents too."""
+    def _extra_state(self) -> dict:
+        """What a checkpoint holds besides modules, optimisers and the loop's state."""
         return {}
 
     def _load_extra_state(self, state: dict) -> None:
@@ -326,8 +335,10 @@ class Algorithm:
             },
             "modules": {k: m.state_dict() for k, m in self._modules().items()},
             "optimizers": {k: o.state_dict() for k, o in self._optimizers().items()},
-            "extra": self._extra_state(replay),
+            "extra": self._extra_state(),
         }
+        if hasattr(self.loop, "state_dict"):
+            payload["extra"]["loop"] = self.loop.state_dict(replay)
         atomic_save(payload, path)
 
     @classmethod
@@ -360,6 +371,8 @@ class Algorithm:
             module.load_state_dict(payload["modules"][name])
         for name, opt in algo._optimizers().items():
             opt.load_state_dict(payload["optimizers"][name])
+        if hasattr(algo.loop, "load_state_dict"):
+            algo.loop.load_state_dict(payload["extra"]["loop"])
         algo._load_extra_state(payload["extra"])
         algo.preset = payload.get("preset")  # files written before it was kept: None
         algo.num_timesteps = int(payload["num_timesteps"])

@@ -49,25 +49,24 @@ from pamdp.algos.base import Algorithm
 from pamdp.algos.offpolicy import (
     OffPolicyConfig,
     OffPolicyLoop,
-    gradient_step,
-    optimizer_step,
+    Temperatures,
+    TwinQ,
     shared_setting,
     soft_updater,
+    temperature_gradient,
 )
-from pamdp.algos.replay import ReplayBuffer, transition_fields
+from pamdp.algos.optim import apply_gradients, descend
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
-from pamdp.distributions import MASKED, masked_logits
-from pamdp.policies import ACTIVATIONS, every_action_linear, mlp
+from pamdp.distributions import LOG_STD_MAX, LOG_STD_MIN, MASKED, SquashedHybrid, masked_logits
+from pamdp.policies import ACTIVATIONS, every_action_mlp, hierarchical_mlps, mlp, small_init_
 from pamdp.spaces import HybridActionSpace
 
 if TYPE_CHECKING:
     from typing_extensions import Self
 
-__all__ = ["HybridSAC", "HybridSACConfig", "SquashedHybrid", "HybridSACActor", "TwinQ", "temperature_gradient"]
+__all__ = ["HybridSAC", "HybridSACConfig", "HybridSACActor"]
 
 FORMS = ("flat", "hierarchical")
-LOG_STD_MIN, LOG_STD_MAX = -5.0, 2.0
-_LOG_2PI = math.log(2.0 * math.pi)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -139,62 +138,6 @@ class HybridSACConfig(OffPolicyConfig, AlgoConfig):
         }
 
 
-@dataclasses.dataclass
-class SquashedHybrid:
-    """A batch of hybrid distributions with tanh-squashed Gaussian parameters, every action's at once.
-
-    Attributes:
-        logits: ``(B, K)`` logits of ``pi_d``, masked actions already at :data:`~pamdp.distributions.MASKED`.
-        mean: ``(B, K, m)`` means of the pre-squash Gaussians ``u``, per action and padded parameter.
-        log_std: ``(B, K, m)`` their log standard deviations.
-        param_mask: ``(K, m)`` float, 1 where action ``a`` uses padded parameter ``i``.
-    """
-
-    logits: torch.Tensor
-    mean: torch.Tensor
-    log_std: torch.Tensor
-    param_mask: torch.Tensor
-
-    @property
-    def log_probs_d(self) -> torch.Tensor:
-        """``(B, K)`` normalised ``log pi_d(a | s)``."""
-        return F.log_softmax(self.logits, dim=-1)
-
-    @property
-    def probs_d(self) -> torch.Tensor:
-        return F.softmax(self.logits, dim=-1)
-
-    def entropy_d(self) -> torch.Tensor:
-        """``(B,)`` the entropy of ``pi_d`` (masked actions contribute nothing)."""
-        return -(self.probs_d * self.log_probs_d).sum(-1)
-
-    def rsample(self, generator: torch.Generator | None = None) -> tuple[torch.Tensor, torch.Tensor]:
-        """Reparameterised pre-squash ``u`` and parameters ``x = tanh(u)`` of every action, ``(B, K, m)`` each;
-        unused entries are zero."""
-        noise = torch.randn(self.mean.shape, generator=generator, dtype=self.mean.dtype, device=self.mean.device)
-        u = (self.mean + self.log_std.exp() * noise) * self.param_mask
-        return u, torch.tanh(u)
-
-    def log_prob_c(self, u: torch.Tensor) -> torch.Tensor:
-        """``(B, K)``: ``log pi_c(tanh(u_a) | s, a)`` for every action, over its own ``m_a`` parameters only.
-
-        ``log(1 - tanh(u)^2) = 2 (log 2 - u - softplus(-2 u))``, which stays finite where ``tanh(u)`` rounds to 1.
-        """
-        z = (u - self.mean) * torch.exp(-self.log_std)
-        gaussian = -0.5 * z.pow(2) - self.log_std - 0.5 * _LOG_2PI
-        log_det = 2.0 * (math.log(2.0) - u - F.softplus(-2.0 * u))
-        return ((gaussian - log_det) * self.param_mask).sum(-1)
-
-    def sample_discrete(self, generator: torch.Generator | None = None) -> torch.Tensor:
-        """``(B,)`` actions drawn from ``pi_d``."""
-        return torch.multinomial(self.probs_d, 1, generator=generator).squeeze(-1)
-
-    def mode(self) -> tuple[torch.Tensor, torch.Tensor]:
-        """The greedy action: ``argmax_a pi_d(a | s)`` and ``tanh`` of its Gaussian's mean, ``(B,)`` and ``(B, m)``."""
-        a = self.logits.argmax(-1)
-        return a, torch.tanh(self.mean[torch.arange(len(a), device=a.device), a]) * self.param_mask[a]
-
-
 class HybridSACActor(nn.Module):
     """The policy in one of two forms (see the module docstring); ``forward(obs, mask)`` is a :class:`SquashedHybrid`.
 
@@ -214,16 +157,11 @@ class HybridSACActor(nn.Module):
         self.total = total = hybrid.total_param_size
         # the all-actions vector's entries in the flattened padded (K * m) layout
         self.register_buffer("flat_index", torch.tensor(np.flatnonzero(mask), dtype=torch.long))
-        if form == "flat":
+        if form == "flat":  # starts near uniform, centred, with unit noise, as the hierarchical form does
             self.net = mlp(obs_dim, hidden_sizes, self.n_actions + 2 * total, activation)
-            heads = [self.net[-1]]
+            small_init_(self.net[-1])
         else:
-            self.pi_d = mlp(obs_dim, hidden_sizes, self.n_actions, activation)
-            self.pi_c = mlp(obs_dim + self.n_actions, hidden_sizes, 2 * self.m, activation)
-            heads = [self.pi_d[-1], self.pi_c[-1]]
-        for head in heads:  # start near uniform, centred, with unit noise (as HybridPolicy does)
-            nn.init.uniform_(head.weight, -3e-3, 3e-3)
-            nn.init.zeros_(head.bias)
+            self.pi_d, self.pi_c = hierarchical_mlps(obs_dim, self.n_actions, hidden_sizes, activation, 2 * self.m)
 
     def _padded(self, flat: torch.Tensor) -> torch.Tensor:
         """``(B, sum_a m_a)`` all-actions values as ``(B, K, m)``, zero where unused."""
@@ -234,9 +172,7 @@ class HybridSACActor(nn.Module):
             logits, means, log_stds = self.net(obs).split([self.n_actions, self.total, self.total], dim=-1)
             mean, log_std = self._padded(means), self._padded(log_stds)
         else:
-            first = self.pi_c[0]  # pi_c of every one-hot, without building the B * K inputs
-            every = self.pi_c[1:](every_action_linear(obs, first.weight, first.bias))
-            mean, log_std = every.split(self.m, dim=-1)
+            mean, log_std = every_action_mlp(self.pi_c, obs).split(self.m, dim=-1)
             logits = self.pi_d(obs)
         log_std = log_std.clamp(LOG_STD_MIN, LOG_STD_MAX)
         return SquashedHybrid(masked_logits(logits, mask), mean, log_std, self.param_mask)
@@ -244,39 +180,6 @@ class HybridSACActor(nn.Module):
     def flat_params(self, x: torch.Tensor) -> torch.Tensor:
         """Every action's parameters ``(B, K, m)`` as the critics' all-actions vector ``(B, sum_a m_a)``."""
         return x.reshape(x.shape[0], -1)[:, self.flat_index]
-
-
-class TwinQ(nn.Module):
-    """Two critics ``Q_i(s, x_all)``, each with K outputs: ``Q_i(s, a, x_all)`` for every discrete action ``a``."""
-
-    def __init__(self, obs_dim: int, hybrid: HybridActionSpace, hidden_sizes, activation: str):
-        super().__init__()
-        size = obs_dim + hybrid.total_param_size
-        self.q1 = mlp(size, hidden_sizes, hybrid.n_actions, activation)
-        self.q2 = mlp(size, hidden_sizes, hybrid.n_actions, activation)
-
-    def forward(self, obs: torch.Tensor, params: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
-        inp = torch.cat([obs, params], dim=-1)
-        return self.q1(inp), self.q2(inp)
-
-
-class Temperatures(nn.Module):
-    """The log-temperatures ``log alpha_d`` and ``log alpha_c`` of the two entropy terms."""
-
-    def __init__(self, alpha_d: float, alpha_c: float):
-        super().__init__()
-        self.log_alpha_d = nn.Parameter(torch.tensor(math.log(alpha_d)))
-        self.log_alpha_c = nn.Parameter(torch.tensor(math.log(alpha_c)))
-
-
-def temperature_gradient(entropy: torch.Tensor, target: torch.Tensor | float) -> torch.Tensor:
-    """The gradient in ``log alpha`` of SAC's temperature loss ``mean(log alpha * (H - target))``, the entropy
-    estimates ``H`` held fixed: ``mean(H - target)``.
-
-    Descent lowers the temperature of a policy more random than its target, raises it for one less random, and
-    leaves it where the entropy meets the target.
-    """
-    return (entropy - target).mean()
 
 
 class HybridSAC(Algorithm):
@@ -288,24 +191,18 @@ class HybridSAC(Algorithm):
     def _build(self) -> None:
         cfg, h = self.config, self.hybrid
         self.actor = HybridSACActor(self.obs_dim, h, cfg.form, cfg.hidden_sizes, cfg.activation)
-        self.critic = TwinQ(self.obs_dim, h, cfg.hidden_sizes, cfg.activation)
+        # Q_i(s, x_all) with one output per discrete action, Q_i(s, a, x_all)
+        self.critic = TwinQ(self.obs_dim + h.total_param_size, h.n_actions, cfg.hidden_sizes, cfg.activation)
         self.critic_target = copy.deepcopy(self.critic).requires_grad_(False)
-        self.temperatures = Temperatures(cfg.init_alpha_d, cfg.init_alpha_c)
+        self.temperatures = Temperatures(alpha_d=cfg.init_alpha_d, alpha_c=cfg.init_alpha_c)
         self.actor_optimizer = torch.optim.Adam(self.actor.parameters(), lr=cfg.actor_lr, fused=True)
         self.critic_optimizer = torch.optim.Adam(self.critic.parameters(), lr=cfg.critic_lr, fused=True)
         self.alpha_optimizer = torch.optim.Adam(self.temperatures.parameters(), lr=cfg.alpha_lr, fused=True)
         self._actor_params, self._critic_params = list(self.actor.parameters()), list(self.critic.parameters())
-        self._actor_step = gradient_step(self.actor_optimizer, cfg.grad_clip)
-        self._critic_step = gradient_step(self.critic_optimizer, cfg.grad_clip)
         self.param_sizes = torch.as_tensor(h.param_sizes, dtype=torch.float32, device=self.device)
-        fields = transition_fields(
-            self.obs_dim,
-            h.max_param_size,
-            masks=h.n_actions if cfg.action_mask else 0,
-            params=((h.total_param_size,), np.float32),  # every action's drawn parameters: what the critics saw
-        )
-        self.replay = ReplayBuffer(cfg.buffer_size, fields, self.device)
-        self.loop = OffPolicyLoop(cfg, h, self.replay)
+        # every action's drawn parameters: what the critics saw
+        self.loop = OffPolicyLoop(self, params=((h.total_param_size,), np.float32))
+        self.replay = self.loop.buffer
         self._soft_update = soft_updater([(self.critic_target, self.critic)])
 
     def _modules(self):
@@ -318,12 +215,6 @@ class HybridSAC(Algorithm):
 
     def _optimizers(self):
         return {"actor": self.actor_optimizer, "critic": self.critic_optimizer, "temperatures": self.alpha_optimizer}
-
-    def _extra_state(self, replay):
-        return {"loop": self.loop.state_dict(replay)}
-
-    def _load_extra_state(self, state):
-        self.loop.load_state_dict(state["loop"])
 
     @property
     def alphas(self) -> tuple[float, float]:
@@ -350,10 +241,8 @@ class HybridSAC(Algorithm):
         return a, x, {"params": self.actor.flat_params(x_all).cpu().numpy()}
 
     # -- learning --------------------------------------------------------------------------------
-    def _run_epoch(self) -> dict[str, float]:
-        stats = self.loop.run_epoch(self.vec_env, self._explore, self._update, self.num_timesteps, self.np_rng)
-        stats["train/alpha_d"], stats["train/alpha_c"] = self.alphas
-        return stats
+    def _epoch_stats(self, step: int) -> dict[str, float]:
+        return dict(zip(("train/alpha_d", "train/alpha_c"), self.alphas))
 
     def soft_value(self, dist: SquashedHybrid, critic: TwinQ, obs: torch.Tensor, alpha_d, alpha_c):
         """Per state and discrete action, ``min_i Q_i(s, x_all)_a - alpha_c log pi_c(x_a|s,a) - alpha_d log
@@ -377,9 +266,8 @@ class HybridSAC(Algorithm):
 
     def temperature_step(self, entropy_d, target_d, entropy_c, target_c) -> None:
         """One Adam step of each log-temperature along :func:`temperature_gradient` of its part's entropy."""
-        optimizer_step(
-            self.alpha_optimizer, [temperature_gradient(entropy_d, target_d), temperature_gradient(entropy_c, target_c)]
-        )
+        gradients = [temperature_gradient(entropy_d, target_d), temperature_gradient(entropy_c, target_c)]
+        apply_gradients(self.alpha_optimizer, gradients)
 
     def _update(self) -> dict[str, float]:
         """One soft Q step of both critics, one policy step, one step of each temperature, the target update."""
@@ -392,13 +280,13 @@ class HybridSAC(Algorithm):
         a = b["a"][:, None]
         q1, q2 = (q.gather(1, a).squeeze(1) for q in self.critic(obs, b["params"]))
         critic_loss = F.mse_loss(q1, y) + F.mse_loss(q2, y)
-        self._critic_step(torch.autograd.grad(critic_loss, self._critic_params))
+        descend(self.critic_optimizer, critic_loss, self._critic_params, cfg.grad_clip)
 
         dist = self.actor(obs, mask)
         soft_q, log_pc = self.soft_value(dist, self.critic, obs, alpha_d, alpha_c)
         p = dist.probs_d
         actor_loss = -(p * soft_q).sum(-1).mean()
-        self._actor_step(torch.autograd.grad(actor_loss, self._actor_params))  # the critics' weights: no gradient
+        descend(self.actor_optimizer, actor_loss, self._actor_params, cfg.grad_clip)  # the critics' get none
 
         with torch.no_grad():
             entropy_d = dist.entropy_d()

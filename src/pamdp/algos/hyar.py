@@ -53,16 +53,16 @@ from pamdp.algos.base import Algorithm
 from pamdp.algos.offpolicy import (
     OffPolicyConfig,
     OffPolicyLoop,
+    TwinQ,
     backprop_actor,
-    clipped_step,
     linear_epsilon,
     shared_setting,
-    soft_update,
+    soft_updater,
     uniform_actions,
 )
-from pamdp.algos.replay import ReplayBuffer, transition_fields
+from pamdp.algos.optim import apply_gradients, descend
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, at_least, interval, one_of, setting
-from pamdp.distributions import masked_logits
+from pamdp.distributions import LOG_STD_MAX, LOG_STD_MIN, masked_logits
 from pamdp.policies import ACTIVATIONS, mlp
 from pamdp.spaces import HybridActionSpace
 
@@ -248,7 +248,7 @@ class ActionRepresentation(nn.Module):
         """Mean and log-std of ``q(z | x, s, e_a)``."""
         out = self.encoder(torch.cat([obs, x * self.mask[a], self.embedding[a]], dim=-1))
         mean, log_std = out.split(self.latent_dim, dim=-1)
-        return mean, log_std.clamp(-5.0, 2.0)
+        return mean, log_std.clamp(LOG_STD_MIN, LOG_STD_MAX)
 
     def _trunk(self, obs: torch.Tensor, a: torch.Tensor, z: torch.Tensor) -> torch.Tensor:
         return self.act(self.decoder(torch.cat([obs, z, self.embedding[a]], dim=-1)))
@@ -325,19 +325,6 @@ class LatentActor(nn.Module):
         return self.low + (u + 1.0) * 0.5 * (self.high - self.low)
 
 
-class TwinCritic(nn.Module):
-    """TD3's two critics ``Q_1, Q_2(s, e, z)`` on the latent action."""
-
-    def __init__(self, obs_dim: int, size: int, hidden_sizes, activation: str):
-        super().__init__()
-        self.q1 = mlp(obs_dim + size, hidden_sizes, 1, activation)
-        self.q2 = mlp(obs_dim + size, hidden_sizes, 1, activation)
-
-    def forward(self, obs: torch.Tensor, latent: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
-        inp = torch.cat([obs, latent], dim=-1)
-        return self.q1(inp).squeeze(-1), self.q2(inp).squeeze(-1)
-
-
 class HyAR(Algorithm):
     """HyAR-TD3 (Li et al. 2022): TD3 in a learned hybrid action representation. See :class:`HyARConfig`."""
 
@@ -352,20 +339,18 @@ class HyAR(Algorithm):
         )
         squash = cfg.bound == "squash"
         self.actor = LatentActor(self.obs_dim, self.latent_size, cfg.hidden_sizes, cfg.activation, squash)
-        self.critic = TwinCritic(self.obs_dim, self.latent_size, cfg.hidden_sizes, cfg.activation)
+        self.critic = TwinQ(self.obs_dim + self.latent_size, 1, cfg.hidden_sizes, cfg.activation)  # Q_i(s, e, z)
         self.actor_target = copy.deepcopy(self.actor).requires_grad_(False)
         self.critic_target = copy.deepcopy(self.critic).requires_grad_(False)
-        self.rep_optimizer = torch.optim.Adam(self.rep.parameters(), lr=cfg.vae_lr, fused=True)
-        self.actor_optimizer = torch.optim.Adam(self.actor.net.parameters(), lr=cfg.actor_lr, fused=True)
-        self.critic_optimizer = torch.optim.Adam(self.critic.parameters(), lr=cfg.critic_lr, fused=True)
-        fields = transition_fields(
-            self.obs_dim,
-            h.max_param_size,
-            masks=h.n_actions if cfg.action_mask else 0,
-            latent=((self.latent_size,), np.float32),  # the latent action that was decoded and executed
-        )
-        self.replay = ReplayBuffer(cfg.buffer_size, fields, self.device)
-        self.loop = OffPolicyLoop(cfg, h, self.replay)
+        self._rep_params, self._actor_params = list(self.rep.parameters()), list(self.actor.net.parameters())
+        self._critic_params = list(self.critic.parameters())
+        self.rep_optimizer = torch.optim.Adam(self._rep_params, lr=cfg.vae_lr, fused=True)
+        self.actor_optimizer = torch.optim.Adam(self._actor_params, lr=cfg.actor_lr, fused=True)
+        self.critic_optimizer = torch.optim.Adam(self._critic_params, lr=cfg.critic_lr, fused=True)
+        self._soft_update = soft_updater([(self.critic_target, self.critic), (self.actor_target.net, self.actor.net)])
+        # the latent action that was decoded and executed
+        self.loop = OffPolicyLoop(self, latent=((self.latent_size,), np.float32))
+        self.replay = self.loop.buffer
         self.pretrained = False  # the warm-up round of representation training is done
         self.n_updates = 0  # TD3 updates so far (the policy delay and the representation rounds count them)
         self.rl_start = 0  # the replay's insertion counter at the representation's pre-training (td3_replay)
@@ -382,16 +367,10 @@ class HyAR(Algorithm):
     def _optimizers(self):
         return {"rep": self.rep_optimizer, "actor": self.actor_optimizer, "critic": self.critic_optimizer}
 
-    def _extra_state(self, replay):
-        return {
-            "loop": self.loop.state_dict(replay),
-            "pretrained": self.pretrained,
-            "n_updates": self.n_updates,
-            "rl_start": self.rl_start,
-        }
+    def _extra_state(self):
+        return {"pretrained": self.pretrained, "n_updates": self.n_updates, "rl_start": self.rl_start}
 
     def _load_extra_state(self, state):
-        self.loop.load_state_dict(state["loop"])
         self.pretrained, self.n_updates = bool(state["pretrained"]), int(state["n_updates"])
         self.rl_start = int(state.get("rl_start", self.config.warmup_steps))  # checkpoints from before td3_replay
         if self.pretrained and len(self.replay) == 0:  # resumed without the replay: warm up again on new data
@@ -441,13 +420,12 @@ class HyAR(Algorithm):
         return linear_epsilon(step, cfg.epsilon_start, cfg.epsilon_end, cfg.epsilon_steps)
 
     # -- learning --------------------------------------------------------------------------------
-    def _run_epoch(self) -> dict[str, float]:
-        stats = self.loop.run_epoch(self.vec_env, self._explore, self._update, self.num_timesteps, self.np_rng)
-        stats["train/latent_box_width"] = float((self.actor.high - self.actor.low).mean())
-        step = self.num_timesteps + stats["steps"]
-        stats["train/epsilon"] = self.epsilon(step)
-        stats["train/noise_std"] = self.noise_std(step)
-        return stats
+    def _epoch_stats(self, step: int) -> dict[str, float]:
+        return {
+            "train/latent_box_width": float((self.actor.high - self.actor.low).mean()),
+            "train/epsilon": self.epsilon(step),
+            "train/noise_std": self.noise_std(step),
+        }
 
     def train_representation(self, updates: int) -> dict[str, float]:
         """``updates`` steps of the representation loss on replayed batches, then new latent bounds."""
@@ -459,9 +437,7 @@ class HyAR(Algorithm):
                 loss, terms = self.rep.loss(
                     b["obs"], b["a"], b["x"], b["next_obs"], cfg.kl_weight, cfg.dynamics_weight, self.torch_gen
                 )
-                self.rep_optimizer.zero_grad(set_to_none=True)
-                loss.backward()
-                self.rep_optimizer.step()
+                descend(self.rep_optimizer, loss, self._rep_params)
                 for k, v in terms.items():
                     sums[k] += v
         self.update_bounds(remap=self.config.lsc_remap and self.pretrained)
@@ -540,13 +516,11 @@ class HyAR(Algorithm):
             noise = torch.randn(u_next.shape, generator=self.torch_gen, device=self.device) * cfg.target_noise
             u_next = (u_next + noise.clamp(-cfg.target_noise_clip, cfg.target_noise_clip)).clamp(-1.0, 1.0)
             latent_next = self.rep.snap(self.actor_target.to_latent(u_next), b.get("next_mask"))
-            q1_next, q2_next = self.critic_target(next_obs, latent_next)
+            q1_next, q2_next = (q.squeeze(-1) for q in self.critic_target(next_obs, latent_next))
             y = b["reward"] + cfg.gamma * (~b["terminated"]).float() * torch.minimum(q1_next, q2_next)
-        q1, q2 = self.critic(obs, latent)
+        q1, q2 = (q.squeeze(-1) for q in self.critic(obs, latent))
         critic_loss = F.mse_loss(q1, y) + F.mse_loss(q2, y)
-        self.critic_optimizer.zero_grad(set_to_none=True)
-        critic_loss.backward()
-        clipped_step(self.critic_optimizer, self.critic.parameters(), cfg.grad_clip)
+        descend(self.critic_optimizer, critic_loss, self._critic_params, cfg.grad_clip)
         stats.update(
             {
                 "losses/critic_loss": float(critic_loss.detach()),
@@ -555,10 +529,9 @@ class HyAR(Algorithm):
             }
         )
         if self.n_updates % cfg.policy_delay == 0:
-            self.actor_optimizer.zero_grad(set_to_none=True)
-            _, q_mu = backprop_actor(self.actor, self._q1, obs, "invert" if cfg.bound == "invert" else "none")
-            clipped_step(self.actor_optimizer, self.actor.net.parameters(), cfg.grad_clip)
-            soft_update(self.critic_target, self.critic, cfg.tau)
-            soft_update(self.actor_target.net, self.actor.net, cfg.tau)
+            bound = "invert" if cfg.bound == "invert" else "none"
+            _, q_mu, grads = backprop_actor(self.actor, self._q1, obs, bound, self._actor_params)
+            apply_gradients(self.actor_optimizer, grads, cfg.grad_clip)
+            self._soft_update(cfg.tau)
             stats["losses/actor_loss"] = float(-q_mu.mean())
         return stats

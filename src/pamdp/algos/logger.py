@@ -72,17 +72,22 @@ class EpisodeTracker:
         self.returns[:] = 0.0
         self.lengths[:] = 0
 
-    def step(self, rewards: np.ndarray, dones: np.ndarray, valid: np.ndarray, info: dict | None = None) -> None:
-        """Add one vector step; ``valid`` is false for the autoreset steps of Gymnasium's vector envs."""
+    def step(
+        self, rewards: np.ndarray, dones: np.ndarray, valid: np.ndarray, info: dict | None = None
+    ) -> tuple[np.ndarray, np.ndarray, list[bool | None]]:
+        """Add one vector step; ``valid`` is false for the autoreset steps of Gymnasium's vector envs. Returns the
+        return, length and success of each episode that ended, in the order of the copies."""
         self.returns += np.where(valid, rewards, 0.0)
         self.lengths += valid
         ended = dones & valid
-        self.done_returns += self.returns[ended].tolist()
-        self.done_lengths += self.lengths[ended].tolist()
-        if ended.any():
-            self.done_goals += successes(info, ended)
+        returns, lengths = self.returns[ended], self.lengths[ended]
+        goals = successes(info, ended) if ended.any() else []
+        self.done_returns += returns.tolist()
+        self.done_lengths += lengths.tolist()
+        self.done_goals += goals
         self.returns[ended] = 0.0
         self.lengths[ended] = 0
+        return returns, lengths, goals
 
     def pop(self) -> dict[str, float]:
         """Statistics of the episodes completed since the last call (empty if none)."""

@@ -1,5 +1,6 @@
 """What the off-policy algorithms share: their loop settings, the collect-and-learn loop over a replay buffer,
-target networks, and the bounded-gradient tricks of deterministic actors.
+target networks, twin critics, the entropy temperature rule, and the bounded-gradient tricks of deterministic
+actors.
 
 :class:`OffPolicyConfig` declares the settings of the loop and the replay once; an algorithm's config inherits
 it beside :class:`~pamdp.algos.settings.AlgoConfig`. :class:`OffPolicyLoop` reads them: it steps the batched
@@ -18,36 +19,37 @@ buffer's ``"mc"`` field when its episode ends (``NaN`` until then), for PADDPG's
 rewards and these returns are the env's rewards times ``reward_scale``, the scale the critics learn on.
 
 The actors of PADDPG, P-DQN and HyAR output bounded values trained along ``dQ/d output``; Hausknecht & Stone's
-three ways of keeping them in ``[-1, 1]`` (spec "PADDPG") are :data:`BOUNDS`, applied by :func:`backprop_actor`.
+three ways of keeping them in ``[-1, 1]`` ("Deep Reinforcement Learning in Parameterized Action Space", ICLR 2016,
+section "Bounded parameter space learning") are :data:`BOUNDS`, applied by :func:`backprop_actor`.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Callable, Sequence
 
 import numpy as np
 import torch
 from torch import nn
 
-from pamdp.algos.logger import EpisodeTracker
-from pamdp.algos.replay import ReplayBuffer
+from pamdp.algos.replay import ReplayBuffer, transition_fields
 from pamdp.algos.settings import NON_NEGATIVE, POSITIVE, at_least, interval, setting
 from pamdp.algos.subnormals import subnormals_flushed
-from pamdp.algos.vector_env import info_action_masks
+from pamdp.algos.vector_env import Step, VectorStepper
 from pamdp.distributions import masked_logits
+from pamdp.policies import mlp
 
 __all__ = [
     "OffPolicyConfig",
     "shared_setting",
     "OffPolicyLoop",
+    "TwinQ",
+    "Temperatures",
+    "temperature_gradient",
     "OUNoise",
     "soft_update",
     "soft_updater",
-    "clipped_step",
-    "clip_grads",
-    "optimizer_step",
-    "gradient_step",
     "linear_epsilon",
     "uniform_actions",
     "mixed_target",
@@ -121,15 +123,10 @@ ActFn = Callable[
 UpdateFn = Callable[[], dict[str, float]]
 
 
-def soft_update(target: nn.Module, source: nn.Module, tau: float) -> None:
-    """Polyak averaging of target networks, as DDPG: ``theta' <- tau * theta + (1 - tau) * theta'``."""
-    with torch.no_grad():  # one foreach call, not a Python loop of a kernel per tensor
-        torch._foreach_lerp_(list(target.parameters()), list(source.parameters()), tau)
-
-
 def soft_updater(pairs: Sequence[tuple[nn.Module, nn.Module]]) -> Callable[[float], None]:
-    """:func:`soft_update` of every ``(target, source)`` pair in one foreach call, the parameter lists gathered
-    once (a module's ``parameters()`` walk costs more than the update itself at these sizes)."""
+    """Polyak averaging of target networks, as DDPG's, ``theta' <- tau * theta + (1 - tau) * theta'``, for every
+    ``(target, source)`` pair in one foreach call (not a kernel per tensor), the parameter lists gathered once (a
+    module's ``parameters()`` walk costs more than the update itself at these sizes)."""
     targets = [p for target, _ in pairs for p in target.parameters()]
     sources = [p for _, source in pairs for p in source.parameters()]
 
@@ -138,6 +135,47 @@ def soft_updater(pairs: Sequence[tuple[nn.Module, nn.Module]]) -> Callable[[floa
             torch._foreach_lerp_(targets, sources, tau)
 
     return update
+
+
+class TwinQ(nn.Module):
+    """Two critics ``Q_1, Q_2`` of the same shape on ``[s, action]``, for the clipped double Q-learning of TD3
+    (Fujimoto et al. 2018) and SAC: a target takes the smaller of the two target critics' values."""
+
+    def __init__(self, in_size: int, out_size: int, hidden_sizes, activation: str):
+        super().__init__()
+        self.q1 = mlp(in_size, hidden_sizes, out_size, activation)
+        self.q2 = mlp(in_size, hidden_sizes, out_size, activation)
+
+    def forward(self, obs: torch.Tensor, action: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        inp = torch.cat([obs, action], dim=-1)
+        return self.q1(inp), self.q2(inp)
+
+
+class Temperatures(nn.Module):
+    """Entropy temperatures ``alpha = exp(log alpha)``, one parameter ``log_<name>`` per keyword (its initial
+    ``alpha``), tuned by SAC's rule (Haarnoja et al. 2018, "Soft Actor-Critic Algorithms and Applications"):
+    descent along :func:`temperature_gradient`. PASVG(0) has one, for ``pi_d``; Hybrid SAC one per part."""
+
+    def __init__(self, **initial: float):
+        super().__init__()
+        for name, alpha in initial.items():
+            self.register_parameter(f"log_{name}", nn.Parameter(torch.tensor(math.log(alpha), dtype=torch.float32)))
+
+
+def temperature_gradient(entropy: torch.Tensor, target: torch.Tensor | float) -> torch.Tensor:
+    """The gradient in ``log alpha`` of SAC's temperature loss ``mean(log alpha * (H - target))``, the entropy
+    estimates ``H`` held fixed: ``mean(H - target)``.
+
+    Descent lowers the temperature of a policy more random than its target, raises it for one less random, and
+    leaves it where the entropy meets the target, so the policy keeps exploring about as much as asked however
+    the critic's values scale.
+    """
+    return (entropy - target).mean()
+
+
+def soft_update(target: nn.Module, source: nn.Module, tau: float) -> None:
+    """One :func:`soft_updater` step of one pair."""
+    soft_updater([(target, source)])(tau)
 
 
 class OUNoise:
@@ -158,76 +196,6 @@ class OUNoise:
         self.state[episode_start] = 0.0
         self.state += -self.theta * self.state + self.sigma * rng.standard_normal(shape)
         return self.state
-
-
-def clipped_step(optimizer: torch.optim.Optimizer, params, max_norm: float) -> None:
-    """One optimizer step, the gradient's total norm first clipped to ``max_norm`` (0: no clipping)."""
-    if max_norm > 0:
-        nn.utils.clip_grad_norm_(params, max_norm)
-    optimizer.step()
-
-
-def clip_grads(grads: Sequence[torch.Tensor], max_norm: float) -> None:
-    """``nn.utils.clip_grad_norm_`` on gradient tensors themselves (0: no clipping), in place."""
-    if max_norm <= 0:
-        return
-    total = torch.linalg.vector_norm(torch.stack(torch._foreach_norm(list(grads))))
-    torch._foreach_mul_(list(grads), (max_norm / (total + 1e-6)).clamp(max=1.0))
-
-
-def optimizer_step(optimizer: torch.optim.Optimizer, grads: Sequence[torch.Tensor]) -> None:
-    """``optimizer.step()`` with ``grads``, in the order of its one parameter group.
-
-    A fused ``Adam`` whose state exists gets one ``torch._fused_adam_`` call, the kernel its own ``step`` ends
-    in, without the Python bookkeeping around it; any other optimizer gets the gradients as ``.grad`` and its
-    own ``step``.
-    """
-    group = optimizer.param_groups[0]
-    params = group["params"]
-    state = optimizer.state
-    fast = (
-        len(optimizer.param_groups) == 1
-        and group.get("fused")
-        and not (group["amsgrad"] or group["maximize"] or group["capturable"] or group["differentiable"])
-        and not group.get("decoupled_weight_decay", False)
-        and all(p in state for p in params)
-    )
-    if not fast:
-        for p, g in zip(params, grads, strict=True):
-            p.grad = g
-        optimizer.step()
-        return
-    steps = [state[p]["step"] for p in params]
-    torch._foreach_add_(steps, 1)
-    beta1, beta2 = group["betas"]
-    torch._fused_adam_(
-        params,
-        list(grads),
-        [state[p]["exp_avg"] for p in params],
-        [state[p]["exp_avg_sq"] for p in params],
-        [],
-        steps,
-        amsgrad=False,
-        lr=float(group["lr"]),
-        beta1=float(beta1),
-        beta2=float(beta2),
-        weight_decay=float(group["weight_decay"]),
-        eps=float(group["eps"]),
-        maximize=False,
-        grad_scale=None,
-        found_inf=None,
-    )
-
-
-def gradient_step(optimizer: torch.optim.Optimizer, max_norm: float) -> Callable[[Sequence[torch.Tensor]], None]:
-    """A step of ``optimizer`` on hand-computed gradients: their total norm clipped to ``max_norm`` (0: none),
-    then :func:`optimizer_step`."""
-
-    def step(grads: Sequence[torch.Tensor]) -> None:
-        clip_grads(grads, max_norm)
-        optimizer_step(optimizer, grads)
-
-    return step
 
 
 def linear_epsilon(step: int, start: float, end: float, steps: int) -> float:
@@ -301,149 +269,135 @@ def backprop_actor(
     critic: Callable[[torch.Tensor, torch.Tensor], torch.Tensor],
     obs: torch.Tensor,
     bound: str,
-) -> tuple[torch.Tensor, torch.Tensor]:
-    """Back-propagate ``-mean_s Q(s, mu(s))`` into the actor, with ``dQ/dmu`` edited by ``bound`` on the way.
+    params: Sequence[torch.Tensor],
+) -> tuple[torch.Tensor, torch.Tensor, tuple[torch.Tensor, ...]]:
+    """Back-propagate ``-mean_s Q(s, mu(s))`` into the actor's ``params``, with ``dQ/dmu`` edited by ``bound`` on
+    the way (for :func:`~pamdp.algos.optim.apply_gradients`).
 
     ``Q`` is summed over its last axis if it has one (P-DQN's K values). The critic's weights get no gradient.
-    Returns the actor's outputs and ``Q(s, mu(s))``, detached.
+    Returns the actor's outputs and ``Q(s, mu(s))``, detached, and the gradients in ``params``.
     """
     out = actor(obs)
     p = out.detach().requires_grad_(True)
     q = critic(obs, p)
     (dq_dp,) = torch.autograd.grad(q.sum(), p)  # per-sample dQ/dp, the ascent direction
-    out.backward(-bounded(dq_dp, p.detach(), bound) / len(out))  # descend on -mean Q over the batch
-    return out.detach(), q.detach()
+    grads = torch.autograd.grad(out, params, -bounded(dq_dp, p.detach(), bound) / len(out))  # descend on -mean Q
+    return out.detach(), q.detach(), grads
 
 
 class OffPolicyLoop:
-    """Collect-and-learn epochs for an off-policy algorithm (see the module docstring).
+    """Collect-and-learn epochs of an off-policy algorithm over its replay buffer (see the module docstring).
+
+    The loop receives the algorithm and reads from it what it needs: the settings (an :class:`OffPolicyConfig`
+    with ``learning_starts`` and ``flush_denormal``; the updates, not the env steps, flush subnormal floats to
+    zero), the env (``vec_env``), the random stream (``np_rng``), the device, and the two methods of the loop,
+    ``_explore`` (:data:`ActFn`) and ``_update`` (:data:`UpdateFn`). It builds the replay buffer, :attr:`buffer`,
+    with the fields every off-policy algorithm stores, the algorithm's ``fields`` and ``mc`` with ``mc_returns``.
 
     Args:
-        config: the algorithm's settings: an :class:`OffPolicyConfig` with ``learning_starts`` and
-            ``flush_denormal`` (the updates, not the env steps, flush subnormal floats to zero).
-        hybrid: the env's hybrid action space.
-        buffer: where transitions go; it needs the fields ``obs, a, x, reward, next_obs, terminated``, the
-            algorithm's extras, and ``mc`` when ``mc_returns``.
+        algo: the algorithm.
         mc_returns: compute Monte-Carlo returns (discounted by ``config.gamma``) when episodes end.
         tail_value: with ``mc_returns``, the value of a truncated episode's final observations
             ``(B, d)`` with their action masks (``(B, K)`` bool, or ``None``) ``-> (B,)``, which bootstraps its
             Monte-Carlo return; ``None`` treats the cut as an end.
+        fields: the algorithm's own fields, ``name=(shape, dtype)``.
 
     With the ``action_mask`` setting the loop reads the env's ``info["action_mask"]`` at every step, passes the
-    current state's to ``act`` and stores both states' in the buffer's ``mask`` and ``next_mask`` fields (build
-    it with ``transition_fields(..., masks=K)``).
+    current state's to ``_explore`` and stores both states' in the buffer's ``mask`` and ``next_mask`` fields.
+    Its checkpoint state (:meth:`state_dict`) is the buffer's and the update credit.
     """
 
     def __init__(
         self,
-        config: OffPolicyConfig,
-        hybrid,
-        buffer: ReplayBuffer,
+        algo,
         mc_returns: bool = False,
         tail_value: Callable[[np.ndarray, np.ndarray | None], np.ndarray] | None = None,
+        **fields,
     ):
-        self.config = config
-        self.hybrid = hybrid
-        self.buffer = buffer
+        cfg, hybrid = algo.config, algo.hybrid
+        self.algo, self.config, self.hybrid = algo, cfg, hybrid
+        masks = hybrid.n_actions if cfg.action_mask else 0
+        spec = transition_fields(algo.obs_dim, hybrid.max_param_size, mc_returns=mc_returns, masks=masks, **fields)
+        self.buffer = ReplayBuffer(cfg.buffer_size, spec, algo.device)
         self.mc_returns = mc_returns
         self.tail_value = tail_value
         self.update_credit = 0.0
-        self.obs: np.ndarray | None = None  # the env's current observations; None until the first reset
-        self.masks: np.ndarray | None = None  # their allowed actions (N, K), with the action_mask setting
+        self.stepper: VectorStepper | None = None  # the env's copies, from the first epoch on
 
-    def _start(self, env, np_rng: np.random.Generator) -> None:
-        self.env = env
-        self.num_envs = env.num_envs
-        self.tracker = EpisodeTracker(self.num_envs)
-        self.prev_done = np.zeros(self.num_envs, dtype=bool)
-        self.episode_start = np.ones(self.num_envs, dtype=bool)
-        self._pending: list[tuple[list[int], list[float]]] = [([], []) for _ in range(self.num_envs)]
-        self.obs, info = env.reset(seed=int(np_rng.integers(2**31 - 1)))
-        self.masks = self._masks(info)
-
-    def _masks(self, info: dict) -> np.ndarray | None:
-        """The allowed actions of each copy's new observation, with the action_mask setting (else ``None``)."""
-        if not self.config.action_mask:
-            return None
-        return info_action_masks(info, self.num_envs, self.hybrid.n_actions)
-
-    def run_epoch(
-        self, env, act: ActFn, update: UpdateFn, start_step: int, np_rng: np.random.Generator
-    ) -> dict[str, float]:
+    def run_epoch(self) -> dict[str, float]:
         """Collect at least ``config.epoch_steps`` valid transitions, updating as they arrive; returns the epoch's
-        stats. ``start_step`` is the number of samples collected before (``act`` gets the running count)."""
-        cfg = self.config
-        n_samples, learning_starts, updates_per_step = cfg.epoch_steps, cfg.learning_starts, cfg.updates_per_step
-        if self.obs is None:
-            self._start(env, np_rng)
-        counts = np.zeros(self.hybrid.n_actions, dtype=np.int64)
+        stats with the algorithm's ``_epoch_stats`` at its end (``_explore`` gets the running count of samples)."""
+        cfg, algo, n_actions = self.config, self.algo, self.hybrid.n_actions
+        act, update, start_step, device = algo._explore, algo._update, algo.num_timesteps, algo.device
+        if self.stepper is None:
+            env = algo.vec_env
+            self.stepper = VectorStepper(env, n_actions, cfg.action_mask, int(algo.np_rng.integers(2**31 - 1)))
+            self.episode_start = np.ones(env.num_envs, dtype=bool)
+            self._pending: list[tuple[list[int], list[float]]] = [([], []) for _ in range(env.num_envs)]
+        stepper = self.stepper
+        counts = np.zeros(n_actions, dtype=np.int64)
         sums: dict[str, float] = {}
         reported: dict[str, int] = {}  # per key: the updates that computed it (some run every few updates only)
         n_updates = n_valid = 0
-        while n_valid < n_samples:
-            obs = np.asarray(self.obs, dtype=np.float32)
-            device = self.buffer.device
-            mask = None if self.masks is None else torch.from_numpy(self.masks).to(device)
+        while n_valid < cfg.epoch_steps:
+            obs = torch.from_numpy(np.asarray(stepper.obs, dtype=np.float32))
+            mask = None if stepper.masks is None else torch.from_numpy(stepper.masks).to(device)
             with torch.no_grad():  # the observations to the algorithm's device, the actions back
-                a, x, extras = act(torch.from_numpy(obs).to(device), start_step + n_valid, self.episode_start, mask)
+                a, x, extras = act(obs.to(device), start_step + n_valid, self.episode_start, mask)
             a, x = a.cpu().numpy(), x.cpu().numpy()
-            next_obs, reward, terminated, truncated, info = self.env.step(self.hybrid.to_env_batch(a, x))
-            next_masks = self._masks(info)
-            valid = ~self.prev_done
-            done = (terminated | truncated) & valid
-            self.tracker.step(np.asarray(reward, dtype=np.float64), done, valid, info)
-            if valid.any():
-                row = {
-                    "obs": obs[valid],
-                    "a": a[valid],
-                    "x": x[valid],
-                    "reward": (np.asarray(reward, dtype=np.float64) * cfg.reward_scale).astype(np.float32)[valid],
-                    "next_obs": np.asarray(next_obs, dtype=np.float32)[valid],
-                    "terminated": (terminated & valid)[valid],
-                    **{k: v[valid] for k, v in extras.items()},
-                }
-                if self.mc_returns:
-                    row["mc"] = np.full(int(valid.sum()), np.nan, dtype=np.float32)
-                if next_masks is not None:
-                    row["mask"], row["next_mask"] = self.masks[valid], next_masks[valid]
-                counters = self.buffer.add(**row)
-                if self.mc_returns:
-                    self._finish_returns(counters, valid, reward, terminated, done, next_obs, next_masks)
-                counts += np.bincount(a[valid], minlength=self.hybrid.n_actions)
-                n = int(valid.sum())
-                n_valid += n
-                if len(self.buffer) >= learning_starts:
-                    self.update_credit += updates_per_step * n
-                    with subnormals_flushed(cfg.flush_denormal):
-                        while self.update_credit >= 1.0:
-                            self.update_credit -= 1.0
-                            for k, v in update().items():
-                                sums[k] = sums.get(k, 0.0) + v
-                                reported[k] = reported.get(k, 0) + 1
-                            n_updates += 1
+            step = stepper.step(self.hybrid.to_env_batch(a, x))
+            valid = step.valid
             self.episode_start = ~valid
-            self.prev_done = done
-            self.obs, self.masks = next_obs, next_masks
+            if not valid.any():
+                continue
+            row = {
+                "obs": obs.numpy()[valid],
+                "a": a[valid],
+                "x": x[valid],
+                "reward": (np.asarray(step.reward, dtype=np.float64) * cfg.reward_scale).astype(np.float32)[valid],
+                "next_obs": np.asarray(step.next_obs, dtype=np.float32)[valid],
+                "terminated": step.terminated[valid],
+                **{k: v[valid] for k, v in extras.items()},
+            }
+            if self.mc_returns:
+                row["mc"] = np.full(int(valid.sum()), np.nan, dtype=np.float32)
+            if step.masks is not None:
+                row["mask"], row["next_mask"] = step.masks[valid], step.next_masks[valid]
+            counters = self.buffer.add(**row)
+            if self.mc_returns:
+                self._finish_returns(counters, step)
+            counts += np.bincount(a[valid], minlength=n_actions)
+            n = int(valid.sum())
+            n_valid += n
+            if len(self.buffer) >= cfg.learning_starts:
+                self.update_credit += cfg.updates_per_step * n
+                with subnormals_flushed(cfg.flush_denormal):
+                    while self.update_credit >= 1.0:
+                        self.update_credit -= 1.0
+                        for k, v in update().items():
+                            sums[k] = sums.get(k, 0.0) + v
+                            reported[k] = reported.get(k, 0) + 1
+                        n_updates += 1
         stats = {k: v / reported[k] for k, v in sums.items()}
         stats["train/updates"] = float(n_updates)
         stats["train/buffer_size"] = float(len(self.buffer))
         stats.update({f"train/action_freq_{k}": float(c) / n_valid for k, c in enumerate(counts)})
-        stats.update(self.tracker.pop())
+        stats.update(stepper.episodes.pop())
         stats["steps"] = n_valid
+        stats.update(algo._epoch_stats(start_step + n_valid))
         return stats
 
-    def _finish_returns(self, counters, valid, reward, terminated, done, next_obs, next_masks) -> None:
+    def _finish_returns(self, counters: np.ndarray, step: Step) -> None:
         """Queue this step's transitions per env copy; write their Monte-Carlo returns when episodes end."""
-        ended = np.flatnonzero(done)
-        tails = np.zeros(self.num_envs)
-        cut = [i for i in ended if not terminated[i]]
+        ended = step.ended
+        tails = np.zeros(len(step.done))
+        cut = [i for i in ended if not step.terminated[i]]
         if cut and self.tail_value is not None:
-            tails[cut] = self.tail_value(
-                np.asarray(next_obs, dtype=np.float32)[cut], None if next_masks is None else next_masks[cut]
-            )
-        for c, i in zip(counters, np.flatnonzero(valid)):
+            masks = None if step.next_masks is None else step.next_masks[cut]
+            tails[cut] = self.tail_value(np.asarray(step.next_obs, dtype=np.float32)[cut], masks)
+        for c, i in zip(counters, np.flatnonzero(step.valid)):
             self._pending[i][0].append(int(c))
-            self._pending[i][1].append(float(reward[i]) * self.config.reward_scale)  # on the critics' scale
+            self._pending[i][1].append(float(step.reward[i]) * self.config.reward_scale)  # on the critics' scale
         for i in ended:
             stored, rewards = self._pending[i]
             returns = discounted_returns(np.asarray(rewards), self.config.gamma, float(tails[i]))

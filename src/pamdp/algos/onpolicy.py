@@ -13,11 +13,10 @@ from collections.abc import Callable
 import numpy as np
 import torch
 
-from pamdp.algos.logger import EpisodeTracker
 from pamdp.algos.settings import one_of, setting
-from pamdp.algos.vector_env import info_action_masks
-from pamdp.policies import PI_C_INPUTS, HybridPolicy
-from pamdp.spaces import HybridActionSpace
+from pamdp.algos.subnormals import subnormals_flushed
+from pamdp.algos.vector_env import VectorStepper
+from pamdp.policies import PI_C_INPUTS
 
 __all__ = [
     "pi_c_input_setting",
@@ -76,69 +75,63 @@ class Rollout:
 
     KEYS = ("obs", "a", "x", "reward", "terminated", "done", "valid", "next_obs", "t")
 
-    def __init__(self, action_mask: bool = False):
-        """``action_mask``: sample among the actions each state's ``info["action_mask"]`` allows, and record
-        those masks (the batch's ``"mask"``, bool ``(T, N, K)``) for the update's probabilities."""
-        self.action_mask = action_mask
-        # (observation, autoreset pending, step within episode, allowed actions or None) of every copy between epochs
-        self.state: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None] | None = None
-        self.tracker: EpisodeTracker | None = None
+    def __init__(self, algo):
+        """``algo``: the algorithm, whose ``policy`` (a :class:`~pamdp.policies.HybridPolicy`) acts in its
+        ``vec_env`` on its device, from its random streams. With the ``action_mask`` setting the policy samples
+        among the actions each state's ``info["action_mask"]`` allows, and the batch records those masks
+        (``"mask"``, bool ``(T, N, K)``) for the update's probabilities."""
+        self.algo = algo
+        self.action_mask = algo.config.action_mask
+        self.stepper: VectorStepper | None = None  # the env's copies, from the first epoch on
 
-    def collect(
-        self,
-        env,
-        policy: HybridPolicy,
-        hybrid: HybridActionSpace,
-        n_samples: int,
-        np_rng: np.random.Generator,
-        torch_gen: torch.Generator,
-    ) -> dict[str, np.ndarray]:
-        """Step ``env`` with ``(a, x) ~ policy`` until ``n_samples`` valid samples; ``(T, N, ...)`` arrays of
+    def collect(self, n_samples: int) -> dict[str, np.ndarray]:
+        """Step the env with ``(a, x) ~ policy`` until ``n_samples`` valid samples; ``(T, N, ...)`` arrays of
         :attr:`KEYS` (``t``: the step within the episode; ``terminated`` and ``done`` are false when not valid),
         and ``mask`` with ``action_mask``.
 
-        The policy runs on ``torch_gen``'s device (the algorithm's) and the env on the CPU: a step moves the
-        observations there and the actions back, nothing else.
+        The policy runs on the algorithm's device and the env on the CPU: a step moves the observations there and
+        the actions back, nothing else.
         """
-        n, device = env.num_envs, torch_gen.device
-        masks_of = lambda info: (  # noqa: E731
-            info_action_masks(info, n, hybrid.n_actions) if self.action_mask else None
-        )
-        if self.state is None:
-            obs, info = env.reset(seed=int(np_rng.integers(2**31 - 1)))
-            self.state = (obs, np.zeros(n, dtype=bool), np.zeros(n, dtype=np.int64), masks_of(info))
-            self.tracker = EpisodeTracker(n)
-        obs, prev_done, t_ep, masks = self.state
+        algo = self.algo
+        if self.stepper is None:
+            env = algo.vec_env
+            seed = int(algo.np_rng.integers(2**31 - 1))
+            self.stepper = VectorStepper(env, algo.hybrid.n_actions, self.action_mask, seed)
+            self.t_ep = np.zeros(env.num_envs, dtype=np.int64)
+        stepper, device = self.stepper, algo.device
         rows: dict[str, list] = {k: [] for k in self.KEYS + (("mask",) if self.action_mask else ())}
         n_valid = 0
         while n_valid < n_samples:
             with torch.no_grad():
-                mask = None if masks is None else torch.from_numpy(masks).to(device)
-                obs_t = torch.as_tensor(np.asarray(obs, dtype=np.float32), device=device)
-                a, x = policy.act(obs_t, mask, False, torch_gen)
+                mask = None if stepper.masks is None else torch.from_numpy(stepper.masks).to(device)
+                obs_t = torch.as_tensor(np.asarray(stepper.obs, dtype=np.float32), device=device)
+                a, x = algo.policy.act(obs_t, mask, False, algo.torch_gen)
             a, x = a.cpu().numpy(), x.cpu().numpy()
-            next_obs, reward, terminated, truncated, info = env.step(hybrid.to_env_batch(a, x))
-            valid = ~prev_done
-            done = (terminated | truncated) & valid
-            row = (obs, a, x, reward, terminated & valid, done, valid, next_obs, t_ep)
+            step = stepper.step(algo.hybrid.to_env_batch(a, x))
+            row = (step.obs, a, x, step.reward, step.terminated, step.done, step.valid, step.next_obs, self.t_ep)
             for k, v in zip(self.KEYS, row):
                 rows[k].append(np.array(v))
-            if masks is not None:
-                rows["mask"].append(masks)
-            self.tracker.step(np.asarray(reward, dtype=np.float64), done, valid, info)
-            n_valid += int(valid.sum())
-            t_ep = np.where(valid, t_ep + 1, 0)
-            prev_done, obs, masks = done, next_obs, masks_of(info)
-        self.state = (obs, prev_done, t_ep, masks)
+            if step.masks is not None:
+                rows["mask"].append(step.masks)
+            n_valid += int(step.valid.sum())
+            self.t_ep = np.where(step.valid, self.t_ep + 1, 0)
         return {k: np.stack(v) for k, v in rows.items()}
 
-    def epoch_stats(self, a: np.ndarray, n_actions: int, explained_var: float) -> dict[str, float]:
-        """The baseline's explained variance, the discrete actions' frequencies, the episodes completed since
-        the last call, and ``steps``."""
-        freq = np.bincount(a, minlength=n_actions) / len(a)
-        stats = {"train/explained_variance": explained_var}
+    def run_epoch(self) -> dict[str, float]:
+        """One epoch: :meth:`collect` ``batch_size`` samples, their :func:`advantage_batch` from the algorithm's
+        baseline (``_values(obs, t)``), then its ``_learn`` of the batch (subnormals flushed with
+        ``flush_denormal``). Returns ``_learn``'s stats with the baseline's explained variance, the discrete
+        actions' frequencies, the episodes completed in the epoch, and ``steps``."""
+        algo, cfg = self.algo, self.algo.config
+        batch = self.collect(cfg.batch_size)
+        data, explained_var = advantage_batch(batch, algo._values, cfg.gamma, cfg.gae_lambda, cfg.normalize_advantages)
+        with subnormals_flushed(cfg.flush_denormal):
+            stats = algo._learn(data)
+        a = data["a"]
+        freq = np.bincount(a, minlength=algo.hybrid.n_actions) / len(a)
+        stats["train/explained_variance"] = explained_var
         stats.update({f"train/action_freq_{k}": float(f) for k, f in enumerate(freq)})
-        stats.update(self.tracker.pop())
+        stats.update(self.stepper.episodes.pop())
         stats["steps"] = len(a)
         return stats
 
@@ -193,10 +186,9 @@ def mask_tensor(data: dict[str, np.ndarray], device: torch.device | str = "cpu")
     return torch.as_tensor(data["mask"], device=device) if "mask" in data else None
 
 
-def network_values(value: torch.nn.Module, obs: np.ndarray) -> np.ndarray:
-    """A value network's ``V(s)`` of a batch of observations (computed on the network's device), as float64 for
-    GAE."""
-    device = next(value.parameters()).device
+def network_values(value: torch.nn.Module, obs: np.ndarray, device: torch.device) -> np.ndarray:
+    """A value network's ``V(s)`` of a batch of observations (computed on ``device``, the network's), as float64
+    for GAE."""
     with torch.no_grad():
         return value(torch.as_tensor(np.asarray(obs, dtype=np.float32), device=device)).double().cpu().numpy()
 

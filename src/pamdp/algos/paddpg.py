@@ -5,7 +5,8 @@ The actor ``mu(s)`` outputs one vector: K action scores and the parameters of *e
 own parameters; the critic ``Q(s, mu(s))`` sees the whole vector, so the actor is trained by DDPG's
 deterministic policy gradient ``dQ/dmu * dmu/dtheta`` through all of it.
 
-Bounded outputs (``bound``, the three options Hausknecht & Stone compared; spec "PADDPG"):
+Bounded outputs (``bound``, the three options Hausknecht & Stone compare in their section on bounded parameter
+space learning):
 
 - ``invert`` (the default, theirs): with ``g = dQ/dp`` at the actor's output, scale ``g`` by
   ``(p_max - p) / (p_max - p_min)`` where it would increase ``p`` and by ``(p - p_min) / (p_max - p_min)``
@@ -43,13 +44,12 @@ from pamdp.algos.offpolicy import (
     OffPolicyLoop,
     OUNoise,
     bounded,
-    gradient_step,
     linear_epsilon,
     mixed_target,
     shared_setting,
     soft_updater,
 )
-from pamdp.algos.replay import ReplayBuffer, transition_fields
+from pamdp.algos.optim import apply_gradients
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, at_least, interval, one_of, setting
 from pamdp.distributions import masked_logits
 from pamdp.policies import ACTIVATIONS, mlp
@@ -172,15 +172,13 @@ class PADDPG(Algorithm):
         # fused: one kernel per step instead of a dozen foreach passes (benchmarks/offpolicy_speed.md).
         self.actor_optimizer = torch.optim.Adam(self.actor.parameters(), lr=cfg.actor_lr, betas=betas, fused=True)
         self.critic_optimizer = torch.optim.Adam(self.critic.parameters(), lr=cfg.critic_lr, betas=betas, fused=True)
-        fields = transition_fields(
-            self.obs_dim,
-            h.max_param_size,
-            mc_returns=cfg.beta > 0,  # the loop fills them only when asked to compute Monte-Carlo returns
-            masks=h.n_actions if cfg.action_mask else 0,
+        self.loop = OffPolicyLoop(
+            self,
+            mc_returns=cfg.beta > 0,
+            tail_value=self._target_value,
             out=((self.out_size,), np.float32),  # the output vector the critic sees (after exploration)
         )
-        self.replay = ReplayBuffer(cfg.buffer_size, fields, self.device)
-        self.loop = OffPolicyLoop(cfg, h, self.replay, mc_returns=cfg.beta > 0, tail_value=self._target_value)
+        self.replay = self.loop.buffer
         self._ou = OUNoise(cfg.ou_theta, cfg.ou_sigma)
 
     def _bind_networks(self) -> None:
@@ -199,12 +197,6 @@ class PADDPG(Algorithm):
 
     def _optimizers(self):
         return {"actor": self.actor_optimizer, "critic": self.critic_optimizer}
-
-    def _extra_state(self, replay):
-        return {"loop": self.loop.state_dict(replay)}
-
-    def _load_extra_state(self, state):
-        self.loop.load_state_dict(state["loop"])
 
     def _act(self, obs, deterministic, mask=None):
         out = self.actor(obs).clamp(-1.0, 1.0)
@@ -247,10 +239,8 @@ class PADDPG(Algorithm):
             o, mask = self._from_numpy(obs), None if mask is None else self._from_numpy(mask)
             return self.critic_target(o, self._masked(self.actor_target(o).clamp(-1.0, 1.0), mask)).cpu().numpy()
 
-    def _run_epoch(self) -> dict[str, float]:
-        stats = self.loop.run_epoch(self.vec_env, self._explore, self._update, self.num_timesteps, self.np_rng)
-        stats["train/epsilon"] = self.epsilon(self.num_timesteps + stats["steps"])
-        return stats
+    def _epoch_stats(self, step: int) -> dict[str, float]:
+        return {"train/epsilon": self.epsilon(step)}
 
     def _update(self) -> dict[str, float]:
         """One critic step on the mixed target and one actor step along the bounded ``dQ/dmu``, back-propagated
@@ -270,7 +260,7 @@ class PADDPG(Algorithm):
             q, cache = critic.forward_cached(torch.cat([obs, b["out"]], dim=-1))
             q = q.squeeze(-1)
             error = q - y
-            gradient_step(self.critic_optimizer, cfg.grad_clip)(critic.backward(cache, error * (2.0 / batch))[0])
+            apply_gradients(self.critic_optimizer, critic.backward(cache, error * (2.0 / batch))[0], cfg.grad_clip)
             # actor: ascend on Q(s, mu(s)) with the critic just updated, dQ/dmu edited at the bounds
             out, actor_cache = actor.forward_cached(obs)
             q_mu, q_cache = critic.forward_cached(torch.cat([obs, self._masked(out, b.get("mask"))], dim=-1))
@@ -279,7 +269,7 @@ class PADDPG(Algorithm):
             if "mask" in b:  # a forbidden action's score is held at -1: no gradient reaches it
                 k = self.hybrid.n_actions
                 dq_dp = torch.cat([dq_dp[:, :k] * b["mask"], dq_dp[:, k:]], dim=-1)
-            gradient_step(self.actor_optimizer, cfg.grad_clip)(actor.backward(actor_cache, -dq_dp / batch)[0])
+            apply_gradients(self.actor_optimizer, actor.backward(actor_cache, -dq_dp / batch)[0], cfg.grad_clip)
             self._soft_update(cfg.tau)
         return {
             "losses/critic_loss": float(error.square().mean()),

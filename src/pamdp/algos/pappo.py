@@ -35,14 +35,13 @@ import torch
 from pamdp.algos.base import Algorithm
 from pamdp.algos.onpolicy import (
     Rollout,
-    advantage_batch,
     mask_tensor,
     network_values,
     pi_c_input_setting,
     update_tensors,
 )
+from pamdp.algos.optim import descend
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
-from pamdp.algos.subnormals import subnormals_flushed
 from pamdp.distributions import HybridDistribution, kl_divergence
 from pamdp.policies import ACTIVATIONS, HybridPolicy, ValueNetwork
 
@@ -181,7 +180,7 @@ class PAPPO(Algorithm):
         )
         self.value = ValueNetwork(self.obs_dim, cfg.vf_hidden_sizes)
         self.optimizer = torch.optim.Adam([*self.policy.parameters(), *self.value.parameters()], lr=cfg.lr)
-        self.rollout = Rollout(cfg.action_mask)  # a loaded model starts new episodes
+        self.loop = Rollout(self)  # a loaded model starts new episodes
 
     def _modules(self):
         return {"policy": self.policy, "value": self.value}
@@ -193,19 +192,12 @@ class PAPPO(Algorithm):
         return self.policy.act(obs, mask, deterministic, self.torch_gen)
 
     def _values(self, obs: np.ndarray, t: np.ndarray) -> np.ndarray:
-        return network_values(self.value, obs)
+        return network_values(self.value, obs, self.device)
 
-    def _run_epoch(self) -> dict[str, float]:
-        cfg = self.config
-        batch = self.rollout.collect(
-            self.vec_env, self.policy, self.hybrid, cfg.batch_size, self.np_rng, self.torch_gen
-        )
-        data, explained_var = advantage_batch(batch, self._values, cfg.gamma, cfg.gae_lambda, cfg.normalize_advantages)
-        with subnormals_flushed(cfg.flush_denormal):
-            returns = torch.as_tensor(data["returns"], dtype=torch.float32, device=self.device)
-            stats = self._update(*update_tensors(data, self.device), returns, mask_tensor(data, self.device))
-        stats.update(self.rollout.epoch_stats(data["a"], self.hybrid.n_actions, explained_var))
-        return stats
+    def _learn(self, data: dict[str, np.ndarray]) -> dict[str, float]:
+        """:meth:`_update` on an :func:`~pamdp.algos.onpolicy.advantage_batch` (the epoch: Rollout.run_epoch)."""
+        returns = torch.as_tensor(data["returns"], dtype=torch.float32, device=self.device)
+        return self._update(*update_tensors(data, self.device), returns, mask_tensor(data, self.device))
 
     def _update(self, obs, a, x, adv, returns, mask=None) -> dict[str, float]:
         """``n_epochs`` passes of minibatch Adam steps on the joint loss, stopped early by ``target_kl``; ``mask``:
@@ -231,11 +223,7 @@ class PAPPO(Algorithm):
                 loss, parts = ppo_loss(
                     dist, self.value(obs[idx]), a[idx], x[idx], old_logp[idx], adv[idx], returns[idx], cfg
                 )
-                self.optimizer.zero_grad()
-                loss.backward()
-                grad_norm = torch.nn.utils.clip_grad_norm_(params, cfg.max_grad_norm)
-                self.optimizer.step()
-                parts["train/grad_norm"] = grad_norm
+                parts["train/grad_norm"] = descend(self.optimizer, loss, params, cfg.max_grad_norm)
                 for k, v in parts.items():
                     sums[k] = sums.get(k, 0.0) + float(v)
                 updates += 1

@@ -41,24 +41,22 @@ from pamdp.algos.dense import Dense
 from pamdp.algos.offpolicy import (
     OffPolicyConfig,
     OffPolicyLoop,
-    clipped_step,
-    gradient_step,
+    Temperatures,
     shared_setting,
     soft_updater,
+    temperature_gradient,
     uniform_actions,
 )
-from pamdp.algos.replay import ReplayBuffer, transition_fields
+from pamdp.algos.optim import apply_gradients, descend
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
-from pamdp.distributions import masked_logits
-from pamdp.policies import ACTIVATIONS, every_action_linear, mlp
+from pamdp.distributions import LOG_STD_MAX, LOG_STD_MIN, masked_logits
+from pamdp.policies import ACTIVATIONS, every_action_linear, every_action_mlp, hierarchical_mlps, mlp
 from pamdp.spaces import HybridActionSpace
 
 if TYPE_CHECKING:
     from typing_extensions import Self
 
 __all__ = ["PASVG0", "PASVG0Config", "GumbelHybridPolicy", "expected_q", "gumbel_noise", "gumbel_softmax_sample"]
-
-LOG_STD_MIN, LOG_STD_MAX = -5.0, 2.0
 
 
 @dataclasses.dataclass(frozen=True)
@@ -207,34 +205,13 @@ class GumbelHybridPolicy(nn.Module):
     def __init__(self, obs_dim: int, hybrid: HybridActionSpace, hidden_sizes, activation: str, init_log_std: float):
         super().__init__()
         self.n_actions, self.param_size = hybrid.n_actions, hybrid.max_param_size
-        self.pi_d = mlp(obs_dim, hidden_sizes, self.n_actions, activation)
-        self.pi_c = mlp(obs_dim + self.n_actions, hidden_sizes, self.param_size, activation)
+        self.pi_d, self.pi_c = hierarchical_mlps(obs_dim, self.n_actions, hidden_sizes, activation, self.param_size)
         self.log_std = nn.Parameter(torch.full((self.n_actions, self.param_size), float(init_log_std)))
         self.register_buffer("mask", torch.tensor(hybrid.param_mask, dtype=torch.float32))
-        # Small final layers start pi_d near uniform and pi_c near the centre of the parameter box.
-        for head in (self.pi_d[-1], self.pi_c[-1]):
-            nn.init.uniform_(head.weight, -3e-3, 3e-3)
-            nn.init.zeros_(head.bias)
 
     def std(self) -> torch.Tensor:
         """The parameter noise's std per action and parameter, ``(K, m)``."""
         return self.log_std.clamp(LOG_STD_MIN, LOG_STD_MAX).exp()
-
-    def sample(
-        self,
-        obs: torch.Tensor,
-        eta_a: torch.Tensor,
-        eta_x: torch.Tensor,
-        temperature: float,
-        hard: bool,
-        mask: torch.Tensor | None = None,
-    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
-        """``(logits, index, a, x)`` for the noise ``(eta_a, eta_x)``: ``pi_d``'s logits (restricted to the actions
-        ``mask`` allows), the action, the critic's action input ``a`` and the parameters ``x``, so an update runs
-        ``pi_d`` once."""
-        logits = masked_logits(self.pi_d(obs), mask)
-        index, a = gumbel_softmax_sample(logits, eta_a, temperature, hard)
-        return logits, index, a, self.params(obs, index, a, eta_x)
 
     def params(self, obs: torch.Tensor, index: torch.Tensor, a: torch.Tensor, eta_x: torch.Tensor) -> torch.Tensor:
         """``x = g(s, a, eta_x)``: ``pi_c``'s parameters for action ``a`` (one-hot or soft; ``index`` its argmax)."""
@@ -249,8 +226,7 @@ class GumbelHybridPolicy(nn.Module):
         batch, K = len(obs), self.n_actions
         onehots = torch.eye(K, dtype=obs.dtype, device=obs.device).expand(batch, K, K)
         obs_k = obs.unsqueeze(-2).expand(batch, K, obs.shape[-1])
-        first = self.pi_c[0]  # pi_c of every one-hot without building the B * K inputs (as params would)
-        means = self.pi_c[1:](every_action_linear(obs, first.weight, first.bias))
+        means = every_action_mlp(self.pi_c, obs)  # without building the B * K inputs (as params would)
         return obs_k, onehots, torch.tanh(means + self.std() * eta_x.unsqueeze(-2)) * self.mask
 
     def forward(
@@ -261,9 +237,13 @@ class GumbelHybridPolicy(nn.Module):
         temperature: float,
         hard: bool,
         mask: torch.Tensor | None = None,
-    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
-        """``(index, a, x)`` for the noise ``(eta_a, eta_x)``; ``a`` is the critic's action input."""
-        return self.sample(obs, eta_a, eta_x, temperature, hard, mask)[1:]
+    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
+        """``(logits, index, a, x)`` for the noise ``(eta_a, eta_x)``: ``pi_d``'s logits (restricted to the actions
+        ``mask`` allows), the action, the critic's action input ``a`` and the parameters ``x``, so an update runs
+        ``pi_d`` once."""
+        logits = masked_logits(self.pi_d(obs), mask)
+        index, a = gumbel_softmax_sample(logits, eta_a, temperature, hard)
+        return logits, index, a, self.params(obs, index, a, eta_x)
 
     def mode(self, obs: torch.Tensor, mask: torch.Tensor | None = None) -> tuple[torch.Tensor, torch.Tensor]:
         """The greedy action: the most probable (allowed) discrete action and its mean parameters."""
@@ -299,22 +279,6 @@ def every_action_q(*critics: Critic) -> Callable:
         return values[0] if len(values) == 1 else torch.minimum(*values)
 
     return q_all
-
-
-class EntropyWeight(nn.Module):
-    """The weight ``alpha = exp(log_alpha)`` of ``pi_d``'s entropy, tuned towards a target entropy (SAC's rule).
-
-    Its loss ``log_alpha * (H - target)`` lowers the weight while ``pi_d``'s entropy ``H`` is above the target
-    and raises it below, so the discrete policy keeps exploring about as much as asked, however the critic's
-    values scale.
-    """
-
-    def __init__(self, initial: float):
-        super().__init__()
-        self.log_alpha = nn.Parameter(torch.tensor(math.log(initial), dtype=torch.float32))
-
-    def forward(self) -> torch.Tensor:
-        return self.log_alpha.exp()
 
 
 class Critic(nn.Module):
@@ -367,19 +331,16 @@ class PASVG0(Algorithm):
                     f"PASVG0Config.target_entropy = {cfg.target_entropy!r}; expected at most ln K = "
                     f"{math.log(h.n_actions):.4f} nats for this env's K = {h.n_actions} actions"
                 )
-            self.entropy_weight = EntropyWeight(cfg.entropy_coef)
+            self.entropy_weight = Temperatures(alpha=cfg.entropy_coef)  # pi_d's, tuned by SAC's rule
             self.entropy_optimizer = torch.optim.Adam(self.entropy_weight.parameters(), lr=cfg.entropy_lr)
         K, m = h.n_actions, h.max_param_size
-        fields = transition_fields(
-            self.obs_dim,
-            m,
-            masks=K if cfg.action_mask else 0,
+        self.loop = OffPolicyLoop(
+            self,
             a_in=((K,), np.float32),  # the critic's action input: one-hot, or the soft sample
             eta_a=((K,), np.float32),
             eta_x=((m,), np.float32),
         )
-        self.replay = ReplayBuffer(cfg.buffer_size, fields, self.device)
-        self.loop = OffPolicyLoop(cfg, h, self.replay)
+        self.replay = self.loop.buffer
         self._bind_networks()
 
     def _bind_networks(self) -> None:
@@ -419,11 +380,10 @@ class PASVG0(Algorithm):
             optimizers["entropy_weight"] = self.entropy_optimizer
         return optimizers
 
-    def _extra_state(self, replay):
-        return {"loop": self.loop.state_dict(replay), "critic_updates": self.critic_updates}
+    def _extra_state(self):
+        return {"critic_updates": self.critic_updates}
 
     def _load_extra_state(self, state):
-        self.loop.load_state_dict(state["loop"])
         self.critic_updates = int(state.get("critic_updates", 0))  # absent from checkpoints before policy_delay
 
     def _noise(self, batch: int) -> tuple[torch.Tensor, torch.Tensor]:
@@ -434,13 +394,13 @@ class PASVG0(Algorithm):
     def _act(self, obs, deterministic, mask=None):
         if deterministic:
             return self.policy.mode(obs, mask)
-        index, _, x = self.policy(obs, *self._noise(len(obs)), self.config.temperature, True, mask)
+        _, index, _, x = self.policy(obs, *self._noise(len(obs)), self.config.temperature, True, mask)
         return index, x
 
     def _explore(self, obs: torch.Tensor, step: int, episode_start: np.ndarray, mask: torch.Tensor | None):
         cfg = self.config
         eta_a, eta_x = self._noise(len(obs))
-        index, a_in, x = self.policy(obs, eta_a, eta_x, cfg.temperature, cfg.straight_through, mask)
+        _, index, a_in, x = self.policy(obs, eta_a, eta_x, cfg.temperature, cfg.straight_through, mask)
         if cfg.explore_epsilon > 0:  # drawn only when on, so that the paper's preset keeps its random stream
             n, K = len(obs), self.hybrid.n_actions
             flip = torch.rand(n, generator=self.torch_gen, device=self.device) < cfg.explore_epsilon
@@ -450,9 +410,6 @@ class PASVG0(Algorithm):
             a_in = torch.where(flip[:, None], onehot, a_in)
             x = torch.where(flip[:, None], self.policy.params(obs, uniform, onehot, eta_x), x)
         return index, x, {"a_in": a_in.cpu().numpy(), "eta_a": eta_a.cpu().numpy(), "eta_x": eta_x.cpu().numpy()}
-
-    def _run_epoch(self) -> dict[str, float]:
-        return self.loop.run_epoch(self.vec_env, self._explore, self._update, self.num_timesteps, self.np_rng)
 
     def _target_q(self, obs: torch.Tensor, a: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
         """The target critic's ``Q'``; with ``twin_critics`` the smaller of the two target critics' values."""
@@ -471,7 +428,7 @@ class PASVG0(Algorithm):
             critics = (self.critic_target,) if self.critic2 is None else (self.critic_target, self.critic2_target)
             _, q_next = expected_q(self.policy_target, every_action_q(*critics), next_obs, eta_x, mask)
         else:
-            _, a_next, x_next = self.policy_target(next_obs, eta_a, eta_x, cfg.temperature, cfg.straight_through, mask)
+            *_, a_next, x_next = self.policy_target(next_obs, eta_a, eta_x, cfg.temperature, cfg.straight_through, mask)
             q_next = self._target_q(next_obs, a_next, x_next)
         return b["reward"] + cfg.gamma * (~b["terminated"]).float() * q_next
 
@@ -487,9 +444,7 @@ class PASVG0(Algorithm):
         critic_loss = F.mse_loss(q, y)
         if self.critic2 is not None:
             critic_loss = critic_loss + F.mse_loss(self.critic2(obs, b["a_in"], b["x"]), y)
-        self.critic_optimizer.zero_grad(set_to_none=True)
-        critic_loss.backward()
-        clipped_step(self.critic_optimizer, self.critic_params, cfg.grad_clip)
+        descend(self.critic_optimizer, critic_loss, self.critic_params, cfg.grad_clip)
         self.critic_updates += 1
         stats = {"losses/critic_loss": float(critic_loss.detach()), "train/q_mean": float(q.detach().mean())}
         if self.critic_updates % cfg.policy_delay == 0:
@@ -505,24 +460,18 @@ class PASVG0(Algorithm):
         if cfg.discrete_gradient == "expected":
             logits, q_pi = expected_q(self.policy, every_action_q(self.critic), obs, b["eta_x"], mask)
         else:
-            logits, _, a, x = self.policy.sample(
-                obs, b["eta_a"], b["eta_x"], cfg.temperature, cfg.straight_through, mask
-            )
+            logits, _, a, x = self.policy(obs, b["eta_a"], b["eta_x"], cfg.temperature, cfg.straight_through, mask)
             q_pi = self.critic(obs, a, x)
         entropy = -(logits.softmax(-1) * logits.log_softmax(-1)).sum(-1).mean()
-        alpha = cfg.entropy_coef if self.entropy_weight is None else float(self.entropy_weight().detach())
+        alpha = cfg.entropy_coef if self.entropy_weight is None else float(self.entropy_weight.log_alpha.detach().exp())
         actor_loss = -q_pi.mean() - alpha * entropy
         # The policy loss differentiates Q in (a, x) only: asking for the policy's gradients alone skips the
         # critic's weight gradients, which backward() would compute and the critic must not receive.
-        grads = torch.autograd.grad(actor_loss, self.policy_params)
-        for p, g in zip(self.policy_params, grads):
-            p.grad = g
-        clipped_step(self.policy_optimizer, self.policy_params, cfg.grad_clip)
+        descend(self.policy_optimizer, actor_loss, self.policy_params, cfg.grad_clip)
         if self.entropy_weight is not None:
-            alpha_loss = self.entropy_weight.log_alpha * (float(entropy.detach()) - cfg.target_entropy)
-            self.entropy_optimizer.zero_grad(set_to_none=True)
-            alpha_loss.backward()
-            self.entropy_optimizer.step()
+            # in double, as the loss log_alpha * (float(H) - target) it replaced: the same step
+            gradient = temperature_gradient(entropy.detach().double(), cfg.target_entropy).float()
+            apply_gradients(self.entropy_optimizer, [gradient])
         self._soft_update(cfg.tau)
         return self._policy_stats(actor_loss.detach(), q_pi, entropy.detach(), alpha)
 
@@ -551,7 +500,7 @@ class PASVG0(Algorithm):
         q, cache = critic.forward_cached(torch.cat([obs, b["a_in"], b["x"]], dim=-1))
         q = q.squeeze(-1)
         error = q - y
-        gradient_step(self.critic_optimizer, cfg.grad_clip)(critic.backward(cache, error * (2.0 / batch))[0])
+        apply_gradients(self.critic_optimizer, critic.backward(cache, error * (2.0 / batch))[0], cfg.grad_clip)
         self.critic_updates += 1
 
         # policy: descend on -mean Q(s, a, x) - alpha * mean H(pi_d), with the recorded noise
@@ -586,7 +535,7 @@ class PASVG0(Algorithm):
             d_table = F.one_hot(index, K).to(d_u.dtype).t() @ (d_u * eta_x * std)
             inside = (policy.log_std >= LOG_STD_MIN) & (policy.log_std <= LOG_STD_MAX)
             grads.insert(0, d_table * inside)
-        gradient_step(self.policy_optimizer, cfg.grad_clip)(grads)
+        apply_gradients(self.policy_optimizer, grads, cfg.grad_clip)
         self._soft_update(cfg.tau)
         q_pi = q_pi.squeeze(-1)
         entropy = entropy.mean()

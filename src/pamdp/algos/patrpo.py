@@ -32,14 +32,13 @@ from pamdp.algos.base import Algorithm
 from pamdp.algos.onpolicy import (
     LinearFeatureBaseline,
     Rollout,
-    advantage_batch,
     mask_tensor,
     network_values,
     pi_c_input_setting,
     update_tensors,
 )
+from pamdp.algos.optim import descend
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, at_least, interval, one_of, setting
-from pamdp.algos.subnormals import subnormals_flushed
 from pamdp.algos.trpo import (
     FisherVectorProduct,
     backtracking_line_search,
@@ -169,10 +168,11 @@ class PATRPO(Algorithm):
         )
         if cfg.baseline == "mlp":
             self.value = ValueNetwork(self.obs_dim, cfg.vf_hidden_sizes)
-            self.vf_optimizer = torch.optim.Adam(self.value.parameters(), lr=cfg.vf_lr)
+            self._vf_params = list(self.value.parameters())
+            self.vf_optimizer = torch.optim.Adam(self._vf_params, lr=cfg.vf_lr)
         else:
             self.linear_baseline = LinearFeatureBaseline(self.obs_dim)
-        self.rollout = Rollout(cfg.action_mask)  # a loaded model starts new episodes
+        self.loop = Rollout(self)  # a loaded model starts new episodes
 
     def _modules(self):
         return {"policy": self.policy, **({"value": self.value} if self.config.baseline == "mlp" else {})}
@@ -180,7 +180,7 @@ class PATRPO(Algorithm):
     def _optimizers(self):
         return {"value": self.vf_optimizer} if self.config.baseline == "mlp" else {}
 
-    def _extra_state(self, replay):
+    def _extra_state(self):
         if self.config.baseline == "linear":
             return {"linear_baseline": torch.as_tensor(self.linear_baseline.coef)}
         return {}
@@ -192,17 +192,11 @@ class PATRPO(Algorithm):
     def _act(self, obs, deterministic, mask=None):
         return self.policy.act(obs, mask, deterministic, self.torch_gen)
 
-    # -- one epoch -------------------------------------------------------------------------------
-    def _run_epoch(self) -> dict[str, float]:
-        cfg = self.config
-        batch = self.rollout.collect(
-            self.vec_env, self.policy, self.hybrid, cfg.batch_size, self.np_rng, self.torch_gen
-        )
-        data, explained_var = advantage_batch(batch, self._values, cfg.gamma, cfg.gae_lambda, cfg.normalize_advantages)
-        with subnormals_flushed(cfg.flush_denormal):
-            stats = self._update_policy(*update_tensors(data, self.device), mask_tensor(data, self.device))
-            stats["losses/value_loss"] = self._fit_baseline(data["obs"], data["t"], data["returns"])
-        stats.update(self.rollout.epoch_stats(data["a"], self.hybrid.n_actions, explained_var))
+    # -- one epoch (the rollout and the advantages: Rollout.run_epoch) ------------------------------
+    def _learn(self, data: dict[str, np.ndarray]) -> dict[str, float]:
+        """The policy's step on an :func:`~pamdp.algos.onpolicy.advantage_batch`, then the baseline's fit."""
+        stats = self._update_policy(*update_tensors(data, self.device), mask_tensor(data, self.device))
+        stats["losses/value_loss"] = self._fit_baseline(data["obs"], data["t"], data["returns"])
         return stats
 
     def _update_policy(self, obs, a, x, adv, mask=None) -> dict[str, float]:
@@ -286,7 +280,7 @@ class PATRPO(Algorithm):
         """The baseline ``V(s)`` of observations at step ``t`` of their episodes."""
         if self.config.baseline == "linear":
             return self.linear_baseline.predict(obs, t)
-        return network_values(self.value, obs)
+        return network_values(self.value, obs, self.device)
 
     def _fit_baseline(self, obs: np.ndarray, t: np.ndarray, returns: np.ndarray) -> float:
         cfg = self.config
@@ -299,8 +293,6 @@ class PATRPO(Algorithm):
             for start in range(0, n, cfg.vf_batch_size):
                 idx = perm[start : start + cfg.vf_batch_size]
                 loss = (self.value(obs_t[idx]) - ret_t[idx]).pow(2).mean()
-                self.vf_optimizer.zero_grad()
-                loss.backward()
-                self.vf_optimizer.step()
+                descend(self.vf_optimizer, loss, self._vf_params)
         with torch.no_grad():
             return float((self.value(obs_t) - ret_t).pow(2).mean())

@@ -46,14 +46,13 @@ from pamdp.algos.offpolicy import (
     OffPolicyLoop,
     OUNoise,
     backprop_actor,
-    clipped_step,
     linear_epsilon,
     mixed_target,
     shared_setting,
-    soft_update,
+    soft_updater,
     uniform_actions,
 )
-from pamdp.algos.replay import ReplayBuffer, transition_fields
+from pamdp.algos.optim import apply_gradients, descend
 from pamdp.algos.settings import (
     LAYERS,
     NON_NEGATIVE,
@@ -290,18 +289,19 @@ class PDQN(Algorithm):
         self.q_net = QNetwork(self.obs_dim, h, cfg.hidden_sizes, cfg.activation, cfg.multi_pass)
         self.actor_target = copy.deepcopy(self.actor).requires_grad_(False)
         self.q_target = copy.deepcopy(self.q_net).requires_grad_(False)
-        self.actor_optimizer = torch.optim.Adam(self.actor.parameters(), lr=cfg.actor_lr, fused=True)
-        self.q_optimizer = torch.optim.Adam(self.q_net.parameters(), lr=cfg.q_lr, fused=True)
+        self._actor_params, self._q_params = list(self.actor.parameters()), list(self.q_net.parameters())
+        self.actor_optimizer = torch.optim.Adam(self._actor_params, lr=cfg.actor_lr, fused=True)
+        self.q_optimizer = torch.optim.Adam(self._q_params, lr=cfg.q_lr, fused=True)
+        self._soft_update_q = soft_updater([(self.q_target, self.q_net)])
+        self._soft_update_actor = soft_updater([(self.actor_target, self.actor)])
         self.blocks = torch.as_tensor(param_blocks(h), device=self.device)
-        fields = transition_fields(
-            self.obs_dim,
-            h.max_param_size,
+        self.loop = OffPolicyLoop(
+            self,
             mc_returns=cfg.beta > 0,
-            masks=h.n_actions if cfg.action_mask else 0,
+            tail_value=self._target_value,
             params=((h.total_param_size,), np.float32),  # every action's, after exploration: what Q learns on
         )
-        self.replay = ReplayBuffer(cfg.buffer_size, fields, self.device)
-        self.loop = OffPolicyLoop(cfg, h, self.replay, mc_returns=cfg.beta > 0, tail_value=self._target_value)
+        self.replay = self.loop.buffer
         self._ou = OUNoise(cfg.ou_theta, cfg.ou_sigma)
 
     def _modules(self):
@@ -309,12 +309,6 @@ class PDQN(Algorithm):
 
     def _optimizers(self):
         return {"actor": self.actor_optimizer, "q_net": self.q_optimizer}
-
-    def _extra_state(self, replay):
-        return {"loop": self.loop.state_dict(replay)}
-
-    def _load_extra_state(self, state):
-        self.loop.load_state_dict(state["loop"])
 
     # -- acting ----------------------------------------------------------------------------------
     def _act(self, obs, deterministic, mask=None):
@@ -361,10 +355,8 @@ class PDQN(Algorithm):
         return masked_logits(self.q_target(obs, self.actor_target(obs).clamp(-1.0, 1.0)), mask).max(-1).values
 
     # -- learning --------------------------------------------------------------------------------
-    def _run_epoch(self) -> dict[str, float]:
-        stats = self.loop.run_epoch(self.vec_env, self._explore, self._update, self.num_timesteps, self.np_rng)
-        stats["train/epsilon"] = self.epsilon(self.num_timesteps + stats["steps"])
-        return stats
+    def _epoch_stats(self, step: int) -> dict[str, float]:
+        return {"train/epsilon": self.epsilon(step)}
 
     def _update(self) -> dict[str, float]:
         """One TD step of the Q-network, one actor step along the bounded ``d sum_k Q_k / dx``, soft target updates."""
@@ -378,16 +370,12 @@ class PDQN(Algorithm):
                 y = mixed_target(y, b["mc"], cfg.beta)
         q = self.q_net(obs, b["params"]).gather(1, b["a"][:, None]).squeeze(1)
         q_loss = F.mse_loss(q, y)
-        self.q_optimizer.zero_grad(set_to_none=True)
-        q_loss.backward()
-        clipped_step(self.q_optimizer, self.q_net.parameters(), cfg.grad_clip)
+        descend(self.q_optimizer, q_loss, self._q_params, cfg.grad_clip)
+        x, q_x, grads = backprop_actor(self.actor, self.q_net, obs, cfg.bound, self._actor_params)
+        apply_gradients(self.actor_optimizer, grads, cfg.grad_clip)
 
-        self.actor_optimizer.zero_grad(set_to_none=True)
-        x, q_x = backprop_actor(self.actor, self.q_net, obs, cfg.bound)
-        clipped_step(self.actor_optimizer, self.actor.parameters(), cfg.grad_clip)
-
-        soft_update(self.q_target, self.q_net, cfg.tau_q)
-        soft_update(self.actor_target, self.actor, cfg.tau_actor)
+        self._soft_update_q(cfg.tau_q)
+        self._soft_update_actor(cfg.tau_actor)
         return {
             "losses/critic_loss": float(q_loss.detach()),
             "losses/actor_loss": float(-q_x.sum(-1).mean()),

@@ -3,6 +3,7 @@ batched or stepped in turn, and the spaces of whatever a user passed (an id, an 
 
 from __future__ import annotations
 
+import dataclasses
 import importlib
 import inspect
 import typing
@@ -11,6 +12,7 @@ import gymnasium
 import numpy as np
 from gymnasium import spaces
 
+from pamdp.algos.logger import EpisodeTracker
 from pamdp.algos.settings import type_name, type_ok
 
 __all__ = [
@@ -21,6 +23,8 @@ __all__ = [
     "describe_env",
     "info_action_masks",
     "AUTO_BATCH_MIN",
+    "Step",
+    "VectorStepper",
 ]
 
 # A batched env steps its copies in one compiled loop and beats scalar copies stepped in turn from two copies on
@@ -152,3 +156,63 @@ def info_action_masks(infos: dict, num_envs: int, n_actions: int) -> np.ndarray:
     has &= reported.any(axis=1)
     masks[has] = reported[has].astype(bool)
     return masks
+
+
+@dataclasses.dataclass
+class Step:
+    """One step of every copy of a vector env, as :meth:`VectorStepper.step` returns it: ``(N, ...)`` arrays.
+
+    ``obs`` and ``masks`` are the copies' states before the step (``masks``: their allowed actions, ``None``
+    without action masks), ``next_obs`` and ``next_masks`` after it. ``valid`` is false on the autoreset steps
+    (see :class:`VectorStepper`); ``terminated`` and ``done`` (terminated or truncated) are true only where valid.
+    ``ended`` lists the copies whose episode ended, ``flatnonzero(done)``, and ``returns``, ``lengths`` and
+    ``successes`` those episodes' (a success ``None`` where the env did not report one).
+    """
+
+    obs: np.ndarray
+    masks: np.ndarray | None
+    reward: np.ndarray
+    terminated: np.ndarray
+    done: np.ndarray
+    valid: np.ndarray
+    next_obs: np.ndarray
+    next_masks: np.ndarray | None
+    info: dict
+    returns: np.ndarray
+    lengths: np.ndarray
+    successes: list[bool | None]
+
+    @property
+    def ended(self) -> np.ndarray:
+        return np.flatnonzero(self.done)
+
+
+class VectorStepper:
+    """Steps a vector env with Gymnasium's next-step autoreset, keeping the episodes' accounts.
+
+    Such an env resets a finished copy on the *next* step and ignores that step's action: the step is marked
+    invalid (no sample, no reward counted). The stepper holds each copy's current observation and allowed actions
+    (``masked``: from ``info["action_mask"]``, :func:`info_action_masks`); its :attr:`episodes` keep the running
+    and finished episodes' returns and lengths. Training (the on- and off-policy loops) and evaluation step their
+    envs through it.
+    """
+
+    def __init__(self, env: gymnasium.vector.VectorEnv, n_actions: int, masked: bool, seed: int):
+        self.env, self.n_actions, self.masked = env, n_actions, masked
+        self.obs, info = env.reset(seed=seed)
+        self.masks = self._masks(info)
+        self.prev_done = np.zeros(env.num_envs, dtype=bool)
+        self.episodes = EpisodeTracker(env.num_envs)
+
+    def _masks(self, info: dict) -> np.ndarray | None:
+        return info_action_masks(info, self.env.num_envs, self.n_actions) if self.masked else None
+
+    def step(self, action) -> Step:
+        """Step every copy with the env's ``action`` and move on to the new observations."""
+        obs, masks = self.obs, self.masks
+        next_obs, reward, terminated, truncated, info = self.env.step(action)
+        valid = ~self.prev_done
+        done = (terminated | truncated) & valid
+        ended = self.episodes.step(np.asarray(reward, dtype=np.float64), done, valid, info)
+        self.obs, self.masks, self.prev_done = next_obs, self._masks(info), done
+        return Step(obs, masks, reward, terminated & valid, done, valid, next_obs, self.masks, info, *ended)
