@@ -20,7 +20,7 @@ import gymnasium
 _REGISTRATIONS = {
     "pamdp/Platform-v0": dict(
         entry_point="pamdp.envs.platform.env:PlatformEnv",
-        vector_entry_point="pamdp.envs.platform.batched:PlatformVectorEnv",
+        vector_entry_point="pamdp.envs.platform.env:PlatformVectorEnv",
         max_episode_steps=200,
     ),
     "pamdp/HalfFieldOffense-v0": dict(

@@ -1,10 +1,10 @@
-"""What pamdp's scalar envs share: copy 0 of the batched layout, and the checks of one action.
+"""The scalar env: a :class:`~pamdp.envs.vector.Domain` at N = 1 as a ``gymnasium.Env``.
 
-A domain's scalar env is its batched env at N = 1 (``pamdp.envs.vector``): it keeps one state row in
-``_states`` (shape ``(1, STATE_SIZE)``) and one :class:`~pamdp.envs.vector.RandomStreams` copy, and steps
-them with the same compiled per-copy functions. :class:`ScalarEnv` holds that plumbing; a domain sets
-``metadata`` (render modes and fps), ``observe`` (its compiled ``observe(states, out)``) and ``obs_size``,
-and implements ``reset``, ``step`` and ``_frame`` (the picture :meth:`~ScalarEnv.render` returns).
+It keeps one state row and one :class:`~pamdp.envs.vector.RandomStreams` copy that follows ``np_random``
+(a replaced generator, e.g. ``numpy.random.RandomState(S)`` or a seeded reset, drops the numbers drawn
+ahead of it), and runs the domain's own batched ``parse``, ``reset`` and ``step`` on them: one action is
+checked as a batch of one (:func:`as_batch`), and the batched infos are read back as copy 0's. It neither
+autoresets nor truncates (``gymnasium.make`` adds the registration's ``TimeLimit``).
 """
 
 from __future__ import annotations
@@ -15,11 +15,110 @@ import numbers
 import gymnasium
 import numpy as np
 
-from pamdp.envs.vector import RandomStreams, check_render_mode
+from pamdp.envs.vector import Domain, RandomStreams, check_render_mode
 
-__all__ = ["ScalarEnv", "split_action", "number"]
+__all__ = ["DomainEnv", "as_batch"]
 
 
+class _OneEach(tuple):
+    """The parameters of one action, each read as a batch of one (``p[None]``) when it is read: a parser that
+    reads only the chosen action's parameter (Hard Move's 1 024 boxes) converts only that one."""
+
+    def __getitem__(self, i):
+        return np.asarray(tuple.__getitem__(self, i))[None]
+
+    def __iter__(self):
+        return map(self.__getitem__, range(len(self)))
+
+
+def as_batch(action):
+    """One action ``(a, params)`` as a batch of one, ``(array([a]), (p_0[None], p_1[None], ...))``; anything
+    else is handed on as it is, for the parser to refuse."""
+    if not isinstance(action, (tuple, list)) or len(action) != 2:
+        return action
+    a, params = action
+    return np.asarray(a)[None], _OneEach(params) if isinstance(params, (tuple, list)) else params
+
+
+class DomainEnv(gymnasium.Env):
+    """One copy of a :class:`~pamdp.envs.vector.Domain` (``domain_class``) as a Gymnasium env.
+
+    Args:
+        render_mode: ``None`` or ``"rgb_array"``.
+        **variant: the domain's constructor arguments.
+    """
+
+    metadata = {"render_modes": ["rgb_array"]}
+    domain_class: type[Domain]
+    num_envs = 1
+    """The domain's hooks see the scalar env as a batched one of one copy."""
+
+    def __init__(self, render_mode: str | None = None, **variant):
+        self.domain = domain = self.domain_class(**variant)
+        check_render_mode(render_mode, self.metadata["render_modes"])
+        self.metadata = {**self.metadata, "render_fps": domain.render_fps}
+        self.render_mode = render_mode
+        self.action_space = domain.action_space
+        self.observation_space = domain.observation_space
+        self.streams = RandomStreams(1, domain.draw, domain.scalar_buffer_size)
+        self._states = domain.initial_states(1)
+        self._started = False
+        self._calm = np.zeros(1, dtype=bool)  # a scalar env never resets inside a step
+
+    def __getattr__(self, name: str):
+        # The domain's variant and tables (``n``, ``motions``, ``settings``...) read as the env's own.
+        if name == "domain":
+            raise AttributeError(name)
+        return getattr(self.domain, name)
+
+    @property
+    def state(self):
+        """The domain's view of the state (see its ``state``), for copy 0."""
+        view = self.domain.state(self._states)
+        return {k: v[0] for k, v in view.items()} if isinstance(view, dict) else view[0]
+
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        super().reset(seed=seed)
+        self.streams.follow(0, self.np_random)
+        if self.domain.reset_draws:
+            self.streams.refill(self.domain.reset_draws)
+        obs, infos = self.domain.reset(self, np.ones(1, dtype=bool), options, np.array([seed is not None]))
+        self._started = True
+        return obs[0], _first(infos)
+
+    def step(self, action):
+        if not self._started:
+            raise gymnasium.error.ResetNeeded("call reset() before step()")
+        parsed = self.domain.parse(as_batch(action), 1)
+        self.streams.follow(0, self.np_random)
+        if self.domain.step_draws:
+            self.streams.refill(self.domain.step_draws)
+        obs, rewards, terminated, truncated, infos = self.domain.step(self, parsed, self._calm)
+        return obs[0], float(rewards[0]), bool(terminated[0]), bool(truncated[0]), _first(infos)
+
+    def render(self):
+        return self.domain.frame(self, 0) if self.render_mode == "rgb_array" else None
+
+    def render_substeps(self) -> list[np.ndarray]:
+        """With ``render_mode="rgb_array"``, for a domain with sub-steps (Platform, Goal): one frame per sub-step
+        of the last step (none after a reset), the last one equal to :meth:`render`'s.
+        ``pamdp.envs.rendering.record_episode`` plays these."""
+        if self.render_mode != "rgb_array":
+            raise ValueError(f"render_substeps needs render_mode='rgb_array', got {self.render_mode!r}")
+        return self.domain.substep_frames()
+
+
+def _first(infos: dict) -> dict:
+    """Copy 0's info from batched infos: the keys it reports, NumPy scalars as Python ones."""
+    info = {}
+    for key, value in infos.items():
+        if not key.startswith("_") and infos.get("_" + key, (True,))[0]:
+            v = value[0]
+            info[key] = v.item() if isinstance(v, np.generic) else v
+    return info
+
+
+# Transitional: the scalar envs of the domains not yet moved to Domain (removed when the last one moves).
 class ScalarEnv(gymnasium.Env):
     """One copy of a domain's batched state and random stream as a Gymnasium env.
 

@@ -1,9 +1,15 @@
-"""What pamdp's batched envs share: per-copy random streams and the Gymnasium ``VectorEnv`` shell.
+"""pamdp's one env shell: a domain's copies as a Gymnasium ``VectorEnv``, and what every domain shares.
 
-Every copy of a batched env draws only from its own generator, seeded as Gymnasium seeds the copies of its
-vector envs: ``reset(seed=s)`` gives copy i ``seed + i``, ``reset(seed=[s0, s1, ...])`` one seed each. A
-copy's trajectory therefore depends on its seed alone, not on how many copies run beside it, and copy i
-equals the scalar env reset with copy i's seed, step for step, noise included.
+A domain is a subclass of :class:`Domain` (see its docstring for the contract; ``envs/platform/env.py`` is
+a worked example): sizes, spaces, random numbers per step, one batch action parser and compiled per-copy
+``reset`` / ``step`` / ``observe`` looped over the copies. :class:`DomainVectorEnv` runs N copies of it;
+``pamdp.envs.scalar.DomainEnv`` is the same domain at N = 1. A variant (Hard Goal, Sliding, Hard Move's
+``n``, HFO's settings) is a constructor argument of the domain, passed through the registration's kwargs.
+
+Every copy draws only from its own generator, seeded as Gymnasium seeds the copies of its vector envs:
+``reset(seed=s)`` gives copy i ``seed + i``, ``reset(seed=[s0, s1, ...])`` one seed each. A copy's
+trajectory therefore depends on its seed alone, not on how many copies run beside it, and copy i equals the
+scalar env reset with copy i's seed, step for step, noise included.
 
 Random numbers reach compiled code through :class:`RandomStreams`: each copy keeps a buffer of standard
 draws (``standard_normal`` or ``random``, one kind per domain) taken in blocks from its own generator, and
@@ -11,30 +17,8 @@ a cursor. Drawing a block of ``k`` numbers gives the same numbers as ``k`` singl
 ``Generator`` and ``RandomState`` alike, and a draw ``normal(0, s)`` is ``0.0 + s * z`` with ``z`` the
 next standard normal (``uniform(a, b)`` is ``a + (b - a) * u``), so a domain's step reads its numbers
 from the buffer in the order it needs them and consumes exactly its generator's stream. Before a step
-(or a reset that draws) Python tops up the buffers of the copies with fewer numbers left than one step can
-take; the compiled step never calls back.
-
-How a domain plugs in (``envs/platform/batched.py`` is a worked example):
-
-- The scalar env subclasses ``pamdp.envs.scalar.ScalarEnv``, which keeps ``RandomStreams(1, draw,
-  capacity)``; before a step that draws, ``self._stream(need)`` follows ``self.np_random`` (dropping the
-  buffer when ``np_random`` was replaced, e.g. by ``numpy.random.RandomState(S)`` or by
-  ``reset(seed=...)``) and tops it up; the env hands ``buffers[0]`` and ``cursors[0]`` to the per-copy
-  step, which returns the new cursor.
-- The batched env subclasses :class:`BatchedVectorEnv`, sets the class attributes ``draw`` (the generator
-  method: ``"standard_normal"`` or ``"random"``), ``draws_per_step`` (the most numbers one copy can take
-  in one step, reset included) and ``buffer_size``, calls ``super().__init__(num_envs, single_env,
-  max_episode_steps, render_mode)`` and implements
-
-  * ``_reset_copies(mask, options) -> (observations, infos)``: put the copies where ``mask`` is true at
-    the start of an episode (``options`` as given to :meth:`~BatchedVectorEnv.reset`);
-  * ``_step_copies(actions, resetting) -> (observations, rewards, terminated, truncated, infos)``: check
-    the batch of ``actions``, reset the copies where ``resetting`` is true (next-step autoreset), step the
-    others with draws from ``self.streams.buffers`` / ``self.streams.cursors`` (advanced in place), and
-    return everything for every copy. The shell then zeroes the resetting copies' rewards and flags and
-    adds the time limit;
-  * ``_frames() -> tuple``: one picture per copy, which :meth:`~BatchedVectorEnv.render` returns with
-    ``render_mode="rgb_array"``.
+(or a reset that draws) the shell tops up the buffers of the copies with fewer numbers left than one step
+can take; the compiled step never calls back.
 
 The shell does the rest: argument checks, seeding, ``options={"reset_mask": mask}``, next-step autoreset
 (the step after an episode ends returns the copy's reset observation, reward 0, both flags false), the
@@ -48,11 +32,12 @@ from collections.abc import Sequence
 
 import numba
 import numpy as np
+from gymnasium.error import ResetNeeded
 from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-__all__ = ["RandomStreams", "BatchedVectorEnv", "copy_seeds", "check_render_mode", "split_actions", "column"]
+__all__ = ["Domain", "DomainVectorEnv", "RandomStreams", "copy_seeds", "check_render_mode", "split_actions", "column"]
 
 DRAWS = ("standard_normal", "random")
 """The generator methods a stream can draw with (both exist on ``Generator`` and ``RandomState``)."""
@@ -174,6 +159,189 @@ class RandomStreams:
             self.cursors[i] = 0
 
 
+class Domain:
+    """The contract between a domain and the env shell; a domain subclasses it once, in its ``env.py``.
+
+    An instance is one variant (its constructor takes the variant's arguments: Hard Move's ``n``, Goal's
+    ``hard``, HFO's settings...) for one env; it may keep per-copy arrays of its own beside the state rows.
+    It sets the class attributes below and ``action_space`` / ``observation_space`` (one copy's), and
+    implements:
+
+    * :meth:`parse`: check a batch of ``n`` actions (``batch_space`` of ``action_space``) and return the
+      arrays its compiled step reads, or raise ``ValueError`` naming the bad part and the expected form. The
+      scalar env hands it one action as a batch of one (:func:`pamdp.envs.scalar.as_batch`);
+    * :meth:`reset` and :meth:`step`: one compiled call each over the copies (``env._states`` rows,
+      ``env.streams`` buffers), returning batched observations, rewards, flags and infos in Gymnasium's
+      merged form (``info[k]`` an array, ``info["_" + k]`` which copies report it);
+    * :meth:`frame`: the picture of copy ``i`` for ``render_mode="rgb_array"``.
+    """
+
+    name: str
+    """The domain's name in error messages."""
+    render_fps: int = 10
+    state_size: int
+    """Length of one copy's state row."""
+    draw: str = "random"
+    """The generator method a copy's numbers come from (see :class:`RandomStreams`)."""
+    reset_draws: int = 0
+    """The most numbers one copy's reset takes."""
+    step_draws: int = 0
+    """The most numbers one copy's step takes before it must be topped up (0: a step draws nothing)."""
+    buffer_size: int = 1
+    """Numbers kept per copy in the batched env."""
+    scalar_buffer_size: int = 1
+    """Numbers kept in the scalar env (just a reset's where nothing should be drawn ahead of ``np_random``)."""
+    max_episode_steps: int | None = None
+    """The registration's time limit, also the batched env's default; None leaves the end to the domain."""
+
+    def initial_states(self, n: int) -> np.ndarray:
+        """The state rows ``(n, state_size)`` before the first reset."""
+        return np.zeros((n, self.state_size))
+
+    def state(self, states: np.ndarray):
+        """What the envs' ``state`` shows of the rows (the scalar env's: copy 0's part of it)."""
+        return states.copy()
+
+    def parse(self, actions, n: int) -> tuple:
+        raise NotImplementedError
+
+    def reset(self, env, mask: np.ndarray, options: dict | None, seeded: np.ndarray) -> tuple:
+        """Start an episode in the copies where ``mask`` is true (``seeded``: those just given a seed)."""
+        raise NotImplementedError
+
+    def step(self, env, parsed: tuple, resetting: np.ndarray) -> tuple:
+        """Reset the copies where ``resetting`` is true, step the others with the ``parsed`` actions."""
+        raise NotImplementedError
+
+    def frame(self, env, i: int) -> np.ndarray:
+        raise NotImplementedError
+
+
+class DomainVectorEnv(VectorEnv):
+    """``num_envs`` copies of a :class:`Domain`, stepped together, with Gymnasium's next-step autoreset.
+
+    Actions are batched like ``batch_space`` of the scalar action space (what
+    :meth:`pamdp.spaces.HybridActionSpace.to_env_batch` produces). The step that ends an episode returns its
+    last observation with ``terminated`` or ``truncated`` set; the next ``step`` ignores that copy's action,
+    resets it, and returns the reset observation with reward 0 and both flags false.
+
+    Args:
+        num_envs: number of copies N.
+        max_episode_steps: episodes are truncated after this many agent steps (default: the domain's,
+            which the registration also sets; ``make_vec`` passes it in). ``None`` leaves the end to the domain.
+        render_mode: ``None`` or ``"rgb_array"``; :meth:`render` then returns one frame per copy.
+        **variant: the domain's constructor arguments.
+    """
+
+    metadata = {"render_modes": ["rgb_array"], "autoreset_mode": AutoresetMode.NEXT_STEP}
+    domain_class: type[Domain]
+
+    def __init__(self, num_envs: int = 1, max_episode_steps="domain", render_mode=None, **variant):
+        if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) or num_envs < 1:
+            raise ValueError(f"num_envs must be a positive integer, got {num_envs!r}")
+        self.domain = domain = self.domain_class(**variant)
+        if max_episode_steps == "domain":
+            max_episode_steps = domain.max_episode_steps
+        if max_episode_steps is not None and (
+            isinstance(max_episode_steps, bool)
+            or not isinstance(max_episode_steps, (int, np.integer))
+            or max_episode_steps < 1
+        ):
+            raise ValueError(f"max_episode_steps must be a positive integer or None, got {max_episode_steps!r}")
+        check_render_mode(render_mode, self.metadata["render_modes"])
+        self.metadata = {**self.metadata, "render_fps": domain.render_fps}
+        self.num_envs = int(num_envs)
+        self.max_episode_steps = max_episode_steps
+        self.render_mode = render_mode
+        self.single_action_space = domain.action_space
+        self.single_observation_space = domain.observation_space
+        self.action_space = batch_space(self.single_action_space, self.num_envs)
+        self.observation_space = batch_space(self.single_observation_space, self.num_envs)
+        self.streams = RandomStreams(self.num_envs, domain.draw, domain.buffer_size)
+        self._states = domain.initial_states(self.num_envs)
+        self.draws_per_step = max(domain.reset_draws, domain.step_draws)
+        self._elapsed = np.zeros(self.num_envs, dtype=np.int64)
+        self._autoreset = np.zeros(self.num_envs, dtype=bool)
+        self._started = False
+
+    def __getattr__(self, name: str):
+        # The domain's variant and tables (``n``, ``motions``, ``settings``...) read as the env's own.
+        if name == "domain":
+            raise AttributeError(name)
+        return getattr(self.domain, name)
+
+    @property
+    def states(self) -> np.ndarray:
+        """A copy of the copies' state rows ``(N, state_size)`` (indices in the domain's dynamics module)."""
+        return self._states.copy()
+
+    @property
+    def state(self):
+        """The domain's view of the state rows, one entry per copy."""
+        return self.domain.state(self._states)
+
+    # -- the copies' generators -------------------------------------------------------------------
+    @property
+    def np_randoms(self) -> tuple:
+        """Each copy's generator; assign a sequence of ``num_envs`` of them to replace them all."""
+        return self.streams.generators
+
+    @np_randoms.setter
+    def np_randoms(self, generators: Sequence) -> None:
+        if len(generators) != self.num_envs:
+            raise ValueError(f"{len(generators)} generators given; expected one per copy ({self.num_envs})")
+        for i, rng in enumerate(generators):
+            self.streams.set(i, rng)
+
+    @property
+    def np_random(self):
+        raise AttributeError("each copy has its own generator: read or assign np_randoms (one per copy)")
+
+    @np_random.setter
+    def np_random(self, value):
+        raise AttributeError("each copy has its own generator: assign np_randoms (one per copy) instead")
+
+    # -- Gymnasium API ----------------------------------------------------------------------------
+    def reset(self, *, seed=None, options: dict | None = None):
+        """Reset all copies, or with ``options={"reset_mask": mask}`` only those where ``mask`` is true.
+
+        ``seed``: None, an int (copy i gets ``seed + i``) or a list with one seed (or None) per copy.
+        """
+        seeded = np.array([s is not None for s in copy_seeds(seed, self.num_envs)])
+        self.streams.seed(seed)
+        mask = np.ones(self.num_envs, dtype=bool)
+        if options is not None and "reset_mask" in options:
+            mask = np.asarray(options["reset_mask"])
+            if mask.shape != (self.num_envs,) or mask.dtype != np.bool_:
+                raise ValueError(f"reset_mask must be a bool array of shape ({self.num_envs},), got {mask!r}")
+        self.streams.refill(self.draws_per_step)
+        obs, infos = self.domain.reset(self, mask, options, seeded)
+        self._started = True
+        self._elapsed[mask] = 0
+        self._autoreset[mask] = False
+        return obs, infos
+
+    def step(self, actions):
+        if not self._started:
+            raise ResetNeeded("call reset() before step()")
+        parsed = self.domain.parse(actions, self.num_envs)
+        resetting = self._autoreset
+        if self.draws_per_step:
+            self.streams.refill(self.draws_per_step)
+        obs, rewards, terminated, truncated, infos = self.domain.step(self, parsed, resetting)
+        self._autoreset = np.empty(self.num_envs, dtype=bool)  # a new array: ``resetting`` was handed out
+        limit = self.max_episode_steps or 0
+        _end_step(resetting, rewards, terminated, truncated, self._elapsed, limit, self._autoreset)
+        return obs, rewards, terminated, truncated, infos
+
+    def render(self):
+        """One frame per copy (a tuple) with ``render_mode="rgb_array"``, else None."""
+        if self.render_mode != "rgb_array":
+            return None
+        return tuple(self.domain.frame(self, i) for i in range(self.num_envs))
+
+
+# Transitional: the shell of the domains not yet moved to Domain (removed when the last one moves).
 class BatchedVectorEnv(VectorEnv):
     """The Gymnasium ``VectorEnv`` shell of pamdp's batched envs (see the module docstring for the hooks).
 

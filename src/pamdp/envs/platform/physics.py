@@ -203,14 +203,15 @@ def step(state, a, p, draws, cursor, trace):
 
 
 @jit
-def step_copies(states, a, p, stepping, draws, cursors, rewards, terminated, substeps):
+def step_copies(states, a, p, stepping, draws, cursors, rewards, terminated, substeps, trace):
     """:func:`step` for every copy ``i`` with ``stepping[i]``: row i of ``states``, ``draws`` and the
-    other arrays is copy i's; ``cursors``, ``rewards``, ``terminated`` and ``substeps`` are written."""
-    no_trace = np.empty((0, TRACE_SIZE))
+    other arrays is copy i's; ``cursors``, ``rewards``, ``terminated`` and ``substeps`` are written.
+    Copy 0 records its sub-steps in ``trace`` (the scalar env's rendering; no rows: nothing)."""
+    no_trace = trace[:0]
     for i in range(states.shape[0]):
         if stepping[i]:
             rewards[i], terminated[i], substeps[i], cursors[i] = step(
-                states[i], a[i], p[i], draws[i], cursors[i], no_trace
+                states[i], a[i], p[i], draws[i], cursors[i], trace if i == 0 else no_trace
             )
 
 
