@@ -38,12 +38,12 @@ _REGISTRATIONS = {
     ),
     "pamdp/CatchPoint-v0": dict(
         entry_point="pamdp.envs.catch_point.env:CatchPointEnv",
-        vector_entry_point="pamdp.envs.catch_point.batched:CatchPointVectorEnv",
+        vector_entry_point="pamdp.envs.catch_point.env:CatchPointVectorEnv",
         max_episode_steps=25,
     ),
     "pamdp/HardMove-v0": dict(
         entry_point="pamdp.envs.hard_move.env:HardMoveEnv",
-        vector_entry_point="pamdp.envs.hard_move.batched:HardMoveVectorEnv",
+        vector_entry_point="pamdp.envs.hard_move.env:HardMoveVectorEnv",
         max_episode_steps=30,
     ),
     "pamdp/Moving-v0": dict(

@@ -195,7 +195,8 @@ class Domain:
     """The registration's time limit, also the batched env's default; None leaves the end to the domain."""
 
     def initial_states(self, n: int) -> np.ndarray:
-        """The state rows ``(n, state_size)`` before the first reset."""
+        """The state rows ``(n, state_size)`` before the first reset (and where the domain keeps per-copy arrays
+        of its own, such as the last actions its pictures show, it allocates them here)."""
         return np.zeros((n, self.state_size))
 
     def state(self, states: np.ndarray):
