@@ -259,7 +259,7 @@ def test_step_before_reset_is_refused():
         ((3, (1.0, 1.0, np.zeros(0))), "3"),
         ((True, (1.0, 1.0, np.zeros(0))), "True"),
         ((0, (1.0, 1.0)), "(1.0, 1.0)"),
-        ((0, (np.array([1.0, 2.0]), 1.0, np.zeros(0))), "array([1., 2.])"),
+        ((0, (np.array([1.0, 2.0]), 1.0, np.zeros(0))), "array([[1., 2.]])"),  # checked as a batch of one
         ((1, (0.5, float("inf"), np.zeros(0))), "inf"),
         ((2, (0.5, 0.5, np.zeros(1))), "break parameter"),
     ],

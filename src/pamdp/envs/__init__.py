@@ -48,11 +48,12 @@ _REGISTRATIONS = {
     ),
     "pamdp/Moving-v0": dict(
         entry_point="pamdp.envs.gym_hybrid.env:MovingEnv",
-        vector_entry_point="pamdp.envs.gym_hybrid.batched:MovingVectorEnv",
+        vector_entry_point="pamdp.envs.gym_hybrid.env:MovingVectorEnv",
     ),
     "pamdp/Sliding-v0": dict(
-        entry_point="pamdp.envs.gym_hybrid.env:SlidingEnv",
-        vector_entry_point="pamdp.envs.gym_hybrid.batched:SlidingVectorEnv",
+        entry_point="pamdp.envs.gym_hybrid.env:MovingEnv",
+        vector_entry_point="pamdp.envs.gym_hybrid.env:MovingVectorEnv",
+        kwargs={"sliding": True},
     ),
 }
 

@@ -1,17 +1,25 @@
 """gym-hybrid's two domains (Thomas Hirtz): ``pamdp/Moving-v0`` and ``pamdp/Sliding-v0``.
 
-- ``dynamics.py``: the dynamics of one copy, once for both agents, compiled by Numba (spec:
-  ``shared/specs/gym_hybrid.md``);
-- ``env.py``: the scalar envs, :class:`MovingEnv` and :class:`SlidingEnv`;
-- ``batched.py``: N copies in one compiled loop, :class:`MovingVectorEnv` and :class:`SlidingVectorEnv`;
+- ``dynamics.py``: the dynamics of one copy, once for both agents, compiled by Numba, and their loops over
+  the copies;
+- ``env.py``: the domain contract, :class:`GymHybrid` (Sliding is its variant ``sliding=True``), and its envs
+  :class:`MovingEnv`, :class:`SlidingEnv` (scalar), :class:`MovingVectorEnv`, :class:`SlidingVectorEnv`
+  (batched);
 - ``render.py``: the top view.
 """
 
-from pamdp.envs.gym_hybrid.batched import MovingVectorEnv, SlidingVectorEnv
-from pamdp.envs.gym_hybrid.env import MovingEnv, SlidingEnv, gym_hybrid_action_space
+from pamdp.envs.gym_hybrid.env import (
+    GymHybrid,
+    MovingEnv,
+    MovingVectorEnv,
+    SlidingEnv,
+    SlidingVectorEnv,
+    gym_hybrid_action_space,
+)
 from pamdp.envs.gym_hybrid.render import draw_gym_hybrid
 
 __all__ = [
+    "GymHybrid",
     "MovingEnv",
     "SlidingEnv",
     "MovingVectorEnv",
