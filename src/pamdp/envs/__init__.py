@@ -30,11 +30,12 @@ _REGISTRATIONS = {
     # Goal, Hard Goal, Moving and Sliding end their episodes by their own step limits (the specs: no TimeLimit).
     "pamdp/Goal-v0": dict(
         entry_point="pamdp.envs.goal.env:GoalEnv",
-        vector_entry_point="pamdp.envs.goal.batched:GoalVectorEnv",
+        vector_entry_point="pamdp.envs.goal.env:GoalVectorEnv",
     ),
     "pamdp/HardGoal-v0": dict(
-        entry_point="pamdp.envs.goal.env:HardGoalEnv",
-        vector_entry_point="pamdp.envs.goal.batched:HardGoalVectorEnv",
+        entry_point="pamdp.envs.goal.env:GoalEnv",
+        vector_entry_point="pamdp.envs.goal.env:GoalVectorEnv",
+        kwargs={"hard": True},
     ),
     "pamdp/CatchPoint-v0": dict(
         entry_point="pamdp.envs.catch_point.env:CatchPointEnv",

@@ -333,16 +333,17 @@ def reset_copies(states, mask, draws, cursors):
 
 
 @jit
-def step_copies(states, kick, tx, ty, pending, draws, cursors, substeps, rewards, terminated, truncated):
+def step_copies(states, kick, tx, ty, pending, draws, cursors, substeps, rewards, terminated, truncated, trace):
     """:func:`step` for every copy ``i`` with ``pending[i]``; ``pending[i]`` is cleared once its agent
     step is finished. Row i of every array is copy i's; ``substeps`` (0 at the start of the agent step),
-    ``cursors``, ``rewards`` and the flags are updated. Returns whether any copy is still pending."""
-    no_trace = np.empty((0, TRACE_SIZE))
+    ``cursors``, ``rewards`` and the flags are updated; copy 0 records its sub-steps in ``trace`` (the scalar
+    env's rendering; no rows: nothing). Returns whether any copy is still pending."""
+    no_trace = trace[:0]
     left = False
     for i in range(states.shape[0]):
         if pending[i]:
             rewards[i], terminated[i], truncated[i], substeps[i], cursors[i], done = step(
-                states[i], kick[i], tx[i], ty[i], draws[i], cursors[i], substeps[i], no_trace
+                states[i], kick[i], tx[i], ty[i], draws[i], cursors[i], substeps[i], trace if i == 0 else no_trace
             )
             pending[i] = not done
             left = left or not done
