@@ -25,7 +25,7 @@ _REGISTRATIONS = {
     ),
     "pamdp/HalfFieldOffense-v0": dict(
         entry_point="pamdp.envs.hfo.env:HalfFieldOffenseEnv",
-        vector_entry_point="pamdp.envs.hfo.batched:HalfFieldOffenseVectorEnv",
+        vector_entry_point="pamdp.envs.hfo.env:HalfFieldOffenseVectorEnv",
     ),
     # Goal, Hard Goal, Moving and Sliding end their episodes by their own step limits (the specs: no TimeLimit).
     "pamdp/Goal-v0": dict(

@@ -116,6 +116,9 @@ class RandomStreams:
         self.buffers = np.zeros((num_copies, self.capacity))
         self.cursors = np.full(num_copies, self.capacity, dtype=np.int64)  # empty
         self._generators: list = [None] * num_copies
+        self.replacements = 0
+        """How many times a copy's generator was replaced: a domain with streams of its own (HFO) reseeds them
+        only when this changed."""
 
     @property
     def generators(self) -> tuple:
@@ -128,6 +131,7 @@ class RandomStreams:
             raise ValueError(f"{rng!r} has no {self.draw}() method; expected a numpy Generator or RandomState")
         self._generators[i] = rng
         self.cursors[i] = self.capacity
+        self.replacements += 1
 
     def follow(self, i: int, rng) -> None:
         """:meth:`set` copy ``i``'s generator to ``rng`` unless it is that object already (the scalar envs'
@@ -173,7 +177,8 @@ class Domain:
     * :meth:`reset` and :meth:`step`: one compiled call each over the copies (``env._states`` rows,
       ``env.streams`` buffers), returning batched observations, rewards, flags and infos in Gymnasium's
       merged form (``info[k]`` an array, ``info["_" + k]`` which copies report it);
-    * :meth:`frame`: the picture of copy ``i`` for ``render_mode="rgb_array"``.
+    * :meth:`frame`: the picture of copy ``i`` for ``render_mode="rgb_array"`` (and :meth:`substep_frames`
+      where a step runs sub-steps worth showing).
     """
 
     name: str
@@ -216,6 +221,11 @@ class Domain:
 
     def frame(self, env, i: int) -> np.ndarray:
         raise NotImplementedError
+
+    def substep_frames(self, env) -> list[np.ndarray]:
+        """The scalar env's frames of its last step: one per sub-step where a step runs several and the domain
+        records them (Platform, Goal; none after a reset), else the one after the step."""
+        return [self.frame(env, 0)]
 
 
 class DomainVectorEnv(VectorEnv):
@@ -340,113 +350,6 @@ class DomainVectorEnv(VectorEnv):
         if self.render_mode != "rgb_array":
             return None
         return tuple(self.domain.frame(self, i) for i in range(self.num_envs))
-
-
-# Transitional: the shell of the domains not yet moved to Domain (removed when the last one moves).
-class BatchedVectorEnv(VectorEnv):
-    """The Gymnasium ``VectorEnv`` shell of pamdp's batched envs (see the module docstring for the hooks).
-
-    Args:
-        num_envs: number of copies N.
-        single_env: a scalar env of the domain; its spaces and render modes are taken over.
-        max_episode_steps: episodes are truncated after this many agent steps (``make_vec`` passes the
-            registration's value in). ``None`` leaves truncation to the domain.
-        render_mode: ``None`` or one of the scalar env's render modes; :meth:`render` returns one frame per
-            copy.
-    """
-
-    metadata = {"render_modes": ["rgb_array"], "autoreset_mode": AutoresetMode.NEXT_STEP}
-    draw: str = "standard_normal"
-    """The generator method the domain's numbers come from (see :class:`RandomStreams`)."""
-    draws_per_step: int = 0
-    """The most numbers one copy can take in one step or reset."""
-    buffer_size: int = 1
-    """Numbers kept per copy (at least :attr:`draws_per_step`)."""
-
-    def __init__(self, num_envs: int, single_env, max_episode_steps: int | None = None, render_mode=None):
-        if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) or num_envs < 1:
-            raise ValueError(f"num_envs must be a positive integer, got {num_envs!r}")
-        if max_episode_steps is not None and (
-            isinstance(max_episode_steps, bool)
-            or not isinstance(max_episode_steps, (int, np.integer))
-            or max_episode_steps < 1
-        ):
-            raise ValueError(f"max_episode_steps must be a positive integer or None, got {max_episode_steps!r}")
-        check_render_mode(render_mode, single_env.metadata["render_modes"])
-        self.metadata = {**self.metadata, "render_fps": single_env.metadata["render_fps"]}
-        self.num_envs = int(num_envs)
-        self.max_episode_steps = max_episode_steps
-        self.render_mode = render_mode
-        self.single_action_space = single_env.action_space
-        self.single_observation_space = single_env.observation_space
-        self.action_space = batch_space(self.single_action_space, self.num_envs)
-        self.observation_space = batch_space(self.single_observation_space, self.num_envs)
-        self.streams = RandomStreams(self.num_envs, self.draw, self.buffer_size)
-        self._elapsed = np.zeros(self.num_envs, dtype=np.int64)
-        self._autoreset = np.zeros(self.num_envs, dtype=bool)
-
-    # -- the copies' generators -------------------------------------------------------------------
-    @property
-    def np_randoms(self) -> tuple:
-        """Each copy's generator; assign a sequence of ``num_envs`` of them to replace them all."""
-        return self.streams.generators
-
-    @np_randoms.setter
-    def np_randoms(self, generators: Sequence) -> None:
-        if len(generators) != self.num_envs:
-            raise ValueError(f"{len(generators)} generators given; expected one per copy ({self.num_envs})")
-        for i, rng in enumerate(generators):
-            self.streams.set(i, rng)
-
-    @property
-    def np_random(self):
-        raise AttributeError("each copy has its own generator: read or assign np_randoms (one per copy)")
-
-    @np_random.setter
-    def np_random(self, value):
-        raise AttributeError("each copy has its own generator: assign np_randoms (one per copy) instead")
-
-    # -- Gymnasium API ----------------------------------------------------------------------------
-    def reset(self, *, seed=None, options: dict | None = None):
-        """Reset all copies, or with ``options={"reset_mask": mask}`` only those where ``mask`` is true.
-
-        ``seed``: None, an int (copy i gets ``seed + i``) or a list with one seed (or None) per copy.
-        """
-        self.streams.seed(seed)
-        mask = np.ones(self.num_envs, dtype=bool)
-        if options is not None and "reset_mask" in options:
-            mask = np.asarray(options["reset_mask"])
-            if mask.shape != (self.num_envs,) or mask.dtype != np.bool_:
-                raise ValueError(f"reset_mask must be a bool array of shape ({self.num_envs},), got {mask!r}")
-        self.streams.refill(self.draws_per_step)
-        obs, infos = self._reset_copies(mask, options)
-        self._elapsed[mask] = 0
-        self._autoreset[mask] = False
-        return obs, infos
-
-    def step(self, actions):
-        resetting = self._autoreset
-        if self.draws_per_step:
-            self.streams.refill(self.draws_per_step)
-        obs, rewards, terminated, truncated, infos = self._step_copies(actions, resetting)
-        self._autoreset = np.empty(self.num_envs, dtype=bool)  # a new array: ``resetting`` was handed out
-        limit = self.max_episode_steps or 0
-        _end_step(resetting, rewards, terminated, truncated, self._elapsed, limit, self._autoreset)
-        return obs, rewards, terminated, truncated, infos
-
-    def render(self):
-        """One frame per copy (a tuple) with ``render_mode="rgb_array"``, else None."""
-        return self._frames() if self.render_mode == "rgb_array" else None
-
-    # -- the domain's part ------------------------------------------------------------------------
-    def _frames(self) -> tuple:
-        raise NotImplementedError
-
-    def _reset_copies(self, mask: np.ndarray, options: dict | None):
-        raise NotImplementedError
-
-    def _step_copies(self, actions, resetting: np.ndarray):
-        raise NotImplementedError
 
 
 # -- the shell's per-step bookkeeping, compiled: in NumPy it was a dozen array operations a step, at 1 024 copies

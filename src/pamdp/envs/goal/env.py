@@ -157,7 +157,7 @@ class Goal(Domain):
     def frame(self, env, i):
         return draw_goal(*(env._states[i, k] for k in _DRAWN))
 
-    def substep_frames(self):
+    def substep_frames(self, env):
         return [draw_goal(*row) for row in self.trace[: self.substeps]]
 
 

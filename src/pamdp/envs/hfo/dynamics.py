@@ -4,9 +4,8 @@ The one writing of ``shared/specs/hfo.md`` section 2 (cited below as "spec 2.x")
 movement, kick, dash, turn, stamina and collisions, the agent-side processing that HFO's C++ agent
 (librcsc) applies to each low-level action, HFO's referee, the LOW_LEVEL_FEATURE_SET for one agent and
 Hausknecht & Stone's shaped reward. Every function works on one copy: its state is a float64 vector
-(the indices below) and its random numbers come from its own stream (:func:`uniform`). The scalar env
-calls :func:`step_one` and :func:`reset_one` for its copy; the batched env calls :func:`step_batch` and
-:func:`reset_batch`, one compiled loop over the copies. A change here changes both.
+(the indices below) and its random numbers come from its own stream (:func:`uniform`). The envs (the
+scalar one at one copy) call :func:`step_batch` and :func:`reset_batch`, one compiled loop over the copies.
 
 Frame (spec 2.1): the server's metres, goal centre at (52.5, 0), y grows "downwards", angles in
 degrees normalised to (-180, 180], +90 along +y, positive relative angles on the agent's right.
@@ -714,24 +713,7 @@ def ending(status, cfg):
     return status == GOAL or status == OUT_OF_BOUNDS or (timeout and timeout_terminal), timeout and not timeout_terminal
 
 
-# --- Entry points: one copy (the scalar env) and a loop over copies (the batched env) -----------
-@jit
-def step_one(s, rng, a, x0, x1, cfg, f, obs):
-    """:func:`step_copy` of one copy; the observation, float32, into ``obs``. Returns ``(reward, status)``."""
-    reward, status = step_copy(s, rng, a, x0, x1, cfg, f)
-    for k in range(obs.shape[0]):
-        obs[k] = f[k]
-    return reward, status
-
-
-@jit
-def reset_one(s, rng, cfg, options, f, obs):
-    """:func:`start_episode` of one copy; the observation, float32, into ``obs``."""
-    start_episode(s, rng, cfg, options, f)
-    for k in range(obs.shape[0]):
-        obs[k] = f[k]
-
-
+# --- Entry points: the loops over the copies ----------------------------------------------------
 @jit
 def step_batch(states, rngs, a, dash_params, turn_params, kick_params, resetting, cfg, obs, reward, status,
                terminated, truncated):  # fmt: skip

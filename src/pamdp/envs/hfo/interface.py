@@ -1,5 +1,5 @@
-"""What the scalar and the batched HFO env share at their boundary: the action space and the checks of
-actions, settings and reset options, and the top-down drawing for ``render_mode="rgb_array"``."""
+"""The HFO domain's boundary: the action space and the checks of batched actions, settings and reset options,
+and the top-down drawing for ``render_mode="rgb_array"``."""
 
 from __future__ import annotations
 
@@ -40,34 +40,6 @@ def check_settings(profile: str, body_reset: str, render_mode) -> None:
         raise ValueError(f"render_mode={render_mode!r}; expected None or 'rgb_array'")
 
 
-def parse_action(action) -> tuple[int, float, float]:
-    """``(a, first parameter, second parameter)`` of one action; ranges are clamped later, as HFO does."""
-    try:
-        a_raw, params = action
-        a = int(a_raw)
-    except (TypeError, ValueError):
-        raise ValueError(f"action {action!r} is malformed; expected {ACTION_FORM}") from None
-    if a != a_raw or not 0 <= a <= 2:
-        raise ValueError(f"discrete action {a_raw!r} is not 0 (DASH), 1 (TURN) or 2 (KICK)")
-    try:
-        p = params[a] if len(params) == 3 else None
-        x = p.tolist() if isinstance(p, np.ndarray) else list(p)
-    except (TypeError, ValueError, IndexError):
-        x = None
-    if not isinstance(x, list) or len(x) != PARAM_SIZES[a]:
-        raise ValueError(
-            f"parameters {params!r} are malformed for {ACTION_NAMES[a]}; expected {ACTION_FORM}, "
-            f"{ACTION_NAMES[a]}'s entry holding {PARAM_SIZES[a]} number(s)"
-        )
-    try:
-        x0, x1 = float(x[0]), float(x[-1])
-    except (TypeError, ValueError):
-        x0 = x1 = math.nan
-    if not (math.isfinite(x0) and math.isfinite(x1)):
-        raise ValueError(f"{ACTION_NAMES[a]} parameters {x} must be finite numbers")
-    return a, x0, x1
-
-
 def parse_actions(actions, n: int):
     """A batch of actions as ``(a, dash, turn, kick)``: int64 (N,) and float64 (N, 2), (N, 1), (N, 2);
     ``ValueError`` if malformed, or if a copy's chosen action has non-finite parameters."""
@@ -80,7 +52,7 @@ def parse_actions(actions, n: int):
         raise ValueError(f"actions are malformed; expected {expected}") from None
     if a.shape != (n,) or len(boxes) != 3 or any(b.shape != (n, m) for b, m in zip(boxes, PARAM_SIZES)):
         shapes = (a.shape, tuple(b.shape for b in boxes)) if len(boxes) == 3 else a.shape
-        raise ValueError(f"actions have shapes {shapes}; expected {expected}")
+        raise ValueError(f"malformed actions of shapes {shapes}; expected {expected}")
     if not (a.dtype.kind in "iu" or np.all(a == np.round(a))) or np.count_nonzero((a < 0) | (a > 2)):
         raise ValueError(f"discrete actions {a.tolist()} must be integers 0 (DASH), 1 (TURN) or 2 (KICK)")
     a = a.astype(np.int64, copy=False)
@@ -92,7 +64,8 @@ def parse_actions(actions, n: int):
         bad = np.flatnonzero(~(np.isfinite(x0) & np.isfinite(x1)))
         if bad.size:
             i = int(bad[0])
-            raise ValueError(f"copy {i}: action {int(a[i])} has non-finite parameters ({x0[i]}, {x1[i]})")
+            name = ACTION_NAMES[a[i]]
+            raise ValueError(f"copy {i}: action {int(a[i])} ({name}) has non-finite parameters ({x0[i]}, {x1[i]})")
     return a, dash, turn, kick
 
 

@@ -129,7 +129,7 @@ class Platform(Domain):
         s = env._states[i]
         return draw_platform(s[physics.X], s[physics.Y], s[physics.E1X], s[physics.E2X])
 
-    def substep_frames(self):
+    def substep_frames(self, env):
         return [draw_platform(*row) for row in self.trace[: self.substeps]]
 
 
