@@ -12,9 +12,10 @@ from __future__ import annotations
 import gymnasium
 import numpy as np
 
-from pamdp.envs.vector import Domain, RandomStreams, check_render_mode
+from pamdp.envs.streams import RandomStreams
+from pamdp.envs.vector import Domain, DomainVectorEnv, check_render_mode
 
-__all__ = ["DomainEnv", "as_batch"]
+__all__ = ["DomainEnv", "as_batch", "env_classes"]
 
 
 class _OneEach(tuple):
@@ -47,11 +48,13 @@ class DomainEnv(gymnasium.Env):
 
     metadata = {"render_modes": ["rgb_array"]}
     domain_class: type[Domain]
+    variant: dict = {}
+    """Constructor arguments of the domain fixed by the class (Hard Goal's ``hard=True``)."""
     num_envs = 1
     """The domain's hooks see the scalar env as a batched one of one copy."""
 
     def __init__(self, render_mode: str | None = None, **variant):
-        self.domain = domain = self.domain_class(**variant)
+        self.domain = domain = self.domain_class(**{**self.variant, **variant})
         check_render_mode(render_mode, self.metadata["render_modes"])
         self.metadata = {**self.metadata, "render_fps": domain.render_fps}
         self.render_mode = render_mode
@@ -113,3 +116,15 @@ def _first(infos: dict) -> dict:
             v = value[0]
             info[key] = v.item() if isinstance(v, np.generic) else v
     return info
+
+
+def env_classes(domain_class: type[Domain], module: str, scalar: str, batched: str, **variant) -> tuple[type, type]:
+    """A domain's scalar env and batched env, classes named ``scalar`` and ``batched`` in ``module`` (the names
+    users import and ``isinstance`` tests), with the constructor arguments ``variant`` fixed."""
+    what = f"{domain_class.name}" + "".join(f", {k}={v!r}" for k, v in variant.items())
+    attrs = {"domain_class": domain_class, "variant": variant, "__module__": module}
+    doc = f"{{}} of {what} (see :class:`{module}.{domain_class.__name__}`)."
+    return (
+        type(scalar, (DomainEnv,), {**attrs, "__doc__": doc.format("One copy as a ``gymnasium.Env``")}),
+        type(batched, (DomainVectorEnv,), {**attrs, "__doc__": doc.format("N copies stepped at once")}),
+    )

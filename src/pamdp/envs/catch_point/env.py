@@ -34,8 +34,8 @@ from gymnasium import spaces
 
 import pamdp.envs.particle as particle
 from pamdp.envs.catch_point.render import draw_catch_point
-from pamdp.envs.scalar import DomainEnv
-from pamdp.envs.vector import Domain, DomainVectorEnv, column, split_actions
+from pamdp.envs.scalar import env_classes
+from pamdp.envs.vector import Domain, column, split_actions
 
 __all__ = ["CatchPoint", "CatchPointEnv", "CatchPointVectorEnv", "catch_point_action_space", "THETA_MAX"]
 
@@ -119,13 +119,4 @@ class CatchPoint(Domain):
         return draw_catch_point(env._states[i], None if a < 0 else a)
 
 
-class CatchPointEnv(DomainEnv):
-    """Catch Point as a ``gymnasium.Env``: the domain at N = 1 (see the module docstring)."""
-
-    domain_class = CatchPoint
-
-
-class CatchPointVectorEnv(DomainVectorEnv):
-    """N copies of Catch Point stepped at once: ``gymnasium.make_vec("pamdp/CatchPoint-v0", num_envs=N)``."""
-
-    domain_class = CatchPoint
+CatchPointEnv, CatchPointVectorEnv = env_classes(CatchPoint, __name__, "CatchPointEnv", "CatchPointVectorEnv")

@@ -41,8 +41,8 @@ from gymnasium import spaces
 
 import pamdp.envs.goal.dynamics as dyn
 from pamdp.envs.goal.render import RENDER_FPS, draw_goal
-from pamdp.envs.scalar import DomainEnv
-from pamdp.envs.vector import Domain, DomainVectorEnv, split_actions
+from pamdp.envs.scalar import env_classes
+from pamdp.envs.vector import Domain, split_actions
 
 __all__ = ["Goal", "GoalEnv", "HardGoalEnv", "GoalVectorEnv", "HardGoalVectorEnv", "hard_goal_shot"]
 
@@ -166,27 +166,5 @@ def _info(substeps: np.ndarray) -> dict:
     return {"substeps": substeps, "_substeps": np.ones(substeps.shape, dtype=bool)}
 
 
-class GoalEnv(DomainEnv):
-    """Goal (``hard=False``) or Hard Goal as a ``gymnasium.Env``: the domain at N = 1 (see the module docstring)."""
-
-    domain_class = Goal
-
-
-class HardGoalEnv(GoalEnv):
-    """Hard Goal as a ``gymnasium.Env``: :class:`GoalEnv` with ``hard=True``."""
-
-    def __init__(self, render_mode: str | None = None):
-        super().__init__(render_mode, hard=True)
-
-
-class GoalVectorEnv(DomainVectorEnv):
-    """N copies of Goal (``hard=False``) or Hard Goal stepped at once."""
-
-    domain_class = Goal
-
-
-class HardGoalVectorEnv(GoalVectorEnv):
-    """N copies of Hard Goal: :class:`GoalVectorEnv` with ``hard=True``."""
-
-    def __init__(self, num_envs: int = 1, max_episode_steps=None, render_mode: str | None = None):
-        super().__init__(num_envs, max_episode_steps, render_mode, hard=True)
+GoalEnv, GoalVectorEnv = env_classes(Goal, __name__, "GoalEnv", "GoalVectorEnv")
+HardGoalEnv, HardGoalVectorEnv = env_classes(Goal, __name__, "HardGoalEnv", "HardGoalVectorEnv", hard=True)

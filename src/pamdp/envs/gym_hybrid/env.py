@@ -43,8 +43,8 @@ from gymnasium import spaces
 
 import pamdp.envs.gym_hybrid.dynamics as dyn
 from pamdp.envs.gym_hybrid.render import RENDER_FPS, draw_gym_hybrid
-from pamdp.envs.scalar import DomainEnv
-from pamdp.envs.vector import Domain, DomainVectorEnv, column, split_actions
+from pamdp.envs.scalar import env_classes
+from pamdp.envs.vector import Domain, column, split_actions
 
 __all__ = ["GymHybrid", "MovingEnv", "SlidingEnv", "MovingVectorEnv", "SlidingVectorEnv", "check_settings"]
 
@@ -135,28 +135,5 @@ class GymHybrid(Domain):
         return draw_gym_hybrid(env._states[i], self.sliding)
 
 
-class MovingEnv(DomainEnv):
-    """``pamdp/Moving-v0``: the agent moves along its heading (see the module docstring)."""
-
-    domain_class = GymHybrid
-
-
-class SlidingEnv(MovingEnv):
-    """``pamdp/Sliding-v0``: the agent keeps sliding along its velocity, which thrust changes by vector
-    addition and breaking to a stop re-aligns with the heading (see the module docstring)."""
-
-    def __init__(self, render_mode: str | None = None, **settings):
-        super().__init__(render_mode, sliding=True, **settings)
-
-
-class MovingVectorEnv(DomainVectorEnv):
-    """N copies of ``pamdp/Moving-v0`` stepped at once."""
-
-    domain_class = GymHybrid
-
-
-class SlidingVectorEnv(MovingVectorEnv):
-    """N copies of ``pamdp/Sliding-v0`` stepped at once."""
-
-    def __init__(self, num_envs: int = 1, max_episode_steps=None, render_mode: str | None = None, **settings):
-        super().__init__(num_envs, max_episode_steps, render_mode, sliding=True, **settings)
+MovingEnv, MovingVectorEnv = env_classes(GymHybrid, __name__, "MovingEnv", "MovingVectorEnv")
+SlidingEnv, SlidingVectorEnv = env_classes(GymHybrid, __name__, "SlidingEnv", "SlidingVectorEnv", sliding=True)

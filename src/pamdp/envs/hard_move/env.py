@@ -29,8 +29,8 @@ from gymnasium import spaces
 import pamdp.envs.particle as particle
 from pamdp.envs.hard_move.motions import check_size, motion_table
 from pamdp.envs.hard_move.render import draw_hard_move
-from pamdp.envs.scalar import DomainEnv
-from pamdp.envs.vector import Domain, DomainVectorEnv, split_actions
+from pamdp.envs.scalar import env_classes
+from pamdp.envs.vector import Domain, split_actions
 
 __all__ = ["HardMove", "HardMoveEnv", "HardMoveVectorEnv", "hard_move_action_space"]
 
@@ -141,13 +141,4 @@ def _gather(params, a, n: int, expected: str) -> np.ndarray:
     return np.fromiter(map(np.ndarray.item, chosen, range(n)), np.float64, n)  # p_{a[i]}[i]
 
 
-class HardMoveEnv(DomainEnv):
-    """Hard Move with ``n`` actuators as a ``gymnasium.Env``: the domain at N = 1 (see the module docstring)."""
-
-    domain_class = HardMove
-
-
-class HardMoveVectorEnv(DomainVectorEnv):
-    """N copies of Hard Move stepped at once: ``gymnasium.make_vec("pamdp/HardMove-v0", num_envs=N, n=...)``."""
-
-    domain_class = HardMove
+HardMoveEnv, HardMoveVectorEnv = env_classes(HardMove, __name__, "HardMoveEnv", "HardMoveVectorEnv")

@@ -46,8 +46,8 @@ from gymnasium import spaces
 
 import pamdp.envs.hfo.dynamics as dyn
 from pamdp.envs.hfo.interface import check_settings, draw_half_field, hfo_action_space, parse_actions, reset_options
-from pamdp.envs.scalar import DomainEnv
-from pamdp.envs.vector import Domain, DomainVectorEnv
+from pamdp.envs.scalar import env_classes
+from pamdp.envs.vector import Domain
 
 __all__ = ["HalfFieldOffense", "HalfFieldOffenseEnv", "HalfFieldOffenseVectorEnv", "kick_mask"]
 
@@ -144,13 +144,6 @@ class HalfFieldOffense(Domain):
         return draw_half_field(env._states[i])
 
 
-class HalfFieldOffenseEnv(DomainEnv):
-    """HFO 1v0 as a ``gymnasium.Env``: the domain at N = 1 (see the module docstring)."""
-
-    domain_class = HalfFieldOffense
-
-
-class HalfFieldOffenseVectorEnv(DomainVectorEnv):
-    """N HFO 1v0 games stepped at once: ``gymnasium.make_vec("pamdp/HalfFieldOffense-v0", num_envs=N)``."""
-
-    domain_class = HalfFieldOffense
+HalfFieldOffenseEnv, HalfFieldOffenseVectorEnv = env_classes(
+    HalfFieldOffense, __name__, "HalfFieldOffenseEnv", "HalfFieldOffenseVectorEnv"
+)

@@ -36,8 +36,8 @@ from gymnasium import spaces
 
 import pamdp.envs.platform.physics as physics
 from pamdp.envs.platform.render import RENDER_FPS, draw_platform
-from pamdp.envs.scalar import DomainEnv
-from pamdp.envs.vector import Domain, DomainVectorEnv, column, split_actions
+from pamdp.envs.scalar import env_classes
+from pamdp.envs.vector import Domain, column, split_actions
 
 __all__ = ["Platform", "PlatformEnv", "PlatformVectorEnv", "ZeroNoise", "platform_action_space"]
 
@@ -138,13 +138,4 @@ def _info(substeps: np.ndarray) -> dict:
     return {"substeps": substeps, "_substeps": np.ones(substeps.shape, dtype=bool)}
 
 
-class PlatformEnv(DomainEnv):
-    """Platform as a ``gymnasium.Env``: the domain at N = 1 (see the module docstring)."""
-
-    domain_class = Platform
-
-
-class PlatformVectorEnv(DomainVectorEnv):
-    """N copies of Platform stepped at once: ``gymnasium.make_vec("pamdp/Platform-v0", num_envs=N)``."""
-
-    domain_class = Platform
+PlatformEnv, PlatformVectorEnv = env_classes(Platform, __name__, "PlatformEnv", "PlatformVectorEnv")
