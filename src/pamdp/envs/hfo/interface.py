@@ -54,7 +54,7 @@ def parse_actions(actions, n: int):
         shapes = (a.shape, tuple(b.shape for b in boxes)) if len(boxes) == 3 else a.shape
         raise ValueError(f"malformed actions of shapes {shapes}; expected {expected}")
     if not (a.dtype.kind in "iu" or np.all(a == np.round(a))) or np.count_nonzero((a < 0) | (a > 2)):
-        raise ValueError(f"discrete actions {a.tolist()} must be integers 0 (DASH), 1 (TURN) or 2 (KICK)")
+        raise ValueError(f"discrete actions {a.tolist()}; expected integers 0 (DASH), 1 (TURN) or 2 (KICK)")
     a = a.astype(np.int64, copy=False)
     dash, turn, kick = boxes
     # A finite sum means every parameter is finite (an overflow only sends us to the exact check).
