@@ -86,7 +86,7 @@ def test_malformed_actions_are_refused_before_anything_moves(env_id, kwargs):
     for bad in (5, (0, 1, 2), (k, params), (0, params[:-1])):
         with pytest.raises(ValueError, match="expected"):
             env.step(bad)
-    for bad in (5, (np.array([0, k]), batched), (np.array([0, 0]), batched[:-1]), (np.zeros(2), batched)):
+    for bad in (5, (np.array([0, k]), batched), (np.array([0, 0]), batched[:-1]), (np.full(2, 0.5), batched)):
         with pytest.raises(ValueError, match="expected"):
             venv.step(bad)
     np.testing.assert_array_equal(env.unwrapped._states, before)
