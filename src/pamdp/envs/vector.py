@@ -51,7 +51,7 @@ def split_actions(actions, domain: str, n: int, expected: str, n_actions=None, n
     a = np.asarray(actions[0])
     if a.shape != (n,) or a.dtype.kind not in "iu":
         raise ValueError(f"invalid discrete actions {actions[0]!r}; expected {expected}")
-    if n_actions is not None and (a.min() < 0 or a.max() >= n_actions):
+    if n_actions is not None and _outside(a, n_actions):
         bad = (a < 0) | (a >= n_actions)
         raise ValueError(f"discrete actions {a[bad]} at indices {np.flatnonzero(bad)}; expected {expected}")
     params = actions[1]
@@ -265,6 +265,16 @@ class DomainVectorEnv(VectorEnv):
 # -- the shell's per-step bookkeeping, compiled: in NumPy it was a dozen array operations a step, at 1 024 copies
 # a third of Catch Point's whole batched step (benchmarks/env_speed.md) ------------------------------------------
 _jit = numba.njit(cache=True, nogil=True)
+
+
+@_jit
+def _outside(a, n_actions) -> bool:
+    """Whether any of ``a`` lies outside ``0..n_actions - 1`` (one compiled pass: ``min`` and ``max`` are two
+    NumPy calls, a good part of checking one action)."""
+    for i in range(a.shape[0]):
+        if a[i] < 0 or a[i] >= n_actions:
+            return True
+    return False
 
 
 @_jit

@@ -41,7 +41,6 @@ from pamdp.envs.vector import Domain, column, split_actions
 
 __all__ = ["Platform", "PlatformEnv", "PlatformVectorEnv", "ZeroNoise", "platform_action_space"]
 
-PARAM_HIGH = np.array(physics.PARAM_MAX)
 NO_TRACE = np.empty((0, physics.TRACE_SIZE))
 
 
@@ -95,14 +94,15 @@ class Platform(Domain):
             f"array of shape ({n}, 1) or ({n},)"
         )
         a, params = split_actions(actions, self.name, n, expected, 3, 3)
-        columns = []
+        columns = np.empty((3, n))
         for i, p in enumerate(params):
-            p = column(p, n, i, expected).astype(np.float64)
-            if not np.isfinite(p).all():
-                raise ValueError(f"parameter {i} contains {p[~np.isfinite(p)]}; expected {expected}")
-            columns.append(p)
-        chosen = np.stack(columns)[a, np.arange(n)]
-        return a.astype(np.int64), np.clip(chosen, 0.0, PARAM_HIGH[a])
+            columns[i] = column(p, n, i, expected)
+        chosen = np.empty(n)
+        bad = physics.choose(a, columns, chosen)
+        if bad >= 0:
+            p = columns[bad]
+            raise ValueError(f"parameter {bad} contains {p[~np.isfinite(p)]}; expected {expected}")
+        return a.astype(np.int64, copy=False), chosen
 
     def reset(self, env, mask, options, seeded):
         env._states[mask] = physics.INITIAL_STATE

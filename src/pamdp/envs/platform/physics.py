@@ -19,6 +19,8 @@ file alone, so a constant imported from elsewhere could go stale in the cache.
 
 from __future__ import annotations
 
+import math
+
 import numba
 import numpy as np
 
@@ -213,6 +215,20 @@ def step_copies(states, a, p, stepping, draws, cursors, rewards, terminated, sub
             rewards[i], terminated[i], substeps[i], cursors[i] = step(
                 states[i], a[i], p[i], draws[i], cursors[i], trace if i == 0 else no_trace
             )
+
+
+@jit
+def choose(a, params, out):
+    """Each copy's parameter of its action ``a[i]``, ``params[a[i], i]``, clipped into its box, into ``out``.
+    Returns the first action whose parameter column holds a number that is not finite (checked in every
+    column, before anything is written), else -1."""
+    for j in range(params.shape[0]):
+        for i in range(params.shape[1]):
+            if not math.isfinite(params[j, i]):
+                return j
+    for i in range(a.shape[0]):
+        out[i] = clip(params[a[i], i], 0.0, PARAM_MAX[a[i]])
+    return -1
 
 
 @jit
