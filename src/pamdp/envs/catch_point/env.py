@@ -1,18 +1,4 @@
-"""Catch Point (HyAR: Li et al., ICLR 2022, and its code ``TJU-DRL-LAB/AI-Optimizer``) as a pamdp domain.
-
-An agent on a plane either pushes itself in a chosen direction or tries to catch a target point; a catch
-succeeds within 0.2 of the target, and 11 failed catches are allowed per episode:
-
-====  =====  ========================  ==================================================
- a    name   parameter                 effect
-====  =====  ========================  ==================================================
- 0    move   angle θ in [-π, π]        push with force 2 in direction (sin θ, cos θ)
- 1    catch  none (an empty box)       no push; catch if within 0.2 after this step
-====  =====  ========================  ==================================================
-
-The reward is minus the squared distance to the target, ``20 - d2`` for a catch, 0 once the budget of
-failed catches is spent. An episode ends (``terminated``) on a catch or on the step after the 11th failed
-catch; the registration's 25-step limit is ``truncated``. The dynamics are ``pamdp.envs.particle``'s.
+"""Catch Point as a pamdp domain: its contract and its two envs (the task: ``pamdp.envs.catch_point``).
 
 Action ``(a, (theta, catch))``, batched ``a`` of shape ``(N,)``, ``theta`` ``(N, 1)`` or ``(N,)``, used as
 given (sine and cosine are periodic) but finite, ``catch`` ``(N, 0)`` (``(N, 1)`` is accepted and ignored).

@@ -1,11 +1,4 @@
-"""Hard Move (HyAR: Li et al., ICLR 2022, and its code ``TJU-DRL-LAB/AI-Optimizer``) as a pamdp domain.
-
-An agent on a plane has ``n`` evenly spaced actuators (4, 6, 8 or 10, the variant); discrete action ``a``
-(one of ``2 ** n``) switches on the actuators of its bits (the most significant bit is actuator 0) and its
-one parameter ``p`` scales the resulting push. The agent must come within 0.2 of a target point. The reward
-is minus the squared distance to the target, ``20 - d2`` on arrival, which ends the episode
-(``terminated``, ``info["is_success"]``); the registration's 30-step limit is ``truncated``. The dynamics
-are ``pamdp.envs.particle``'s.
+"""Hard Move as a pamdp domain: its contract and its two envs (the task: ``pamdp.envs.hard_move``).
 
 Action ``(a, (p_0, ..., p_{K-1}))`` with ``K = 2 ** n``, batched ``a`` of shape ``(N,)`` and each ``p``
 ``(N, 1)`` or ``(N,)``, or all ``K`` stacked in one array ``(K, N, 1)`` or ``(K, N)``, which is faster to

@@ -1,13 +1,4 @@
-"""Half Field Offense 1v0 (Hausknecht & Stone, ICLR 2016; ``LARG/HFO``) as a pamdp domain.
-
-Score on an empty goal from a random start, with HFO's low-level actions and features: a simulation of
-rcssserver 15.2.2 and of HFO's agent and referee (``dynamics``). Actions in HFO's units: DASH(power in
-[0, 100], direction in [-180, 180] degrees off the body, rounded to a multiple of 45), TURN(direction in
-[-180, 180], compensated for the player's speed as HFO's agent does), KICK(power in [0, 100], direction in
-[-180, 180], silently dropped when the ball is not kickable). Finite parameters outside those boxes are
-handled as HFO handles them: dash power is clamped to [-100, 100] (negative power dashes backwards at twice
-the stamina cost), kick power to [0, 100], and directions to [-180, 180]. Batched:
-``(a[N], (dash[N, 2], turn[N, 1], kick[N, 2]))``; malformed or non-finite actions raise ``ValueError``.
+"""Half Field Offense 1v0 as a pamdp domain: its contract and its two envs (the task: ``pamdp.envs.hfo``).
 
 ``info`` holds ``status`` ("IN_GAME", "GOAL", "OUT_OF_BOUNDS" or "OUT_OF_TIME"), ``step``, the number of
 actions taken this episode, and ``action_mask``, bool ``(3,)``: which of DASH, TURN and KICK have an effect

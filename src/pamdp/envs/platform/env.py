@@ -1,22 +1,4 @@
-"""Platform (Masson, Ranchod & Konidaris, AAAI 2016; the Gym port ``cycraig/gym-platform``) as a pamdp domain.
-
-The agent is a box that must cross three platforms, separated by two gaps, to reach the right edge
-(``x = 1035``) while avoiding two enemies that patrol platforms 1 and 2. Every agent step is a
-*parameterised action* ``(a, p)``:
-
-====  ======  ===============  ==========================================================
- a    name    parameter range  effect
-====  ======  ===============  ==========================================================
- 0    run     [0, 30]          20 physics sub-steps, each adding ``p`` to vx (ground cap 70)
- 1    hop     [0, 720]         jump with vy = 35 aiming at horizontal speed ``p / 8.14``
- 2    leap    [0, 430]         jump with vy = 25 aiming at horizontal speed ``p / 6.10``
-====  ======  ===============  ==========================================================
-
-A jump lasts until the player is standing on a platform again (or the episode ends), so one agent
-step runs a variable number of sub-steps (``info["substeps"]``, ~72 on average for a random policy).
-The reward of a step is the horizontal progress ``(x_end - x_start) / 1035`` so the episode return is
-the fraction of the course covered (exactly 1.0 at the goal). Falling into a gap or touching an
-enemy ends the episode (``terminated``); the 200-step limit of the registration is ``truncated``.
+"""Platform as a pamdp domain: its contract and its two envs (the task: ``pamdp.envs.platform``).
 
 Action ``(a, (p_run, p_hop, p_leap))``, batched ``a`` of shape ``(N,)`` and each ``p`` ``(N, 1)`` or
 ``(N,)``; only ``p_a`` is read, after clipping into its box, and every ``p`` must be finite. Observation:
