@@ -21,7 +21,7 @@ from gymnasium import spaces
 import pamdp.envs.particle as particle
 from pamdp.envs.catch_point.render import draw_catch_point
 from pamdp.envs.scalar import env_classes
-from pamdp.envs.vector import Domain, column, split_actions
+from pamdp.envs.vector import column, split_actions
 
 __all__ = ["CatchPoint", "CatchPointEnv", "CatchPointVectorEnv", "catch_point_action_space", "THETA_MAX"]
 
@@ -44,22 +44,13 @@ def expected_actions(n: int) -> str:
     )
 
 
-class CatchPoint(Domain):
+class CatchPoint(particle.ParticleDomain):
     name = "Catch Point"
-    render_fps = particle.RENDER_FPS
-    state_size = particle.STATE_SIZE
-    reset_draws = scalar_buffer_size = particle.RESET_DRAWS
-    buffer_size = particle.RESET_DRAWS * 256
-    """256 episodes' worth of uniforms drawn at a time per copy."""
     max_episode_steps = 25
 
     def __init__(self):
+        super().__init__()
         self.action_space = catch_point_action_space()
-        self.observation_space = spaces.Box(-np.inf, np.inf, shape=(particle.OBS_SIZE,), dtype=np.float64)
-
-    def initial_states(self, n):
-        self.last_actions = np.full(n, -1, dtype=np.int64)  # for the pictures
-        return np.zeros((n, self.state_size))
 
     def parse(self, actions, n):
         """``a`` (n,) int64 and ``theta`` (n,) float64, structure, shapes and dtypes checked; the compiled step
@@ -70,13 +61,6 @@ class CatchPoint(Domain):
         if catch not in ((n, 0), (n, 1)):
             raise ValueError(f"invalid catch parameters of shape {catch}; expected {expected}")
         return a.astype(np.int64, copy=False), theta.astype(np.float64, copy=False)
-
-    def reset(self, env, mask, options, seeded):
-        particle.reset_copies(env._states, mask, env.streams.buffers, env.streams.cursors)
-        self.last_actions[mask] = -1
-        obs = np.empty((env.num_envs, particle.OBS_SIZE))
-        particle.observe(env._states, obs)
-        return obs, self._info(env)
 
     def step(self, env, parsed, resetting):
         (a, theta), n, streams = parsed, env.num_envs, env.streams
@@ -89,16 +73,15 @@ class CatchPoint(Domain):
             raise ValueError(f"copy {bad}: action {a[bad]} with angle {theta[bad]}; expected {expected_actions(n)}")
         if env.render_mode is not None:
             self.last_actions[:] = np.where(resetting, -1, a)
-        return obs, rewards, terminated, np.zeros(n, dtype=bool), self._info(env, caught, ~resetting)
+        return obs, rewards, terminated, np.zeros(n, dtype=bool), self.infos(env, ~resetting, caught)
 
-    def _info(self, env, caught=None, stepped=None) -> dict:
+    def infos(self, env, stepped=None, success=None) -> dict:
         """Every copy reports its failed catches, the copies that stepped (rather than reset) whether they
         caught the point."""
         fails = env._states[:, particle.FAILS].astype(np.int64)
-        info = {"failed_catches": fails, "_failed_catches": np.ones(env.num_envs, dtype=bool)}
-        if caught is not None:
-            info["is_success"], info["_is_success"] = caught, stepped
-        return info
+        return {"failed_catches": fails, "_failed_catches": np.ones(env.num_envs, dtype=bool)} | super().infos(
+            env, stepped, success
+        )
 
     def frame(self, env, i):
         a = int(self.last_actions[i])

@@ -23,7 +23,7 @@ import pamdp.envs.particle as particle
 from pamdp.envs.hard_move.motions import check_size, motion_table
 from pamdp.envs.hard_move.render import draw_hard_move
 from pamdp.envs.scalar import env_classes
-from pamdp.envs.vector import Domain, split_actions
+from pamdp.envs.vector import split_actions
 
 __all__ = ["HardMove", "HardMoveEnv", "HardMoveVectorEnv", "hard_move_action_space"]
 
@@ -39,24 +39,15 @@ def hard_move_action_space(n: int) -> spaces.Tuple:
     return spaces.Tuple((spaces.Discrete(k), spaces.Tuple(tuple(spaces.Box(**box) for _ in range(k)))))
 
 
-class HardMove(Domain):
+class HardMove(particle.ParticleDomain):
     name = "Hard Move"
-    render_fps = particle.RENDER_FPS
-    state_size = particle.STATE_SIZE
-    reset_draws = scalar_buffer_size = particle.RESET_DRAWS
-    buffer_size = particle.RESET_DRAWS * 256
-    """256 episodes' worth of uniforms drawn at a time per copy."""
     max_episode_steps = 30
 
     def __init__(self, n: int = 4):
+        super().__init__()
         self.n = check_size(n)
         self.motions = motion_table(self.n)
         self.action_space = hard_move_action_space(self.n)
-        self.observation_space = spaces.Box(-np.inf, np.inf, shape=(particle.OBS_SIZE,), dtype=np.float64)
-
-    def initial_states(self, n):
-        self.last_actions, self.last_params = np.full(n, -1, dtype=np.int64), np.zeros(n)  # for the pictures
-        return np.zeros((n, self.state_size))
 
     def parse(self, actions, n):
         """``a`` (n,) int64 and each copy's own parameter ``p[i] = p_{a[i]}[i]`` (n,) float64 (the compiled step
@@ -88,13 +79,6 @@ class HardMove(Domain):
             raise ValueError(f"parameters stacked to shape {params.shape}, dtype {params.dtype}; expected {expected}")
         return a, params.reshape(k, n)[a, np.arange(n)].astype(np.float64, copy=False)
 
-    def reset(self, env, mask, options, seeded):
-        particle.reset_copies(env._states, mask, env.streams.buffers, env.streams.cursors)
-        self.last_actions[mask] = -1
-        obs = np.empty((env.num_envs, particle.OBS_SIZE))
-        particle.observe(env._states, obs)
-        return obs, {}
-
     def step(self, env, parsed, resetting):
         (a, p), n, streams = parsed, env.num_envs, env.streams
         obs, rewards, terminated = np.empty((n, particle.OBS_SIZE)), np.zeros(n), np.zeros(n, dtype=bool)
@@ -107,13 +91,7 @@ class HardMove(Domain):
             self.last_actions[:] = np.where(resetting, -1, a)
             self.last_params[:] = p
         # As Gymnasium's vector envs merge the scalar envs' infos: a copy that was reset reports nothing.
-        return (
-            obs,
-            rewards,
-            terminated,
-            np.zeros(n, dtype=bool),
-            {"is_success": terminated.copy(), "_is_success": ~resetting},
-        )
+        return obs, rewards, terminated, np.zeros(n, dtype=bool), self.infos(env, ~resetting, terminated.copy())
 
     def frame(self, env, i):
         a = int(self.last_actions[i])
