@@ -1,10 +1,10 @@
 """HyAR's particle world, the plane of Catch Point and Hard Move, compiled by Numba.
 
-Written once from ``shared/specs/catch_point.md`` and ``shared/specs/hard_move.md`` (section numbers in
+Written once from HyAR's code (``TJU-DRL-LAB/AI-Optimizer``; Li et al., ICLR 2022) (section numbers in
 comments refer to them). One agent, pushed by a force, moves on an unbounded plane towards a fixed target
 point; nothing in a step is random. :func:`catch_point_step` and :func:`hard_move_step` advance one copy by
-one agent step; the scalar envs call them for their one copy and :func:`catch_point_copies` /
-:func:`hard_move_copies` loop them over the copies of the batched envs.
+one agent step; :func:`catch_point_copies` / :func:`hard_move_copies` loop them over the copies (the scalar
+env's one copy included).
 
 A copy's state is a float64 row of :data:`STATE_SIZE` numbers (:data:`AX` ... :data:`FAILS`), updated in
 place. The only random numbers are the reset's four uniforms: the original's ``np.random.uniform(-1, 1, 2)``

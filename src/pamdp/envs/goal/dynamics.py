@@ -1,10 +1,12 @@
-"""Robot Soccer Goal's dynamics, written once from ``shared/specs/goal.md`` and compiled by Numba.
+"""Robot Soccer Goal's dynamics (``cycraig/gym-goal``, with MP-DQN's scaled features), written once and compiled
+by Numba.
 
 :func:`reset` puts one copy at the start of an episode and :func:`step` advances it by (part of) one
-agent step; the scalar env calls them for its one copy, :func:`reset_copies` and :func:`step_copies`
-loop them over the batched env's copies. A copy's state is a float64 row of :data:`STATE_SIZE` numbers
+agent step; :func:`reset_copies` and :func:`step_copies` loop them over the copies (the scalar env's one copy
+included). A copy's state is a float64 row of :data:`STATE_SIZE` numbers
 (player, keeper, ball: position, velocity and, for the two players, orientation; then the agent-step
-counter), updated in place. Section numbers in comments (``§7.1``) refer to the spec.
+counter), updated in place. Section numbers in comments (``§7.1``) refer to the project's
+written account of that code.
 
 Noise: every random number is a uniform one, ``uniform(lo, hi) = lo + (hi - lo) * u`` with ``u`` the
 next number of the copy's ``draws`` (NumPy's ``random()``: a block of them equals as many single draws,

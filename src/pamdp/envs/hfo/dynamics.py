@@ -1,6 +1,7 @@
 """One copy of Half Field Offense 1v0: physics, referee, features and shaped reward, compiled by Numba.
 
-The one writing of ``shared/specs/hfo.md`` section 2 (cited below as "spec 2.x"): rcssserver 15.2.2's
+The one writing (``LARG/HFO`` and ``rcsoccersim/rcssserver``, cited below by the sections of the project's
+written account of them, "spec 2.x") of rcssserver 15.2.2's
 movement, kick, dash, turn, stamina and collisions, the agent-side processing that HFO's C++ agent
 (librcsc) applies to each low-level action, HFO's referee, the LOW_LEVEL_FEATURE_SET for one agent and
 Hausknecht & Stone's shaped reward. Every function works on one copy: its state is a float64 vector

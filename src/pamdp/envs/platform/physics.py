@@ -1,9 +1,10 @@
-"""Platform's dynamics, written once from ``shared/specs/platform.md`` and compiled by Numba.
+"""Platform's dynamics (Masson, Ranchod & Konidaris 2016, as ``cycraig/gym-platform`` codes them), written once
+and compiled by Numba.
 
-:func:`step` advances one copy by one agent step; the scalar env calls it for its one copy and
-:func:`step_copies` loops it over the copies of the batched env. A copy's state is a float64 row of
+:func:`step` advances one copy by one agent step and :func:`step_copies` loops it over the copies (the scalar
+env's one copy included). A copy's state is a float64 row of
 :data:`STATE_SIZE` numbers (:data:`X` ... :data:`E2DX`), updated in place. Section numbers in comments
-(``§7.6``) refer to the spec.
+(``§7.6``) refer to the project's written account of that code.
 
 Noise: the step reads standard normals from ``draws``, starting at ``cursor``, in the spec's §9 order
 (the jump's two numbers at take-off, then in every sub-step the player's, then the enemy's), and returns
