@@ -172,13 +172,6 @@ def test_bad_actions_are_refused(action, match):
         env.step(action)
 
 
-def test_bad_constructor_arguments_are_refused():
-    with pytest.raises(ValueError, match="render_mode='human' is not supported"):
-        CatchPointEnv(render_mode="human")
-    with pytest.raises(ValueError, match="num_envs must be a positive integer, got 0"):
-        CatchPointVectorEnv(num_envs=0)
-
-
 # --- the batched env ------------------------------------------------------------------------------------
 @pytest.mark.parametrize("n, seed", [(1, 0), (6, 40)])
 def test_copy_i_equals_a_scalar_env_seeded_with_seed_plus_i(n, seed):

@@ -91,3 +91,45 @@ def test_malformed_actions_are_refused_before_anything_moves(env_id, kwargs):
             venv.step(bad)
     np.testing.assert_array_equal(env.unwrapped._states, before)
     np.testing.assert_array_equal(venv.unwrapped._states, vbefore)
+
+
+@pytest.mark.parametrize("env_id, kwargs", CASES, ids=IDS)
+def test_the_shells_arguments_and_order_are_checked(env_id, kwargs):
+    batched = entry_of(gymnasium.spec(env_id).vector_entry_point)
+    for bad in (dict(num_envs=0), dict(num_envs=2.5), dict(max_episode_steps=0), dict(max_episode_steps=True)):
+        with pytest.raises(ValueError, match="must be a positive integer"):
+            batched(**{"num_envs": 2, **bad}, **gymnasium.spec(env_id).kwargs, **kwargs)
+    scalar = entry_of(gymnasium.spec(env_id).entry_point)
+    for make in (scalar, batched):
+        with pytest.raises(ValueError, match="render_mode='human' is not supported"):
+            make(render_mode="human", **gymnasium.spec(env_id).kwargs, **kwargs)
+    env, venv = gymnasium.make(env_id, **kwargs).unwrapped, make_vec(env_id, kwargs, 2)
+    with pytest.raises(gymnasium.error.ResetNeeded):
+        env.step(env.action_space.sample())
+    with pytest.raises(gymnasium.error.ResetNeeded):
+        venv.step(venv.action_space.sample())
+
+
+def entry_of(entry):
+    return gymnasium.envs.registration.load_env_creator(entry) if isinstance(entry, str) else entry
+
+
+@pytest.mark.parametrize("env_id, kwargs", CASES, ids=IDS)
+def test_seeds_generators_and_reset_mask(env_id, kwargs):
+    venv = make_vec(env_id, kwargs, 3)
+    venv.reset(seed=None)  # fresh entropy for every copy: fine
+    assert all(isinstance(g, np.random.Generator) for g in venv.np_randoms)
+    for seed in (3.5, [1, 2], [1, 2, "x"], True):
+        with pytest.raises(ValueError, match="expected None, an int, or a list of 3 ints"):
+            venv.reset(seed=seed)
+    with pytest.raises(AttributeError, match="np_randoms"):
+        venv.np_random = np.random.default_rng(0)
+    with pytest.raises(ValueError, match="expected one per copy"):
+        venv.np_randoms = [np.random.default_rng(0)]
+    with pytest.raises(ValueError, match="has no"):
+        venv.np_randoms = [np.random.default_rng(0), np.random.default_rng(1), object()]
+    reset_obs, _ = venv.reset(seed=0)
+    venv.action_space.seed(0)
+    moved, *_ = venv.step(venv.action_space.sample())
+    obs, _ = venv.reset(seed=[None, 1, None], options={"reset_mask": np.array([False, True, False])})
+    np.testing.assert_array_equal(obs, [moved[0], reset_obs[1], moved[2]])

@@ -247,11 +247,6 @@ def test_check_env_and_spaces(env_id):
     assert env.observation_space.shape == (10,) and env.observation_space.dtype == np.float64
 
 
-def test_step_before_reset_is_refused():
-    with pytest.raises(gymnasium.error.ResetNeeded):
-        MovingEnv().step(act(2))
-
-
 @pytest.mark.parametrize(
     "action, shown",
     [
