@@ -124,6 +124,8 @@ def test_seeds_generators_and_reset_mask(env_id, kwargs):
             venv.reset(seed=seed)
     with pytest.raises(AttributeError, match="np_randoms"):
         venv.np_random = np.random.default_rng(0)
+    with pytest.raises(AttributeError, match="np_randoms"):
+        _ = venv.unwrapped.np_random
     with pytest.raises(ValueError, match="expected one per copy"):
         venv.np_randoms = [np.random.default_rng(0)]
     with pytest.raises(ValueError, match="has no"):

@@ -187,6 +187,8 @@ class DomainVectorEnv(VectorEnv):
 
     def __getattr__(self, name: str):
         # The domain's variant and tables (``n``, ``motions``, ``settings``...) read as the env's own.
+        if name == "np_random":  # its property refused it; Python then asks here, so the hint is given here
+            raise AttributeError("each copy has its own generator: read or assign np_randoms (one per copy)")
         if name == "domain":
             raise AttributeError(name)
         return getattr(self.domain, name)
