@@ -75,7 +75,9 @@ class Domain:
     """The contract between a domain and the env shell; a domain subclasses it once, in its ``env.py``.
 
     An instance is one variant (its constructor takes the variant's arguments: Hard Move's ``n``, Goal's
-    ``hard``, HFO's settings...) for one env; it may keep per-copy arrays of its own beside the state rows.
+    ``hard``, HFO's settings...) for one env; it may keep per-copy arrays of its own beside the state rows, and
+    a variant may set its own sizes (``state_size``, the spaces) in its constructor: more players, another
+    observation.
     It sets the class attributes below and ``action_space`` / ``observation_space`` (one copy's), and
     implements:
 
