@@ -1,6 +1,6 @@
 """The scalar env: a :class:`~pamdp.envs.vector.Domain` at N = 1 as a ``gymnasium.Env``.
 
-It keeps one state row and one :class:`~pamdp.envs.vector.RandomStreams` copy that follows ``np_random``
+It keeps one state row and one :class:`~pamdp.envs.streams.RandomStreams` copy that follows ``np_random``
 (a replaced generator, e.g. ``numpy.random.RandomState(S)`` or a seeded reset, drops the numbers drawn
 ahead of it), and runs the domain's own batched ``parse``, ``reset`` and ``step`` on them: one action is
 checked as a batch of one (:func:`as_batch`), and the batched infos are read back as copy 0's. It neither
@@ -23,6 +23,8 @@ class _OneEach(tuple):
     reads only the chosen action's parameter (Hard Move's 1 024 boxes) converts only that one."""
 
     def __getitem__(self, i):
+        if isinstance(i, slice):
+            return _OneEach(tuple.__getitem__(self, i))
         return np.asarray(tuple.__getitem__(self, i))[None]
 
     def __iter__(self):

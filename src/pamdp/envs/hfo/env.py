@@ -67,7 +67,7 @@ class HalfFieldOffense(Domain):
         first_step_reward: bool = False,
         terminal_deltas: bool = False,
     ):
-        check_settings(profile, body_reset, None)
+        check_settings(profile, body_reset)
         self.profile = dyn.PROFILES[profile]
         self.settings = dyn.settings(
             self.profile, deterministic, timeout_terminal, terminal_deltas, first_step_reward, body_reset == "uniform"

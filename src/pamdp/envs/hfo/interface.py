@@ -30,14 +30,12 @@ def hfo_action_space() -> spaces.Tuple:
     return spaces.Tuple((spaces.Discrete(3), spaces.Tuple(boxes)))
 
 
-def check_settings(profile: str, body_reset: str, render_mode) -> None:
-    """Raise ``ValueError`` for an unknown feature profile, body-reset rule or render mode."""
+def check_settings(profile: str, body_reset: str) -> None:
+    """Raise ``ValueError`` for an unknown feature profile or body-reset rule (the shell checks the render mode)."""
     if profile not in dyn.PROFILES:
         raise ValueError(f"profile={profile!r} is not one of {sorted(dyn.PROFILES)}")
     if body_reset not in ("carry", "uniform"):
         raise ValueError(f"body_reset={body_reset!r}; expected 'carry' (HFO's behaviour) or 'uniform'")
-    if render_mode not in (None, "rgb_array"):
-        raise ValueError(f"render_mode={render_mode!r}; expected None or 'rgb_array'")
 
 
 def parse_actions(actions, n: int):
