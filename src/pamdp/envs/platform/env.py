@@ -66,7 +66,7 @@ class Platform(Domain):
     def state(self, states):
         return {
             "player": states[:, physics.X : physics.VY + 1].copy(),
-            "enemies": states[:, physics.E1X :].reshape(-1, 2, 2),
+            "enemies": states[:, physics.E1X :].reshape(-1, 2, 2).copy(),
         }
 
     def parse(self, actions, n):
