@@ -9,6 +9,8 @@ autoresets nor truncates (``gymnasium.make`` adds the registration's ``TimeLimit
 
 from __future__ import annotations
 
+import inspect
+
 import gymnasium
 import numpy as np
 
@@ -122,11 +124,31 @@ def _first(infos: dict) -> dict:
 
 def env_classes(domain_class: type[Domain], module: str, scalar: str, batched: str, **variant) -> tuple[type, type]:
     """A domain's scalar env and batched env, classes named ``scalar`` and ``batched`` in ``module`` (the names
-    users import and ``isinstance`` tests), with the constructor arguments ``variant`` fixed."""
+    users import and ``isinstance`` tests), with the constructor arguments ``variant`` fixed. Their signatures
+    list the domain's arguments, as code that inspects an env's constructor (``pamdp.algos``) expects."""
     what = f"{domain_class.name}" + "".join(f", {k}={v!r}" for k, v in variant.items())
     attrs = {"domain_class": domain_class, "variant": variant, "__module__": module}
     doc = f"{{}} of {what} (see :class:`{module}.{domain_class.__name__}`)."
-    return (
-        type(scalar, (DomainEnv,), {**attrs, "__doc__": doc.format("One copy as a ``gymnasium.Env``")}),
-        type(batched, (DomainVectorEnv,), {**attrs, "__doc__": doc.format("N copies stepped at once")}),
-    )
+    shells = []
+    for name, shell, text in (
+        (scalar, DomainEnv, "One copy as a ``gymnasium.Env``"),
+        (batched, DomainVectorEnv, "N copies stepped at once"),
+    ):
+        signature = _signature(shell, domain_class, variant, max_episode_steps=domain_class.max_episode_steps)
+        shells.append(type(name, (shell,), {**attrs, "__doc__": doc.format(text), "__signature__": signature}))
+    return shells[0], shells[1]
+
+
+def _signature(shell: type, domain_class: type[Domain], variant: dict, **defaults) -> inspect.Signature:
+    """The shell's own arguments, then the domain's as keywords (defaults: ``defaults`` and ``variant``)."""
+    own = [
+        p.replace(default=defaults.get(name, p.default))
+        for name, p in inspect.signature(shell.__init__).parameters.items()
+        if name != "self" and p.kind is not p.VAR_KEYWORD
+    ]
+    domain = [
+        p.replace(default=variant.get(name, p.default), kind=p.KEYWORD_ONLY)
+        for name, p in inspect.signature(domain_class.__init__).parameters.items()
+        if name != "self"
+    ]
+    return inspect.Signature(own + domain)

@@ -72,9 +72,21 @@ class GymHybrid(Domain):
     buffer_size = 64 * dyn.DRAWS_PER_RESET
     """The numbers of 64 resets per copy: a copy's buffer is topped up once every 64 episodes."""
 
-    def __init__(self, sliding: bool = False, **settings):
+    def __init__(
+        self,
+        sliding: bool = False,
+        max_turn: float = np.pi / 2,
+        max_acceleration: float = 0.5,
+        delta_t: float = 0.005,
+        max_step: int = 200,
+        penalty: float = 0.001,
+        break_value: float = 0.1,
+    ):
         self.sliding = bool(sliding)
-        self.settings = check_settings(**settings)
+        self.settings = check_settings(
+            max_turn=max_turn, max_acceleration=max_acceleration, delta_t=delta_t, max_step=max_step,
+            penalty=penalty, break_value=break_value,
+        )  # fmt: skip
         self.action_space = gym_hybrid_action_space()
         self.observation_space = spaces.Box(-np.inf, np.inf, shape=(dyn.OBS_SIZE,), dtype=np.float64)
 
