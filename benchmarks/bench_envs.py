@@ -8,14 +8,21 @@ the batched env takes that format (Hard Move), each the median over ``--repeats`
 ``time.process_time`` (this process's CPU time, which another process on the core does not inflate). Actions are
 sampled before timing. An env whose module is missing or fails to build is skipped, and the record says which
 and why.
+
+First it times Numba's compilation: a fresh process that imports pamdp, makes every env (scalar and batched),
+resets and steps it once, run twice with ``NUMBA_CACHE_DIR`` set to an empty folder: cold (everything compiled
+and written to the cache) and warm (everything loaded from it), each the child's CPU seconds.
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import resource
 import statistics
+import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -92,6 +99,32 @@ def measure(env_id: str, kwargs: dict, num_envs: int, repeats: int, scalar_steps
     return tuple(statistics.median(r) if r else float("nan") for r in rates.values())
 
 
+FIRST_USE = """
+import gymnasium, pamdp
+from pamdp.envs import _REGISTRATIONS
+for env_id in _REGISTRATIONS:
+    for make in (gymnasium.make, lambda i: gymnasium.make_vec(i, 2, vectorization_mode="vector_entry_point")):
+        env = make(env_id)
+        env.action_space.seed(0)
+        env.reset(seed=0)
+        env.step(env.action_space.sample())
+"""
+
+
+def compile_seconds() -> tuple[float, float]:
+    """CPU seconds of a fresh process's first use of every env with an empty Numba cache (cold), then again
+    with the cache that run wrote (warm)."""
+    times = []
+    with tempfile.TemporaryDirectory() as cache:
+        for _ in range(2):
+            before = resource.getrusage(resource.RUSAGE_CHILDREN)
+            env = {**os.environ, "NUMBA_CACHE_DIR": cache}
+            subprocess.run([sys.executable, "-c", FIRST_USE], check=True, env=env)
+            after = resource.getrusage(resource.RUSAGE_CHILDREN)
+            times.append(after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime)
+    return times[0], times[1]
+
+
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--num-envs", type=int, default=1024)
@@ -102,6 +135,8 @@ def main() -> None:
     a = p.parse_args()
     if a.cpu is not None:
         os.sched_setaffinity(0, {a.cpu})
+    cold, warm = compile_seconds()
+    print(f"first use of every env: {cold:.1f} CPU-s cold, {warm:.1f} CPU-s warm", flush=True)
     rows, skipped = [], []
     for env_id, kwargs in cases():
         name = env_id + (f" {kwargs}" if kwargs else "")
@@ -119,6 +154,8 @@ def main() -> None:
         f"time; scalar: {a.scalar_steps:,} steps of `gymnasium.make`'s env a timing, resets included; batched: "
         f"{a.num_envs:,} copies, at least {MIN_ENV_STEPS:,} env steps a timing, autoresets included"
         + (f"; pinned to core {a.cpu}" if a.cpu is not None else ""),
+        f"- Numba: a fresh process's first use of every env (import, make scalar and batched, reset, step) takes "
+        f"{cold:.1f} CPU-s with an empty cache (compiling) and {warm:.1f} CPU-s with the cache it wrote",
         "",
         f"| env | scalar steps/s | batched steps/s ({a.num_envs:,} copies) | batched / scalar "
         "| batched, parameters stacked in one (K, N, m) array |",

@@ -176,11 +176,13 @@ def worker_versions() -> dict:
 
 
 # --- driver ------------------------------------------------------------------------------------------
-def _call(python: str, args: list[str], pin: bool) -> dict:
+def _call(python: str, args: list[str], pin: bool, src: str | None = None) -> dict:
     cmd = [python, os.path.abspath(__file__), "--worker", *args]
     if pin and shutil.which("taskset"):
         cmd = ["taskset", "-c", "0", *cmd]
     env = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1", MKL_NUM_THREADS="1", NUMBA_NUM_THREADS="1")
+    if src is not None:  # another version of pamdp (--baseline-src)
+        env["PYTHONPATH"] = src
     res = subprocess.run(cmd, capture_output=True, text=True, env=env, check=False)
     if res.returncode != 0:
         raise RuntimeError(f"worker {' '.join(cmd)} failed:\n{res.stderr}")
@@ -206,6 +208,10 @@ def main(argv=None) -> None:
     parser.add_argument("--check-seeds", type=int, default=200, help="episodes of the dynamics check")
     parser.add_argument("--no-pin", action="store_true", help="do not pin workers to core 0")
     parser.add_argument("--out", default=os.path.join(HERE, "platform_speed.md"))
+    parser.add_argument(
+        "--baseline-src",
+        help="also time the pamdp envs of this source tree (e.g. `git archive COMMIT src`), interleaved",
+    )
     parser.add_argument("--worker", nargs="*", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
 
@@ -226,14 +232,19 @@ def main(argv=None) -> None:
     episodes, steps, bad = compare_with_peer(_call(peer, ["peer-trajectories", str(args.check_seeds)], pin))
     print(f"  {episodes} episodes, {steps} steps, {bad} mismatching", flush=True)
 
-    configs = [("hybrid-platform (peer)", peer, "peer", 1), ("pamdp PlatformEnv", ours, "scalar", 1)] + [
-        (f"pamdp PlatformVectorEnv, N={n}", ours, "vector", n) for n in (1, 64, 128, 1024)
+    configs = [("hybrid-platform (peer)", peer, "peer", 1, None), ("pamdp PlatformEnv", ours, "scalar", 1, None)] + [
+        (f"pamdp PlatformVectorEnv, N={n}", ours, "vector", n, None) for n in (1, 64, 128, 1024)
     ]
+    if args.baseline_src:
+        configs += [
+            (f"baseline {name.removeprefix('pamdp ')}", ours, kind, n, args.baseline_src)
+            for name, _, kind, n, _ in configs[1:]
+        ]
     results: dict[str, list[float]] = {name: [] for name, *_ in configs}
     wall: dict[str, list[float]] = {name: [] for name, *_ in configs}
     for rep in range(args.repeats):
-        for name, python, kind, n in configs:
-            out = _call(python, ["speed", kind, str(n), str(args.seconds)], pin)
+        for name, python, kind, n, src in configs:
+            out = _call(python, ["speed", kind, str(n), str(args.seconds)], pin, src)
             results[name].append(out["steps_per_second"])
             wall[name].append(out["wall_steps_per_second"])
             print(

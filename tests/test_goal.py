@@ -299,17 +299,6 @@ def test_bad_batched_actions_raise(action, shown):
     assert_refused(venv, action, shown, "expected (a, (p_0, ..., p_10))")
 
 
-def test_bad_constructor_arguments_raise():
-    with pytest.raises(ValueError, match="render_mode='human' is not supported"):
-        GoalEnv(render_mode="human")
-    with pytest.raises(ValueError, match="must be a positive integer"):
-        GoalVectorEnv(num_envs=0)
-    with pytest.raises(ValueError, match="render_mode='human' is not supported"):
-        HardGoalVectorEnv(num_envs=2, render_mode="human")
-    with pytest.raises(gymnasium.error.ResetNeeded):
-        GoalEnv().step((1, (np.zeros(2), np.zeros(1), np.zeros(1))))
-
-
 def test_render_draws_every_substep(tmp_path):
     env = GoalEnv(render_mode="rgb_array")
     env.reset(seed=0)

@@ -122,10 +122,13 @@ def test_bad_actuator_counts_are_refused(n):
 @pytest.mark.parametrize(
     "action, match",
     [
-        ((16, (np.zeros(1),) * 16), "invalid discrete action 16"),
+        ((16, (np.zeros(1),) * 16), r"discrete actions \[16\] at indices \[0\]"),
         ((3, (np.zeros(1),) * 15), r"invalid parameters \(15 boxes\)"),
-        ((3, (np.zeros(1),) * 3 + (np.array([np.nan]),) + (np.zeros(1),) * 12), "parameter p_3 is nan"),
-        ((3, (np.zeros(2),) * 16), "invalid parameter p_3"),
+        (
+            (3, (np.zeros(1),) * 3 + (np.array([np.nan]),) + (np.zeros(1),) * 12),
+            "copy 0: parameter nan of action 3; expected a finite number",
+        ),
+        ((3, (np.zeros(2),) * 16), r"the chosen parameters have shapes \[\(1, 2\)\]"),
     ],
 )
 def test_bad_actions_are_refused(action, match):

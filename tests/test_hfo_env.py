@@ -195,8 +195,8 @@ def test_bad_reset_options_raise_clear_errors(options, words):
         (3, ["malformed", "expected"]),
         ((5, (np.zeros(2), np.zeros(1), np.zeros(2))), ["5", "DASH"]),
         ((1.5, (np.zeros(2), np.zeros(1), np.zeros(2))), ["1.5"]),
-        ((0, (np.zeros(2), np.zeros(1))), ["malformed", "DASH"]),
-        ((0, (np.zeros(3), np.zeros(1), np.zeros(2))), ["DASH", "2 number"]),
+        ((0, (np.zeros(2), np.zeros(1))), ["malformed", "dash"]),  # one action is checked as a batch of one
+        ((0, (np.zeros(3), np.zeros(1), np.zeros(2))), ["(1, 3)", "dash[1, 2]"]),
         ((2, (np.zeros(2), np.zeros(1), np.array([np.nan, 0.0]))), ["KICK", "finite"]),
         ((1, (np.zeros(2), np.array([np.inf]), np.zeros(2))), ["TURN", "finite"]),
     ],

@@ -9,7 +9,7 @@ import pytest
 from gymnasium.utils import seeding
 
 import pamdp  # noqa: F401  (registers the envs)
-from pamdp.envs.vector import RandomStreams, copy_seeds
+from pamdp.envs.streams import RandomStreams, copy_seeds
 
 GENERATORS = {"Generator": lambda s: np.random.default_rng(s), "RandomState": lambda s: np.random.RandomState(s)}
 

@@ -20,39 +20,41 @@ import gymnasium
 _REGISTRATIONS = {
     "pamdp/Platform-v0": dict(
         entry_point="pamdp.envs.platform.env:PlatformEnv",
-        vector_entry_point="pamdp.envs.platform.batched:PlatformVectorEnv",
+        vector_entry_point="pamdp.envs.platform.env:PlatformVectorEnv",
         max_episode_steps=200,
     ),
     "pamdp/HalfFieldOffense-v0": dict(
         entry_point="pamdp.envs.hfo.env:HalfFieldOffenseEnv",
-        vector_entry_point="pamdp.envs.hfo.batched:HalfFieldOffenseVectorEnv",
+        vector_entry_point="pamdp.envs.hfo.env:HalfFieldOffenseVectorEnv",
     ),
     # Goal, Hard Goal, Moving and Sliding end their episodes by their own step limits (the specs: no TimeLimit).
     "pamdp/Goal-v0": dict(
         entry_point="pamdp.envs.goal.env:GoalEnv",
-        vector_entry_point="pamdp.envs.goal.batched:GoalVectorEnv",
+        vector_entry_point="pamdp.envs.goal.env:GoalVectorEnv",
     ),
     "pamdp/HardGoal-v0": dict(
-        entry_point="pamdp.envs.goal.env:HardGoalEnv",
-        vector_entry_point="pamdp.envs.goal.batched:HardGoalVectorEnv",
+        entry_point="pamdp.envs.goal.env:GoalEnv",
+        vector_entry_point="pamdp.envs.goal.env:GoalVectorEnv",
+        kwargs={"hard": True},
     ),
     "pamdp/CatchPoint-v0": dict(
         entry_point="pamdp.envs.catch_point.env:CatchPointEnv",
-        vector_entry_point="pamdp.envs.catch_point.batched:CatchPointVectorEnv",
+        vector_entry_point="pamdp.envs.catch_point.env:CatchPointVectorEnv",
         max_episode_steps=25,
     ),
     "pamdp/HardMove-v0": dict(
         entry_point="pamdp.envs.hard_move.env:HardMoveEnv",
-        vector_entry_point="pamdp.envs.hard_move.batched:HardMoveVectorEnv",
+        vector_entry_point="pamdp.envs.hard_move.env:HardMoveVectorEnv",
         max_episode_steps=30,
     ),
     "pamdp/Moving-v0": dict(
         entry_point="pamdp.envs.gym_hybrid.env:MovingEnv",
-        vector_entry_point="pamdp.envs.gym_hybrid.batched:MovingVectorEnv",
+        vector_entry_point="pamdp.envs.gym_hybrid.env:MovingVectorEnv",
     ),
     "pamdp/Sliding-v0": dict(
-        entry_point="pamdp.envs.gym_hybrid.env:SlidingEnv",
-        vector_entry_point="pamdp.envs.gym_hybrid.batched:SlidingVectorEnv",
+        entry_point="pamdp.envs.gym_hybrid.env:MovingEnv",
+        vector_entry_point="pamdp.envs.gym_hybrid.env:MovingVectorEnv",
+        kwargs={"sliding": True},
     ),
 }
 

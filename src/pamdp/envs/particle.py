@@ -1,10 +1,10 @@
 """HyAR's particle world, the plane of Catch Point and Hard Move, compiled by Numba.
 
-Written once from ``shared/specs/catch_point.md`` and ``shared/specs/hard_move.md`` (section numbers in
+Written once from HyAR's code (``TJU-DRL-LAB/AI-Optimizer``; Li et al., ICLR 2022) (section numbers in
 comments refer to them). One agent, pushed by a force, moves on an unbounded plane towards a fixed target
 point; nothing in a step is random. :func:`catch_point_step` and :func:`hard_move_step` advance one copy by
-one agent step; the scalar envs call them for their one copy and :func:`catch_point_copies` /
-:func:`hard_move_copies` loop them over the copies of the batched envs.
+one agent step; :func:`catch_point_copies` / :func:`hard_move_copies` loop them over the copies (the scalar
+env's one copy included).
 
 A copy's state is a float64 row of :data:`STATE_SIZE` numbers (:data:`AX` ... :data:`FAILS`), updated in
 place. The only random numbers are the reset's four uniforms: the original's ``np.random.uniform(-1, 1, 2)``
@@ -23,8 +23,10 @@ import math
 
 import numba
 import numpy as np
+from gymnasium import spaces
 
 from pamdp.envs.rendering import Canvas
+from pamdp.envs.vector import Domain
 
 # --- §1 constants -----------------------------------------------------------------------------------
 DT = 0.1
@@ -167,13 +169,42 @@ def observe(states, out):
         out[i, 2], out[i, 3] = s[GX] - s[AX], s[GY] - s[AY]
 
 
+# --- what both domains' contracts share ------------------------------------------------------------
+class ParticleDomain(Domain):
+    """The part of Catch Point's and Hard Move's contracts that is the plane's: the state row, the observation,
+    the resets (four uniforms each, 256 episodes' worth drawn at a time per copy, none ahead in the scalar env)
+    and the last actions their pictures show. A subclass adds its actions, its step and its ``info``."""
+
+    render_fps = 10
+    """One frame per agent step (dt = 0.1 s) plays an episode in real time."""
+    state_size = STATE_SIZE
+    reset_draws = scalar_buffer_size = RESET_DRAWS
+    buffer_size = RESET_DRAWS * 256
+
+    def __init__(self):
+        self.observation_space = spaces.Box(-np.inf, np.inf, shape=(OBS_SIZE,), dtype=np.float64)
+
+    def initial_states(self, n):
+        self.last_actions, self.last_params = np.full(n, -1, dtype=np.int64), np.zeros(n)  # for the pictures
+        return np.zeros((n, STATE_SIZE))
+
+    def reset(self, env, mask, options, seeded):
+        reset_copies(env._states, mask, env.streams.buffers, env.streams.cursors)
+        self.last_actions[mask] = -1
+        obs = np.empty((env.num_envs, OBS_SIZE))
+        observe(env._states, obs)
+        return obs, self.infos(env)
+
+    def infos(self, env, stepped=None, success=None) -> dict:
+        """The batched ``info`` of a reset (``stepped`` None) or a step."""
+        return {} if stepped is None else {"is_success": success, "_is_success": stepped}
+
+
 # --- the top view both domains draw ----------------------------------------------------------------
 VIEW = 2.0
 """The pictures show the square [-2, 2]^2 (agent and target start in [-1, 1]^2)."""
 PIXELS_PER_UNIT = 80
 RENDER_SIZE = int(2 * VIEW * PIXELS_PER_UNIT)
-RENDER_FPS = 10
-"""One frame per agent step (dt = 0.1 s) plays an episode in real time."""
 
 
 def to_pixels(x: float, y: float) -> tuple[float, float]:

@@ -1,109 +1,154 @@
-"""What pamdp's scalar envs share: copy 0 of the batched layout, and the checks of one action.
+"""The scalar env: a :class:`~pamdp.envs.vector.Domain` at N = 1 as a ``gymnasium.Env``.
 
-A domain's scalar env is its batched env at N = 1 (``pamdp.envs.vector``): it keeps one state row in
-``_states`` (shape ``(1, STATE_SIZE)``) and one :class:`~pamdp.envs.vector.RandomStreams` copy, and steps
-them with the same compiled per-copy functions. :class:`ScalarEnv` holds that plumbing; a domain sets
-``metadata`` (render modes and fps), ``observe`` (its compiled ``observe(states, out)``) and ``obs_size``,
-and implements ``reset``, ``step`` and ``_frame`` (the picture :meth:`~ScalarEnv.render` returns).
+It keeps one state row and one :class:`~pamdp.envs.streams.RandomStreams` copy that follows ``np_random``
+(a replaced generator, e.g. ``numpy.random.RandomState(S)`` or a seeded reset, drops the numbers drawn
+ahead of it), and runs the domain's own batched ``parse``, ``reset`` and ``step`` on them: one action is
+checked as a batch of one (:func:`as_batch`), and the batched infos are read back as copy 0's. It neither
+autoresets nor truncates (``gymnasium.make`` adds the registration's ``TimeLimit``).
 """
 
 from __future__ import annotations
 
-import math
-import numbers
+import inspect
 
 import gymnasium
 import numpy as np
 
-from pamdp.envs.vector import RandomStreams, check_render_mode
+from pamdp.envs.streams import RandomStreams
+from pamdp.envs.vector import Domain, DomainVectorEnv, check_render_mode
 
-__all__ = ["ScalarEnv", "split_action", "number"]
+__all__ = ["DomainEnv", "as_batch", "env_classes"]
 
 
-class ScalarEnv(gymnasium.Env):
-    """One copy of a domain's batched state and random stream as a Gymnasium env.
+class _OneEach(tuple):
+    """The parameters of one action, each read as a batch of one (``p[None]``) when it is read: a parser that
+    reads only the chosen action's parameter (Hard Move's 1 024 boxes) converts only that one."""
+
+    def __getitem__(self, i):
+        if isinstance(i, slice):
+            return _OneEach(tuple.__getitem__(self, i))
+        return np.asarray(tuple.__getitem__(self, i))[None]
+
+    def __iter__(self):
+        return map(self.__getitem__, range(len(self)))
+
+
+def as_batch(action):
+    """One action ``(a, params)`` as a batch of one, ``(array([a]), (p_0[None], p_1[None], ...))``; anything
+    else is handed on as it is, for the parser to refuse."""
+    if not isinstance(action, (tuple, list)) or len(action) != 2:
+        return action
+    a, params = action
+    return np.asarray(a)[None], _OneEach(params) if isinstance(params, (tuple, list)) else params
+
+
+class DomainEnv(gymnasium.Env):
+    """One copy of a :class:`~pamdp.envs.vector.Domain` (``domain_class``) as a Gymnasium env.
 
     Args:
-        render_mode: ``None`` or one of ``metadata["render_modes"]``.
-        action_space, observation_space: the env's spaces.
-        states: the initial state rows, shape ``(1, STATE_SIZE)``.
-        draw, capacity: the stream's generator method and the numbers it keeps drawn ahead
-            (see :class:`~pamdp.envs.vector.RandomStreams`).
+        render_mode: ``None`` or ``"rgb_array"``.
+        **variant: the domain's constructor arguments.
     """
 
     metadata = {"render_modes": ["rgb_array"]}
-    obs_size: int
-    """Length of the observation vector ``observe`` writes."""
+    domain_class: type[Domain]
+    variant: dict = {}
+    """Constructor arguments of the domain fixed by the class (Hard Goal's ``hard=True``)."""
+    num_envs = 1
+    """The domain's hooks see the scalar env as a batched one of one copy."""
 
-    @staticmethod
-    def observe(states: np.ndarray, out: np.ndarray) -> None:
-        """The domain's compiled observation of the state rows into ``out`` ``(N, obs_size)``."""
-        raise NotImplementedError
-
-    def __init__(self, render_mode, action_space, observation_space, states: np.ndarray, draw: str, capacity: int):
+    def __init__(self, render_mode: str | None = None, **variant):
+        self.domain = domain = self.domain_class(**{**self.variant, **variant})
         check_render_mode(render_mode, self.metadata["render_modes"])
+        self.metadata = {**self.metadata, "render_fps": domain.render_fps}
         self.render_mode = render_mode
-        self.action_space = action_space
-        self.observation_space = observation_space
-        self._states = states
-        self._streams = RandomStreams(1, draw, capacity)
+        self.action_space = domain.action_space
+        self.observation_space = domain.observation_space
+        self.streams = RandomStreams(1, domain.draw, domain.scalar_buffer_size)
+        self._states = domain.initial_states(1)
+        self._started = False
+        self._calm = np.zeros(1, dtype=bool)  # a scalar env never resets inside a step
+
+    def __getattr__(self, name: str):
+        # The domain's variant and tables (``n``, ``motions``, ``settings``...) read as the env's own.
+        if name == "domain":
+            raise AttributeError(name)
+        return getattr(self.domain, name)
 
     @property
-    def state(self) -> np.ndarray:
-        """A copy of the state row (indices in the domain's dynamics module)."""
-        return self._states[0].copy()
+    def state(self):
+        """The domain's view of the state (see its ``state``), for copy 0."""
+        view = self.domain.state(self._states)
+        return {k: v[0] for k, v in view.items()} if isinstance(view, dict) else view[0]
 
-    def _observation(self) -> np.ndarray:
-        out = np.empty((1, self.obs_size))
-        self.observe(self._states, out)
-        return out[0]
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        super().reset(seed=seed)
+        self.streams.follow(0, self.np_random)
+        if self.domain.reset_draws:
+            self.streams.refill(self.domain.reset_draws)
+        obs, infos = self.domain.reset(self, np.ones(1, dtype=bool), options, np.array([seed is not None]))
+        self._started = True
+        return obs[0], _first(infos)
 
-    def _stream(self, need: int) -> RandomStreams:
-        """The stream, drawing from ``np_random`` (a replaced generator drops the numbers drawn ahead) and
-        holding at least ``need`` numbers: copy 0's are ``buffers[0]`` from ``cursors[0]`` on."""
-        self._streams.follow(0, self.np_random)
-        self._streams.refill(need)
-        return self._streams
+    def step(self, action):
+        if not self._started:
+            raise gymnasium.error.ResetNeeded("call reset() before step()")
+        parsed = self.domain.parse(as_batch(action), 1)
+        self.streams.follow(0, self.np_random)
+        if self.domain.step_draws:
+            self.streams.refill(self.domain.step_draws)
+        obs, rewards, terminated, truncated, infos = self.domain.step(self, parsed, self._calm)
+        return obs[0], float(rewards[0]), bool(terminated[0]), bool(truncated[0]), _first(infos)
 
     def render(self):
-        return self._frame() if self.render_mode == "rgb_array" else None
+        return self.domain.frame(self, 0) if self.render_mode == "rgb_array" else None
 
-    def _frame(self) -> np.ndarray:
-        raise NotImplementedError
-
-    def _substep_frames(self, draw) -> list[np.ndarray]:
-        """``draw(*row)`` for each row of ``_trace`` the last step wrote (``_substeps`` of them)."""
+    def render_substeps(self) -> list[np.ndarray]:
+        """With ``render_mode="rgb_array"``: the frames of the last step, one per sub-step where the domain runs
+        several (Platform, Goal; none after a reset), the last one equal to :meth:`render`'s.
+        ``pamdp.envs.rendering.record_episode`` plays these."""
         if self.render_mode != "rgb_array":
             raise ValueError(f"render_substeps needs render_mode='rgb_array', got {self.render_mode!r}")
-        return [draw(*row) for row in self._trace[: self._substeps]]
+        return self.domain.substep_frames(self)
 
 
-def split_action(action, domain: str, n_actions: int, n_params: int | None, expected: str) -> tuple[int, tuple]:
-    """Check the form of one action ``(a, params)``: ``a`` an int (or 0-d int array) in ``0..n_actions - 1``,
-    ``params`` a tuple or list of ``n_params`` (None: not checked). Returns ``(int(a), params)``; a bad
-    part raises ``ValueError`` naming it and the ``expected`` form."""
-    if not isinstance(action, (tuple, list)) or len(action) != 2:
-        raise ValueError(f"invalid {domain} action {action!r}; expected {expected}")
-    a, params = action
-    if not isinstance(a, (int, np.integer)) or isinstance(a, bool):  # the usual types skip the slower ABC test
-        if isinstance(a, np.ndarray) and a.shape == ():
-            a = a.item()
-        if isinstance(a, bool) or not isinstance(a, numbers.Integral):
-            raise ValueError(f"invalid discrete action {a!r}; expected {expected}")
-    if not 0 <= a < n_actions:
-        raise ValueError(f"invalid discrete action {a!r}; expected {expected}")
-    if n_params is not None and (not isinstance(params, (tuple, list)) or len(params) != n_params):
-        raise ValueError(f"invalid parameters {params!r}; expected {expected}")
-    return int(a), params
+def _first(infos: dict) -> dict:
+    """Copy 0's info from batched infos: the keys it reports, NumPy scalars as Python ones."""
+    info = {}
+    for key, value in infos.items():
+        if not key.startswith("_") and infos.get("_" + key, (True,))[0]:
+            v = value[0]
+            info[key] = v.item() if isinstance(v, np.generic) else v
+    return info
 
 
-def number(p, i: int, expected: str, label: str = "parameter ") -> float:
-    """Parameter ``i`` given as a number or a shape-``(1,)`` array, as a finite float64; ``ValueError``
-    otherwise, naming it ``label`` followed by ``i``."""
-    arr = np.asarray(p)
-    if arr.shape not in ((), (1,)) or arr.dtype.kind not in "iuf":
-        raise ValueError(f"invalid {label}{i} {p!r}; expected {expected}")
-    v = float(arr.item())
-    if not math.isfinite(v):
-        raise ValueError(f"{label}{i} is {v}; expected {expected}")
-    return v
+def env_classes(domain_class: type[Domain], module: str, scalar: str, batched: str, **variant) -> tuple[type, type]:
+    """A domain's scalar env and batched env, classes named ``scalar`` and ``batched`` in ``module`` (the names
+    users import and ``isinstance`` tests), with the constructor arguments ``variant`` fixed. Their signatures
+    list the domain's arguments, as code that inspects an env's constructor (``pamdp.algos``) expects."""
+    what = f"{domain_class.name}" + "".join(f", {k}={v!r}" for k, v in variant.items())
+    attrs = {"domain_class": domain_class, "variant": variant, "__module__": module}
+    doc = f"{{}} of {what} (see :class:`{module}.{domain_class.__name__}`)."
+    shells = []
+    for name, shell, text in (
+        (scalar, DomainEnv, "One copy as a ``gymnasium.Env``"),
+        (batched, DomainVectorEnv, "N copies stepped at once"),
+    ):
+        signature = _signature(shell, domain_class, variant, max_episode_steps=domain_class.max_episode_steps)
+        shells.append(type(name, (shell,), {**attrs, "__doc__": doc.format(text), "__signature__": signature}))
+    return shells[0], shells[1]
+
+
+def _signature(shell: type, domain_class: type[Domain], variant: dict, **defaults) -> inspect.Signature:
+    """The shell's own arguments, then the domain's as keywords (defaults: ``defaults`` and ``variant``)."""
+    own = [
+        p.replace(default=defaults.get(name, p.default))
+        for name, p in inspect.signature(shell.__init__).parameters.items()
+        if name != "self" and p.kind is not p.VAR_KEYWORD
+    ]
+    domain = [
+        p.replace(default=variant.get(name, p.default), kind=p.KEYWORD_ONLY)
+        for name, p in inspect.signature(domain_class.__init__).parameters.items()
+        if name != "self"
+    ]
+    return inspect.Signature(own + domain)

@@ -1,40 +1,18 @@
-"""What pamdp's batched envs share: per-copy random streams and the Gymnasium ``VectorEnv`` shell.
+"""pamdp's one env shell: a domain's copies as a Gymnasium ``VectorEnv``, and what every domain shares.
 
-Every copy of a batched env draws only from its own generator, seeded as Gymnasium seeds the copies of its
-vector envs: ``reset(seed=s)`` gives copy i ``seed + i``, ``reset(seed=[s0, s1, ...])`` one seed each. A
-copy's trajectory therefore depends on its seed alone, not on how many copies run beside it, and copy i
-equals the scalar env reset with copy i's seed, step for step, noise included.
+A domain is a subclass of :class:`Domain` (see its docstring for the contract; ``envs/platform/env.py`` is
+a worked example): sizes, spaces, random numbers per step, one batch action parser and compiled per-copy
+``reset`` / ``step`` / ``observe`` looped over the copies. :class:`DomainVectorEnv` runs N copies of it;
+``pamdp.envs.scalar.DomainEnv`` is the same domain at N = 1. A variant (Hard Goal, Sliding, Hard Move's
+``n``, HFO's settings) is a constructor argument of the domain, passed through the registration's kwargs.
 
-Random numbers reach compiled code through :class:`RandomStreams`: each copy keeps a buffer of standard
-draws (``standard_normal`` or ``random``, one kind per domain) taken in blocks from its own generator, and
-a cursor. Drawing a block of ``k`` numbers gives the same numbers as ``k`` single draws, for NumPy's
-``Generator`` and ``RandomState`` alike, and a draw ``normal(0, s)`` is ``0.0 + s * z`` with ``z`` the
-next standard normal (``uniform(a, b)`` is ``a + (b - a) * u``), so a domain's step reads its numbers
-from the buffer in the order it needs them and consumes exactly its generator's stream. Before a step
-(or a reset that draws) Python tops up the buffers of the copies with fewer numbers left than one step can
-take; the compiled step never calls back.
+Every copy draws only from its own generator, seeded as Gymnasium seeds the copies of its vector envs:
+``reset(seed=s)`` gives copy i ``seed + i``, ``reset(seed=[s0, s1, ...])`` one seed each. A copy's
+trajectory therefore depends on its seed alone, not on how many copies run beside it, and copy i equals the
+scalar env reset with copy i's seed, step for step, noise included.
 
-How a domain plugs in (``envs/platform/batched.py`` is a worked example):
-
-- The scalar env subclasses ``pamdp.envs.scalar.ScalarEnv``, which keeps ``RandomStreams(1, draw,
-  capacity)``; before a step that draws, ``self._stream(need)`` follows ``self.np_random`` (dropping the
-  buffer when ``np_random`` was replaced, e.g. by ``numpy.random.RandomState(S)`` or by
-  ``reset(seed=...)``) and tops it up; the env hands ``buffers[0]`` and ``cursors[0]`` to the per-copy
-  step, which returns the new cursor.
-- The batched env subclasses :class:`BatchedVectorEnv`, sets the class attributes ``draw`` (the generator
-  method: ``"standard_normal"`` or ``"random"``), ``draws_per_step`` (the most numbers one copy can take
-  in one step, reset included) and ``buffer_size``, calls ``super().__init__(num_envs, single_env,
-  max_episode_steps, render_mode)`` and implements
-
-  * ``_reset_copies(mask, options) -> (observations, infos)``: put the copies where ``mask`` is true at
-    the start of an episode (``options`` as given to :meth:`~BatchedVectorEnv.reset`);
-  * ``_step_copies(actions, resetting) -> (observations, rewards, terminated, truncated, infos)``: check
-    the batch of ``actions``, reset the copies where ``resetting`` is true (next-step autoreset), step the
-    others with draws from ``self.streams.buffers`` / ``self.streams.cursors`` (advanced in place), and
-    return everything for every copy. The shell then zeroes the resetting copies' rewards and flags and
-    adds the time limit;
-  * ``_frames() -> tuple``: one picture per copy, which :meth:`~BatchedVectorEnv.render` returns with
-    ``render_mode="rgb_array"``.
+Random numbers reach compiled code through :class:`~pamdp.envs.streams.RandomStreams`, one buffer of draws per
+copy, topped up by the shell before a step; the compiled step never calls back.
 
 The shell does the rest: argument checks, seeding, ``options={"reset_mask": mask}``, next-step autoreset
 (the step after an episode ends returns the copy's reset observation, reward 0, both flags false), the
@@ -48,27 +26,13 @@ from collections.abc import Sequence
 
 import numba
 import numpy as np
-from gymnasium.utils import seeding
+from gymnasium.error import ResetNeeded
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-__all__ = ["RandomStreams", "BatchedVectorEnv", "copy_seeds", "check_render_mode", "split_actions", "column"]
+from pamdp.envs.streams import RandomStreams, copy_seeds
 
-DRAWS = ("standard_normal", "random")
-"""The generator methods a stream can draw with (both exist on ``Generator`` and ``RandomState``)."""
-
-
-def copy_seeds(seed, num_copies: int) -> list:
-    """The seed of each copy for ``reset(seed=seed)``: ``seed + i`` for an int, the list itself for a
-    list of ``num_copies`` ints (or None), ``num_copies`` Nones for None."""
-    if seed is None:
-        return [None] * num_copies
-    if isinstance(seed, (int, np.integer)) and not isinstance(seed, bool):
-        return [int(seed) + i for i in range(num_copies)]
-    if isinstance(seed, (list, tuple, np.ndarray)) and len(seed) == num_copies:
-        if all(s is None or (isinstance(s, (int, np.integer)) and not isinstance(s, bool)) for s in seed):
-            return [None if s is None else int(s) for s in seed]
-    raise ValueError(f"seed={seed!r}; expected None, an int, or a list of {num_copies} ints (or None), one per copy")
+__all__ = ["Domain", "DomainVectorEnv", "check_render_mode", "split_actions", "column"]
 
 
 def check_render_mode(render_mode, modes) -> None:
@@ -87,7 +51,7 @@ def split_actions(actions, domain: str, n: int, expected: str, n_actions=None, n
     a = np.asarray(actions[0])
     if a.shape != (n,) or a.dtype.kind not in "iu":
         raise ValueError(f"invalid discrete actions {actions[0]!r}; expected {expected}")
-    if n_actions is not None and (a.min() < 0 or a.max() >= n_actions):
+    if n_actions is not None and _outside(a, n_actions):
         bad = (a < 0) | (a >= n_actions)
         raise ValueError(f"discrete actions {a[bad]} at indices {np.flatnonzero(bad)}; expected {expected}")
     params = actions[1]
@@ -107,114 +71,139 @@ def column(p, n: int, name: int | str, expected: str) -> np.ndarray:
     return p.reshape(n)
 
 
-class RandomStreams:
-    """Per-copy buffers of standard draws, each taken in blocks from its copy's own generator.
+class Domain:
+    """The contract between a domain and the env shell; a domain subclasses it once, in its ``env.py``.
 
-    ``buffers`` is ``(num_copies, capacity)`` float64 and ``cursors`` ``(num_copies,)`` int64: copy i's
-    next number is ``buffers[i, cursors[i]]``. Code that consumes numbers advances ``cursors[i]``; it must
-    never read past ``capacity``, which :meth:`refill` ensures for up to ``need`` numbers.
+    An instance is one variant (its constructor takes the variant's arguments: Hard Move's ``n``, Goal's
+    ``hard``, HFO's settings...) for one env; it may keep per-copy arrays of its own beside the state rows, and
+    a variant may set its own sizes (``state_size``, the spaces) in its constructor: more players, another
+    observation.
+    It sets the class attributes below and ``action_space`` / ``observation_space`` (one copy's), and
+    implements:
 
-    Args:
-        num_copies: number of copies.
-        draw: the generator method that yields the numbers, ``"standard_normal"`` or ``"random"``.
-        capacity: numbers kept per copy; a copy is topped up when fewer than ``need`` are left, so a larger
-            capacity means fewer (but larger) draws.
+    * :meth:`parse`: check a batch of ``n`` actions (``batch_space`` of ``action_space``) and return the
+      arrays its compiled step reads, or raise ``ValueError`` naming the bad part and the expected form. The
+      scalar env hands it one action as a batch of one (:func:`pamdp.envs.scalar.as_batch`);
+    * :meth:`reset` and :meth:`step`: one compiled call each over the copies (``env._states`` rows,
+      ``env.streams`` buffers), returning batched observations, rewards, flags and infos in Gymnasium's
+      merged form (``info[k]`` an array, ``info["_" + k]`` which copies report it);
+    * :meth:`frame`: the picture of copy ``i`` for ``render_mode="rgb_array"`` (and :meth:`substep_frames`
+      where a step runs sub-steps worth showing).
     """
 
-    def __init__(self, num_copies: int, draw: str, capacity: int):
-        if draw not in DRAWS:
-            raise ValueError(f"draw={draw!r}; expected one of {DRAWS}")
-        if not isinstance(capacity, (int, np.integer)) or capacity < 1:
-            raise ValueError(f"capacity={capacity!r}; expected a positive integer")
-        self.draw = draw
-        self.capacity = int(capacity)
-        self.buffers = np.zeros((num_copies, self.capacity))
-        self.cursors = np.full(num_copies, self.capacity, dtype=np.int64)  # empty
-        self._generators: list = [None] * num_copies
+    name: str
+    """The domain's name in error messages."""
+    render_fps: int = 10
+    state_size: int
+    """Length of one copy's state row."""
+    draw: str = "random"
+    """The generator method a copy's numbers come from (see :class:`RandomStreams`)."""
+    reset_draws: int = 0
+    """The most numbers one copy's reset takes."""
+    step_draws: int = 0
+    """The most numbers one copy's step takes before it must be topped up (0: a step draws nothing)."""
+    buffer_size: int = 1
+    """Numbers kept per copy in the batched env."""
+    scalar_buffer_size: int = 1
+    """Numbers kept in the scalar env (just a reset's where nothing should be drawn ahead of ``np_random``)."""
+    max_episode_steps: int | None = None
+    """The registration's time limit, also the batched env's default; None leaves the end to the domain."""
 
-    @property
-    def generators(self) -> tuple:
-        """Each copy's generator (None until it is seeded or first drawn from)."""
-        return tuple(self._generators)
+    def initial_states(self, n: int) -> np.ndarray:
+        """The state rows ``(n, state_size)`` before the first reset (and where the domain keeps per-copy arrays
+        of its own, such as the last actions its pictures show, it allocates them here)."""
+        return np.zeros((n, self.state_size))
 
-    def set(self, i: int, rng) -> None:
-        """Make ``rng`` copy ``i``'s generator and drop the numbers drawn from the previous one."""
-        if not callable(getattr(rng, self.draw, None)):
-            raise ValueError(f"{rng!r} has no {self.draw}() method; expected a numpy Generator or RandomState")
-        self._generators[i] = rng
-        self.cursors[i] = self.capacity
+    def state(self, states: np.ndarray):
+        """What the envs' ``state`` shows of the rows (the scalar env's: copy 0's part of it)."""
+        return states.copy()
 
-    def follow(self, i: int, rng) -> None:
-        """:meth:`set` copy ``i``'s generator to ``rng`` unless it is that object already (the scalar envs'
-        ``np_random`` may be replaced at any time; the next step must then draw from the new one)."""
-        if rng is not self._generators[i]:
-            self.set(i, rng)
+    def parse(self, actions, n: int) -> tuple:
+        raise NotImplementedError
 
-    def seed(self, seed) -> None:
-        """Seed every copy as :func:`copy_seeds` says; a copy whose seed is None keeps its generator (or
-        gets one from fresh entropy if it has none), as a Gymnasium env does on ``reset(seed=None)``."""
-        for i, s in enumerate(copy_seeds(seed, len(self._generators))):
-            if s is not None or self._generators[i] is None:
-                self.set(i, seeding.np_random(s)[0])
+    def reset(self, env, mask: np.ndarray, options: dict | None, seeded: np.ndarray) -> tuple:
+        """Start an episode in the copies where ``mask`` is true (``seeded``: those just given a seed)."""
+        raise NotImplementedError
 
-    def refill(self, need: int) -> None:
-        """Top up every copy that has fewer than ``need`` numbers left: the rest moves to the front and the
-        buffer is filled from the copy's generator, in the generator's order."""
-        if need > self.capacity:
-            raise ValueError(f"need={need} numbers exceed the capacity {self.capacity}")
-        if not _any_above(self.cursors, self.capacity - need):  # most steps: a compiled test, no index array
-            return
-        for i in np.flatnonzero(self.cursors > self.capacity - need):
-            if self._generators[i] is None:
-                self.set(i, seeding.np_random(None)[0])
-            left = self.capacity - int(self.cursors[i])
-            row = self.buffers[i]
-            row[:left] = row[self.capacity - left :]
-            row[left:] = getattr(self._generators[i], self.draw)(self.capacity - left)
-            self.cursors[i] = 0
+    def step(self, env, parsed: tuple, resetting: np.ndarray) -> tuple:
+        """Reset the copies where ``resetting`` is true, step the others with the ``parsed`` actions."""
+        raise NotImplementedError
+
+    def frame(self, env, i: int) -> np.ndarray:
+        raise NotImplementedError
+
+    def substep_frames(self, env) -> list[np.ndarray]:
+        """The scalar env's frames of its last step: one per sub-step where a step runs several and the domain
+        records them (Platform, Goal; none after a reset), else the one after the step."""
+        return [self.frame(env, 0)]
 
 
-class BatchedVectorEnv(VectorEnv):
-    """The Gymnasium ``VectorEnv`` shell of pamdp's batched envs (see the module docstring for the hooks).
+class DomainVectorEnv(VectorEnv):
+    """``num_envs`` copies of a :class:`Domain`, stepped together, with Gymnasium's next-step autoreset.
+
+    Actions are batched like ``batch_space`` of the scalar action space (what
+    :meth:`pamdp.spaces.HybridActionSpace.to_env_batch` produces). The step that ends an episode returns its
+    last observation with ``terminated`` or ``truncated`` set; the next ``step`` ignores that copy's action,
+    resets it, and returns the reset observation with reward 0 and both flags false.
 
     Args:
         num_envs: number of copies N.
-        single_env: a scalar env of the domain; its spaces and render modes are taken over.
-        max_episode_steps: episodes are truncated after this many agent steps (``make_vec`` passes the
-            registration's value in). ``None`` leaves truncation to the domain.
-        render_mode: ``None`` or one of the scalar env's render modes; :meth:`render` returns one frame per
-            copy.
+        max_episode_steps: episodes are truncated after this many agent steps (default: the domain's,
+            which the registration also sets; ``make_vec`` passes it in). ``None`` leaves the end to the domain.
+        render_mode: ``None`` or ``"rgb_array"``; :meth:`render` then returns one frame per copy.
+        **variant: the domain's constructor arguments.
     """
 
     metadata = {"render_modes": ["rgb_array"], "autoreset_mode": AutoresetMode.NEXT_STEP}
-    draw: str = "standard_normal"
-    """The generator method the domain's numbers come from (see :class:`RandomStreams`)."""
-    draws_per_step: int = 0
-    """The most numbers one copy can take in one step or reset."""
-    buffer_size: int = 1
-    """Numbers kept per copy (at least :attr:`draws_per_step`)."""
+    domain_class: type[Domain]
+    variant: dict = {}
+    """Constructor arguments of the domain fixed by the class (Hard Goal's ``hard=True``)."""
 
-    def __init__(self, num_envs: int, single_env, max_episode_steps: int | None = None, render_mode=None):
+    def __init__(self, num_envs: int = 1, max_episode_steps="domain", render_mode=None, **variant):
         if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) or num_envs < 1:
             raise ValueError(f"num_envs must be a positive integer, got {num_envs!r}")
+        self.domain = domain = self.domain_class(**{**self.variant, **variant})
+        if max_episode_steps == "domain":
+            max_episode_steps = domain.max_episode_steps
         if max_episode_steps is not None and (
             isinstance(max_episode_steps, bool)
             or not isinstance(max_episode_steps, (int, np.integer))
             or max_episode_steps < 1
         ):
             raise ValueError(f"max_episode_steps must be a positive integer or None, got {max_episode_steps!r}")
-        check_render_mode(render_mode, single_env.metadata["render_modes"])
-        self.metadata = {**self.metadata, "render_fps": single_env.metadata["render_fps"]}
+        check_render_mode(render_mode, self.metadata["render_modes"])
+        self.metadata = {**self.metadata, "render_fps": domain.render_fps}
         self.num_envs = int(num_envs)
         self.max_episode_steps = max_episode_steps
         self.render_mode = render_mode
-        self.single_action_space = single_env.action_space
-        self.single_observation_space = single_env.observation_space
+        self.single_action_space = domain.action_space
+        self.single_observation_space = domain.observation_space
         self.action_space = batch_space(self.single_action_space, self.num_envs)
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
-        self.streams = RandomStreams(self.num_envs, self.draw, self.buffer_size)
+        self.streams = RandomStreams(self.num_envs, domain.draw, domain.buffer_size)
+        self._states = domain.initial_states(self.num_envs)
+        self.draws_per_step = max(domain.reset_draws, domain.step_draws)
         self._elapsed = np.zeros(self.num_envs, dtype=np.int64)
         self._autoreset = np.zeros(self.num_envs, dtype=bool)
+        self._started = False
+
+    def __getattr__(self, name: str):
+        # The domain's variant and tables (``n``, ``motions``, ``settings``...) read as the env's own.
+        if name == "np_random":  # its property refused it; Python then asks here, so the hint is given here
+            raise AttributeError("each copy has its own generator: read or assign np_randoms (one per copy)")
+        if name == "domain":
+            raise AttributeError(name)
+        return getattr(self.domain, name)
+
+    @property
+    def states(self) -> np.ndarray:
+        """A copy of the copies' state rows ``(N, state_size)`` (indices in the domain's dynamics module)."""
+        return self._states.copy()
+
+    @property
+    def state(self):
+        """The domain's view of the state rows, one entry per copy."""
+        return self.domain.state(self._states)
 
     # -- the copies' generators -------------------------------------------------------------------
     @property
@@ -243,6 +232,7 @@ class BatchedVectorEnv(VectorEnv):
 
         ``seed``: None, an int (copy i gets ``seed + i``) or a list with one seed (or None) per copy.
         """
+        seeded = np.array([s is not None for s in copy_seeds(seed, self.num_envs)])
         self.streams.seed(seed)
         mask = np.ones(self.num_envs, dtype=bool)
         if options is not None and "reset_mask" in options:
@@ -250,16 +240,20 @@ class BatchedVectorEnv(VectorEnv):
             if mask.shape != (self.num_envs,) or mask.dtype != np.bool_:
                 raise ValueError(f"reset_mask must be a bool array of shape ({self.num_envs},), got {mask!r}")
         self.streams.refill(self.draws_per_step)
-        obs, infos = self._reset_copies(mask, options)
+        obs, infos = self.domain.reset(self, mask, options, seeded)
+        self._started = True
         self._elapsed[mask] = 0
         self._autoreset[mask] = False
         return obs, infos
 
     def step(self, actions):
+        if not self._started:
+            raise ResetNeeded("call reset() before step()")
+        parsed = self.domain.parse(actions, self.num_envs)
         resetting = self._autoreset
         if self.draws_per_step:
             self.streams.refill(self.draws_per_step)
-        obs, rewards, terminated, truncated, infos = self._step_copies(actions, resetting)
+        obs, rewards, terminated, truncated, infos = self.domain.step(self, parsed, resetting)
         self._autoreset = np.empty(self.num_envs, dtype=bool)  # a new array: ``resetting`` was handed out
         limit = self.max_episode_steps or 0
         _end_step(resetting, rewards, terminated, truncated, self._elapsed, limit, self._autoreset)
@@ -267,17 +261,9 @@ class BatchedVectorEnv(VectorEnv):
 
     def render(self):
         """One frame per copy (a tuple) with ``render_mode="rgb_array"``, else None."""
-        return self._frames() if self.render_mode == "rgb_array" else None
-
-    # -- the domain's part ------------------------------------------------------------------------
-    def _frames(self) -> tuple:
-        raise NotImplementedError
-
-    def _reset_copies(self, mask: np.ndarray, options: dict | None):
-        raise NotImplementedError
-
-    def _step_copies(self, actions, resetting: np.ndarray):
-        raise NotImplementedError
+        if self.render_mode != "rgb_array":
+            return None
+        return tuple(self.domain.frame(self, i) for i in range(self.num_envs))
 
 
 # -- the shell's per-step bookkeeping, compiled: in NumPy it was a dozen array operations a step, at 1 024 copies
@@ -286,10 +272,11 @@ _jit = numba.njit(cache=True, nogil=True)
 
 
 @_jit
-def _any_above(values, limit) -> bool:
-    """Whether any of ``values`` exceeds ``limit``."""
-    for i in range(values.shape[0]):
-        if values[i] > limit:
+def _outside(a, n_actions) -> bool:
+    """Whether any of ``a`` lies outside ``0..n_actions - 1`` (one compiled pass: ``min`` and ``max`` are two
+    NumPy calls, a good part of checking one action)."""
+    for i in range(a.shape[0]):
+        if a[i] < 0 or a[i] >= n_actions:
             return True
     return False
 

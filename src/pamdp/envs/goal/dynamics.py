@@ -1,10 +1,12 @@
-"""Robot Soccer Goal's dynamics, written once from ``shared/specs/goal.md`` and compiled by Numba.
+"""Robot Soccer Goal's dynamics (``cycraig/gym-goal``, with MP-DQN's scaled features), written once and compiled
+by Numba.
 
 :func:`reset` puts one copy at the start of an episode and :func:`step` advances it by (part of) one
-agent step; the scalar env calls them for its one copy, :func:`reset_copies` and :func:`step_copies`
-loop them over the batched env's copies. A copy's state is a float64 row of :data:`STATE_SIZE` numbers
+agent step; :func:`reset_copies` and :func:`step_copies` loop them over the copies (the scalar env's one copy
+included). A copy's state is a float64 row of :data:`STATE_SIZE` numbers
 (player, keeper, ball: position, velocity and, for the two players, orientation; then the agent-step
-counter), updated in place. Section numbers in comments (``§7.1``) refer to the spec.
+counter), updated in place. Section numbers in comments (``§7.1``) refer to the project's
+written account of that code.
 
 Noise: every random number is a uniform one, ``uniform(lo, hi) = lo + (hi - lo) * u`` with ``u`` the
 next number of the copy's ``draws`` (NumPy's ``random()``: a block of them equals as many single draws,
@@ -333,16 +335,17 @@ def reset_copies(states, mask, draws, cursors):
 
 
 @jit
-def step_copies(states, kick, tx, ty, pending, draws, cursors, substeps, rewards, terminated, truncated):
+def step_copies(states, kick, tx, ty, pending, draws, cursors, substeps, rewards, terminated, truncated, trace):
     """:func:`step` for every copy ``i`` with ``pending[i]``; ``pending[i]`` is cleared once its agent
     step is finished. Row i of every array is copy i's; ``substeps`` (0 at the start of the agent step),
-    ``cursors``, ``rewards`` and the flags are updated. Returns whether any copy is still pending."""
-    no_trace = np.empty((0, TRACE_SIZE))
+    ``cursors``, ``rewards`` and the flags are updated; copy 0 records its sub-steps in ``trace`` (the scalar
+    env's rendering; no rows: nothing). Returns whether any copy is still pending."""
+    no_trace = trace[:0]
     left = False
     for i in range(states.shape[0]):
         if pending[i]:
             rewards[i], terminated[i], truncated[i], substeps[i], cursors[i], done = step(
-                states[i], kick[i], tx[i], ty[i], draws[i], cursors[i], substeps[i], no_trace
+                states[i], kick[i], tx[i], ty[i], draws[i], cursors[i], substeps[i], trace if i == 0 else no_trace
             )
             pending[i] = not done
             left = left or not done

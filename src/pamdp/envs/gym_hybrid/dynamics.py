@@ -1,12 +1,12 @@
-"""gym-hybrid's Moving and Sliding, written once from ``shared/specs/gym_hybrid.md`` and compiled by Numba.
+"""gym-hybrid's Moving and Sliding (``thomashirtz/gym-hybrid``), written once and compiled by Numba.
 
 The two domains share everything but the agent's ACCELERATE and BREAK (spec §3), so every function takes
 ``sliding`` (False: Moving, the agent moves along its heading; True: Sliding, it keeps a velocity direction
 of its own). A copy's state is row i of a float64 array of :data:`STATE_SIZE` columns (:data:`X` ...
 :data:`T`, and functions of them that a step would otherwise compute twice, :data:`D` ... :data:`SIN_PHI`),
 updated in place; the constructor's settings are a row of :data:`N_SETTINGS` numbers (:data:`DEFAULTS`).
-:func:`step` advances copy i by one agent step and :func:`reset` starts its episode; the scalar env calls
-them for its one copy (i = 0), :func:`step_copies` loops them over the copies of the batched env.
+:func:`step` advances copy i by one agent step and :func:`reset` starts its episode; :func:`step_copies` and
+:func:`reset_copies` loop them over the copies (the scalar env's one copy included).
 
 Random numbers: only a reset draws, six uniforms in the spec's §5 order, read from ``draws`` (standard
 uniforms of the copy's generator, ``pamdp.envs.vector``) as ``low + (high - low) * u``, which is how

@@ -1,23 +1,20 @@
-"""gym-hybrid's Moving-v0 and Sliding-v0 (Thomas Hirtz) as scalar Gymnasium envs, from ``shared/specs/gym_hybrid.md``.
+"""gym-hybrid's Moving and Sliding as one pamdp domain: its contract and its envs (the task:
+``pamdp.envs.gym_hybrid``).
 
-An agent in the square field [-1, 1]² must stop inside a target circle of radius 0.1. Every agent step is a
-parameterised action ``(a, p)``, and every action ends with the agent moving for ``delta_t`` at its speed:
+Action ``(a, (p_accelerate, p_turn, p_break))``, batched ``a`` of shape ``(N,)``, ``p_accelerate`` and
+``p_turn`` ``(N, 1)`` or ``(N,)`` (finite; the chosen one is clipped into its box) and ``p_break`` ``(N, 0)``.
+Observation (float64): agent x, y, speed, cos and sin of its heading, target x, y, the distance to the
+target, 1 within the target (``d <= 0.1``) else 0, and the elapsed fraction ``t / max_step``. ``state``:
+copies of the state rows (indices in ``dynamics``, with the heading ``THETA`` and Sliding's velocity
+direction ``PHI``, which the observation does not show).
 
-====  ==========  ===============  ================================================================
- a    name        parameter range  effect
-====  ==========  ===============  ================================================================
- 0    accelerate  [0, 1]           add ``0.5 p`` to the speed (Sliding: a thrust along the heading)
- 1    turn        [-1, 1]          turn the heading by ``(π/2) p``
- 2    break       none             slow down by 0.1, or stop below 0.1
-====  ==========  ===============  ================================================================
+Random numbers: a reset draws six uniforms in the original's order (the target, then the agent); nothing
+in a step is random, and the scalar env draws no number ahead, so assigning ``numpy.random.RandomState(S)``
+to its ``np_random`` after a first ``reset()`` replays the original driven by that generator.
 
-Moving's agent moves along its heading; Sliding's keeps a velocity direction of its own that thrust
-changes by vector addition, so turning does not redirect its motion. Each step pays the decrease of the
-distance to the target minus 0.001; stopping (speed exactly 0) strictly inside the target ends the episode
-with a bonus of 1 (``info["is_success"]``), leaving the field or taking a 201st step ends it with -1. Both
-are ``terminated``: the elapsed fraction of the 200 steps is in the observation.
-
-The dynamics are ``dynamics.step`` (compiled), shared with the batched envs of ``batched.py``.
+The original constructor's settings (``max_turn``, ``max_acceleration``, ``delta_t``, ``max_step``,
+``penalty``, ``break_value``) are constructor arguments too; the defaults are the original's and every
+published result's.
 """
 
 from __future__ import annotations
@@ -25,21 +22,21 @@ from __future__ import annotations
 import math
 import numbers
 
-import gymnasium
 import numpy as np
 from gymnasium import spaces
 
 import pamdp.envs.gym_hybrid.dynamics as dyn
 from pamdp.envs.gym_hybrid.render import RENDER_FPS, draw_gym_hybrid
-from pamdp.envs.scalar import ScalarEnv, number, split_action
+from pamdp.envs.scalar import env_classes
+from pamdp.envs.vector import Domain, column, split_actions
 
-__all__ = ["MovingEnv", "SlidingEnv", "gym_hybrid_action_space", "parse_action", "check_settings"]
+__all__ = ["GymHybrid", "MovingEnv", "SlidingEnv", "MovingVectorEnv", "SlidingVectorEnv", "check_settings"]
 
 ACTION_FORM = "(a, (p_accelerate, p_turn, p_break)) with a in {0, 1, 2}, p_accelerate and p_turn finite"
 
 
 def gym_hybrid_action_space() -> spaces.Tuple:
-    """``Tuple(Discrete(3), Tuple(Box(0, 1, (1,)), Box(-1, 1, (1,)), Box(0,)))``, float32 (§3): break has no
+    """``Tuple(Discrete(3), Tuple(Box(0, 1, (1,)), Box(-1, 1, (1,)), Box(0,)))``, float32: break has no
     parameter, hence its zero-size box."""
     boxes = (
         spaces.Box(np.float32(0.0), np.float32(1.0), shape=(1,), dtype=np.float32),
@@ -67,40 +64,17 @@ def check_settings(**settings) -> np.ndarray:
     return row
 
 
-class GymHybridEnv(ScalarEnv):
-    """What Moving and Sliding share; :class:`MovingEnv` and :class:`SlidingEnv` choose the agent.
-
-    Action: ``(a, (p_accelerate, p_turn, p_break))`` with ``a`` in {0, 1, 2}, ``p_accelerate`` and ``p_turn``
-    arrays of shape ``(1,)`` (a plain number is accepted too) and ``p_break`` of shape ``(0,)``; only the
-    chosen action's parameter is read, after clipping into its box. Malformed actions and NaN or infinite
-    parameters raise ``ValueError``.
-
-    Observation (float64): agent x, y, speed, cos and sin of its heading, target x, y, the distance to the
-    target, 1 within the target (``d <= 0.1``) else 0, and the elapsed fraction ``t / max_step`` (1.005 on
-    the last of at most 201 steps). ``info`` is empty but at the end of an episode: ``is_success``, True at
-    the goal.
-
-    Random numbers: ``reset`` draws six uniforms from ``self.np_random`` when it is called, in the
-    original's order (the target, then the agent); nothing in a step is random. Assigning
-    ``numpy.random.RandomState(S)`` to ``np_random`` after a first ``reset()`` replays the original driven
-    by that generator.
-
-    ``state`` is a copy of the internal state row (indices in ``dynamics``: the heading ``THETA`` and
-    Sliding's velocity direction ``PHI``, which the observation does not show).
-
-    Args:
-        render_mode: ``None`` or ``"rgb_array"`` (the field from above, see ``render.draw_gym_hybrid``).
-        max_turn, max_acceleration, delta_t, max_step, penalty, break_value: the original constructor's
-            settings; the defaults are the original's and every published result's.
-    """
-
-    metadata = {"render_modes": ["rgb_array"], "render_fps": RENDER_FPS}
-    sliding = False
-    """Which agent: Moving's (False) or Sliding's (True)."""
+class GymHybrid(Domain):
+    name = "gym-hybrid"
+    render_fps = RENDER_FPS
+    state_size = dyn.STATE_SIZE
+    reset_draws = scalar_buffer_size = dyn.DRAWS_PER_RESET
+    buffer_size = 64 * dyn.DRAWS_PER_RESET
+    """The numbers of 64 resets per copy: a copy's buffer is topped up once every 64 episodes."""
 
     def __init__(
         self,
-        render_mode: str | None = None,
+        sliding: bool = False,
         max_turn: float = np.pi / 2,
         max_acceleration: float = 0.5,
         delta_t: float = 0.005,
@@ -108,58 +82,54 @@ class GymHybridEnv(ScalarEnv):
         penalty: float = 0.001,
         break_value: float = 0.1,
     ):
-        obs_space = spaces.Box(-np.inf, np.inf, shape=(dyn.OBS_SIZE,), dtype=np.float64)
-        # Exactly one reset's numbers at a time, so np_random holds no number drawn ahead between resets.
-        states = dyn.INITIAL_STATE[None].copy()  # one row: the batched env's layout at N = 1
-        super().__init__(render_mode, gym_hybrid_action_space(), obs_space, states, "random", dyn.DRAWS_PER_RESET)
+        self.sliding = bool(sliding)
         self.settings = check_settings(
             max_turn=max_turn, max_acceleration=max_acceleration, delta_t=delta_t, max_step=max_step,
             penalty=penalty, break_value=break_value,
         )  # fmt: skip
-        self._started = False
+        self.action_space = gym_hybrid_action_space()
+        self.observation_space = spaces.Box(-np.inf, np.inf, shape=(dyn.OBS_SIZE,), dtype=np.float64)
 
-    def _observation(self) -> np.ndarray:
-        out = np.empty((1, dyn.OBS_SIZE))
-        dyn.observe(self._states, 0, self.settings, out)
-        return out[0]
+    def initial_states(self, n):
+        return np.tile(dyn.INITIAL_STATE, (n, 1))
 
-    def reset(self, *, seed: int | None = None, options: dict | None = None):
-        super().reset(seed=seed)
-        streams = self._stream(dyn.DRAWS_PER_RESET)
-        streams.cursors[0] = dyn.reset(self._states, 0, streams.buffers, streams.cursors[0])
-        self._started = True
-        return self._observation(), {}
+    def parse(self, actions, n):
+        """``a`` (n,) and the accelerate and turn parameters (n,), float32 or float64 as given (the compiled
+        step widens them to float64), not yet clipped."""
+        expected = f"{ACTION_FORM} arrays of shape ({n}, 1) or ({n},), p_break of shape ({n}, 0); a of shape ({n},)"
+        a, params = split_actions(actions, self.name, n, expected, n_params=3)
+        columns = []
+        for i in range(2):
+            p = column(params[i], n, i, expected)
+            columns.append(p if p.dtype in (np.float32, np.float64) else p.astype(np.float64))
+        if np.shape(params[2]) != (n, 0):
+            raise ValueError(f"invalid break parameters of shape {np.shape(params[2])}; expected {expected}")
+        bad = dyn.first_bad_action(a, *columns)  # one compiled pass instead of a NumPy pass per check
+        if bad >= 0:
+            raise ValueError(
+                f"copy {bad}: discrete action {int(a[bad])}, parameters {float(columns[0][bad])}, "
+                f"{float(columns[1][bad])}; expected {expected}"
+            )
+        return a, columns[0], columns[1]
 
-    def step(self, action):
-        if not self._started:
-            raise gymnasium.error.ResetNeeded("call reset() before step()")
-        a, p = parse_action(action)
-        reward, terminated, goal = dyn.step(self._states, 0, a, p, self.settings, self.sliding)
-        return self._observation(), reward, terminated, False, {"is_success": goal} if terminated else {}
+    def reset(self, env, mask, options, seeded):
+        obs = np.empty((env.num_envs, dyn.OBS_SIZE))
+        dyn.reset_copies(env._states, mask, self.settings, env.streams.buffers, env.streams.cursors, obs)
+        return obs, {}
 
-    def _frame(self):
-        return draw_gym_hybrid(self._states[0], self.sliding)
+    def step(self, env, parsed, resetting):
+        (a, p_accelerate, p_turn), n, streams = parsed, env.num_envs, env.streams
+        obs, rewards = np.empty((n, dyn.OBS_SIZE)), np.empty(n)
+        terminated, goal = np.empty(n, dtype=bool), np.empty(n, dtype=bool)
+        dyn.step_copies(
+            env._states, a, p_accelerate, p_turn, resetting, self.settings, self.sliding,
+            streams.buffers, streams.cursors, obs, rewards, terminated, goal,
+        )  # fmt: skip
+        return obs, rewards, terminated, np.zeros(n, dtype=bool), {"is_success": goal, "_is_success": terminated.copy()}
 
-
-class MovingEnv(GymHybridEnv):
-    """``pamdp/Moving-v0``: the agent moves along its heading (see :class:`GymHybridEnv`)."""
-
-    sliding = False
-
-
-class SlidingEnv(GymHybridEnv):
-    """``pamdp/Sliding-v0``: the agent keeps sliding along its velocity, which thrust changes by vector
-    addition and breaking to a stop re-aligns with the heading (see :class:`GymHybridEnv`)."""
-
-    sliding = True
+    def frame(self, env, i):
+        return draw_gym_hybrid(env._states[i], self.sliding)
 
 
-def parse_action(action) -> tuple[int, float]:
-    """Check one gym-hybrid ``action``; return ``(a, p)`` with ``p`` the chosen action's parameter as a
-    float64, not yet clipped (0.0 for break)."""
-    expected = f"{ACTION_FORM} numbers or shape-(1,) arrays, p_break of shape (0,)"
-    a, params = split_action(action, "gym-hybrid", 3, 3, expected)
-    values = [number(params[0], 0, expected), number(params[1], 1, expected)]
-    if np.shape(params[2]) != (0,):
-        raise ValueError(f"invalid break parameter {params[2]!r}; expected {expected}")
-    return a, values[a] if a < 2 else 0.0
+MovingEnv, MovingVectorEnv = env_classes(GymHybrid, __name__, "MovingEnv", "MovingVectorEnv")
+SlidingEnv, SlidingVectorEnv = env_classes(GymHybrid, __name__, "SlidingEnv", "SlidingVectorEnv", sliding=True)

@@ -1,14 +1,20 @@
-"""Hard Move (HyAR, Li et al. ICLR 2022) as a scalar Gymnasium env, from ``shared/specs/hard_move.md``.
+"""Hard Move as a pamdp domain: its contract and its two envs (the task: ``pamdp.envs.hard_move``).
 
-An agent on a plane has ``n`` evenly spaced actuators; discrete action ``a`` (one of ``2 ** n``) switches
-on the actuators of its bits (the most significant bit is actuator 0) and its one parameter ``p`` scales
-the resulting push. The agent must come within 0.2 of a target point. The reward is minus the squared
-distance to the target, ``20 - d2`` on arrival, which ends the episode (``terminated``); the registration's
-30-step limit is ``truncated``. The dynamics are ``pamdp.envs.particle``'s (compiled), shared with the
-batched env ``batched.HardMoveVectorEnv``.
+Action ``(a, (p_0, ..., p_{K-1}))`` with ``K = 2 ** n``, batched ``a`` of shape ``(N,)`` and each ``p``
+``(N, 1)`` or ``(N,)``, or all ``K`` stacked in one array ``(K, N, 1)`` or ``(K, N)``, which is faster to
+read at n = 10. Only each copy's own ``p_a`` is read and checked (finite); it is used as given, not clipped:
+``|p| > 1`` pushes harder, ``p < 0`` backwards. Observation ``[vx, vy, gx - ax, gy - ay]`` (float64).
+
+Random numbers: a reset draws the agent's then the target's position, ``uniform(-1, 1, 2)`` each, four
+``random()`` numbers of the copy's generator (the scalar env draws none ahead), so assigning
+``numpy.random.RandomState(S)`` to the scalar env's ``np_random`` replays the original driven by
+``np.random.seed(S)``. ``state`` holds copies of the state rows (indices in ``pamdp.envs.particle``),
+``motions`` the table of :func:`~pamdp.envs.hard_move.motions.motion_table`.
 """
 
 from __future__ import annotations
+
+from operator import attrgetter
 
 import numpy as np
 from gymnasium import spaces
@@ -16,78 +22,94 @@ from gymnasium import spaces
 import pamdp.envs.particle as particle
 from pamdp.envs.hard_move.motions import check_size, motion_table
 from pamdp.envs.hard_move.render import draw_hard_move
-from pamdp.envs.scalar import ScalarEnv, number, split_action
+from pamdp.envs.scalar import env_classes
+from pamdp.envs.vector import split_actions
 
-__all__ = ["HardMoveEnv", "hard_move_action_space", "parse_action"]
+__all__ = ["HardMove", "HardMoveEnv", "HardMoveVectorEnv", "hard_move_action_space"]
+
+STACK_AT_MOST = 256
+"""Up to this many boxes (n = 4, 6, 8) stacking all the parameters of a batch costs less than taking each
+copy's own; at n = 10 (1024 boxes) taking each copy's own costs less (docs/environments.md gives the speeds)."""
 
 
 def hard_move_action_space(n: int) -> spaces.Tuple:
-    """``Tuple(Discrete(2 ** n), Tuple(Box(-1, 1, (1,)) x 2 ** n))``, float32 (hard_move.md §2)."""
+    """``Tuple(Discrete(2 ** n), Tuple(Box(-1, 1, (1,)) x 2 ** n))``, float32."""
     box = {"low": np.float32(-1.0), "high": np.float32(1.0), "shape": (1,), "dtype": np.float32}
     k = 2 ** check_size(n)
     return spaces.Tuple((spaces.Discrete(k), spaces.Tuple(tuple(spaces.Box(**box) for _ in range(k)))))
 
 
-class HardMoveEnv(ScalarEnv):
-    """Hard Move with ``n`` actuators as a Gymnasium env (see the module docstring for the task).
+class HardMove(particle.ParticleDomain):
+    name = "Hard Move"
+    max_episode_steps = 30
 
-    Action: ``(a, (p_0, ..., p_{2^n - 1}))`` with each ``p`` an array of shape ``(1,)`` (or a plain
-    number); only ``p_a`` is read and checked (reading all ``2 ** n`` would cost more than the step). It is
-    used as given, not clipped: ``|p| > 1`` pushes harder, ``p < 0`` backwards. A malformed action, or a
-    NaN or infinite ``p_a``, raises ``ValueError``.
-
-    Observation: ``[vx, vy, gx - ax, gy - ay]`` (float64): the agent's velocity, the target relative to
-    the agent. ``info["is_success"]`` after a step: whether it reached the target (which ends the episode).
-
-    Random numbers: ``reset`` draws the agent's then the target's position, ``uniform(-1, 1, 2)`` each,
-    from ``self.np_random`` (as ``random()`` numbers, four per reset, never drawn ahead); a step draws
-    none. Assign ``numpy.random.RandomState(S)`` to ``np_random`` and ``reset()`` without a seed to replay
-    the original driven by ``np.random.seed(S)``; ``state`` is a copy of the internal state row (indices
-    in ``pamdp.envs.particle``), ``motions`` the table of :func:`motion_table`.
-
-    Args:
-        n: number of actuators, 4, 6, 8 or 10.
-        render_mode: ``None`` or ``"rgb_array"`` (the plane from above, see ``render.draw_hard_move``).
-    """
-
-    metadata = {"render_modes": ["rgb_array"], "render_fps": particle.RENDER_FPS}
-    observe = staticmethod(particle.observe)
-    obs_size = particle.OBS_SIZE
-
-    def __init__(self, n: int = 4, render_mode: str | None = None):
+    def __init__(self, n: int = 4):
+        super().__init__()
         self.n = check_size(n)
-        obs_space = spaces.Box(-np.inf, np.inf, shape=(particle.OBS_SIZE,), dtype=np.float64)
-        states = np.zeros((1, particle.STATE_SIZE))  # one row: the batched env's layout at N = 1
-        super().__init__(render_mode, hard_move_action_space(self.n), obs_space, states, "random", particle.RESET_DRAWS)
         self.motions = motion_table(self.n)
-        self._last_action: tuple[int, float] | None = None
+        self.action_space = hard_move_action_space(self.n)
 
-    def reset(self, *, seed: int | None = None, options: dict | None = None):
-        super().reset(seed=seed)
-        streams = self._stream(particle.RESET_DRAWS)
-        streams.cursors[0] = particle.reset(self._states[0], streams.buffers[0], streams.cursors[0])
-        self._last_action = None
-        return self._observation(), {}
+    def parse(self, actions, n):
+        """``a`` (n,) int64 and each copy's own parameter ``p[i] = p_{a[i]}[i]`` (n,) float64 (the compiled step
+        checks that it is finite).
 
-    def step(self, action):
-        a, p = parse_action(action, len(self.motions))
-        mx, my = self.motions[a]
-        reward, terminated = particle.hard_move_step(self._states[0], mx, my, p)
-        self._last_action = (a, p)
-        return self._observation(), reward, terminated, False, {"is_success": terminated}
+        The parameters are gathered without a Python loop over the ``K`` boxes or the copies: a sequence of at
+        most :data:`STACK_AT_MOST` boxes for several copies is stacked (in C) and read by fancy indexing, as a
+        stacked array is; from a longer one, or for one copy, ``map`` takes each copy's own box and value
+        (C-level iteration; only those boxes are checked).
+        """
+        k = len(self.motions)
+        expected = (
+            f"(a, (p_0, ..., p_{k - 1})) with a an int array of shape ({n},) in 0..{k - 1} and each p an array "
+            f"of shape ({n}, 1) or ({n},), or all of them stacked in one array of shape ({k}, {n}, 1) or ({k}, {n})"
+        )
+        a, params = split_actions(actions, self.name, n, expected, k)
+        a = a.astype(np.int64, copy=False)
+        if not isinstance(params, np.ndarray):
+            if not isinstance(params, (tuple, list)) or len(params) != k:
+                given = f"{len(params)} boxes" if isinstance(params, (tuple, list)) else f"a {type(params).__name__}"
+                raise ValueError(f"invalid parameters ({given}); expected {expected}")
+            if k > STACK_AT_MOST or n == 1:
+                return a, _gather(params, a, n, expected)
+            try:
+                params = np.asarray(params)
+            except ValueError:
+                raise ValueError(f"the parameter boxes differ in shape; expected {expected}") from None
+        if params.shape not in ((k, n, 1), (k, n)) or params.dtype.kind not in "iuf":
+            raise ValueError(f"parameters stacked to shape {params.shape}, dtype {params.dtype}; expected {expected}")
+        return a, params.reshape(k, n)[a, np.arange(n)].astype(np.float64, copy=False)
 
-    def _frame(self):
-        return draw_hard_move(self._states[0], self.n, *(self._last_action or (None, 0.0)))
+    def step(self, env, parsed, resetting):
+        (a, p), n, streams = parsed, env.num_envs, env.streams
+        obs, rewards, terminated = np.empty((n, particle.OBS_SIZE)), np.zeros(n), np.zeros(n, dtype=bool)
+        bad = particle.hard_move_copies(
+            env._states, a, p, self.motions, resetting, streams.buffers, streams.cursors, obs, rewards, terminated
+        )
+        if bad >= 0:
+            raise ValueError(f"copy {bad}: parameter {p[bad]} of action {a[bad]}; expected a finite number")
+        if env.render_mode is not None:
+            self.last_actions[:] = np.where(resetting, -1, a)
+            self.last_params[:] = p
+        # As Gymnasium's vector envs merge the scalar envs' infos: a copy that was reset reports nothing.
+        return obs, rewards, terminated, np.zeros(n, dtype=bool), self.infos(env, ~resetting, terminated.copy())
+
+    def frame(self, env, i):
+        a = int(self.last_actions[i])
+        return draw_hard_move(env._states[i], self.n, None if a < 0 else a, float(self.last_params[i]))
 
 
-def parse_action(action, n_actions: int) -> tuple[int, float]:
-    """Check one Hard Move ``action`` with ``n_actions`` discrete actions; return ``(a, p_a)``, ``p_a`` a
-    float64. Only ``p_a`` is checked."""
-    expected = (
-        f"(a, (p_0, ..., p_{n_actions - 1})) with a in 0..{n_actions - 1} and p_a a finite number or shape-(1,) array"
-    )
-    a, params = split_action(action, "Hard Move", n_actions, None, expected)
-    if not isinstance(params, (tuple, list)) or len(params) != n_actions:
-        given = f"{len(params)} boxes" if isinstance(params, (tuple, list)) else f"a {type(params).__name__}"
-        raise ValueError(f"invalid parameters ({given}); expected {expected}")
-    return a, number(params[a], a, expected, "parameter p_")
+def _gather(params, a, n: int, expected: str) -> np.ndarray:
+    """``params[a[i]][i]`` for every copy ``i``, by C-level iteration over the chosen boxes (checked)."""
+    chosen = list(map(params.__getitem__, a.tolist()))  # copy i's box
+    try:
+        shapes = set(map(attrgetter("shape"), chosen))
+        kinds = {dtype.kind for dtype in set(map(attrgetter("dtype"), chosen))}
+    except AttributeError:
+        raise ValueError(f"the chosen parameters are not all arrays; expected {expected}") from None
+    if not shapes <= {(n,), (n, 1)} or not kinds <= set("iuf"):
+        found = f"shapes {sorted(shapes)} and dtype kinds {sorted(kinds)}"
+        raise ValueError(f"the chosen parameters have {found}; expected {expected}")
+    return np.fromiter(map(np.ndarray.item, chosen, range(n)), np.float64, n)  # p_{a[i]}[i]
+
+
+HardMoveEnv, HardMoveVectorEnv = env_classes(HardMove, __name__, "HardMoveEnv", "HardMoveVectorEnv")

@@ -1,12 +1,12 @@
 """One copy of Half Field Offense 1v0: physics, referee, features and shaped reward, compiled by Numba.
 
-The one writing of ``shared/specs/hfo.md`` section 2 (cited below as "spec 2.x"): rcssserver 15.2.2's
+The one writing (``LARG/HFO`` and ``rcsoccersim/rcssserver``, cited below by the sections of the project's
+written account of them, "spec 2.x") of rcssserver 15.2.2's
 movement, kick, dash, turn, stamina and collisions, the agent-side processing that HFO's C++ agent
 (librcsc) applies to each low-level action, HFO's referee, the LOW_LEVEL_FEATURE_SET for one agent and
 Hausknecht & Stone's shaped reward. Every function works on one copy: its state is a float64 vector
-(the indices below) and its random numbers come from its own stream (:func:`uniform`). The scalar env
-calls :func:`step_one` and :func:`reset_one` for its copy; the batched env calls :func:`step_batch` and
-:func:`reset_batch`, one compiled loop over the copies. A change here changes both.
+(the indices below) and its random numbers come from its own stream (:func:`uniform`). The envs (the
+scalar one at one copy) call :func:`step_batch` and :func:`reset_batch`, one compiled loop over the copies.
 
 Frame (spec 2.1): the server's metres, goal centre at (52.5, 0), y grows "downwards", angles in
 degrees normalised to (-180, 180], +90 along +y, positive relative angles on the agent's right.
@@ -714,22 +714,25 @@ def ending(status, cfg):
     return status == GOAL or status == OUT_OF_BOUNDS or (timeout and timeout_terminal), timeout and not timeout_terminal
 
 
-# --- Entry points: one copy (the scalar env) and a loop over copies (the batched env) -----------
+# --- Entry points: the loops over the copies ----------------------------------------------------
 @jit
-def step_one(s, rng, a, x0, x1, cfg, f, obs):
-    """:func:`step_copy` of one copy; the observation, float32, into ``obs``. Returns ``(reward, status)``."""
-    reward, status = step_copy(s, rng, a, x0, x1, cfg, f)
-    for k in range(obs.shape[0]):
-        obs[k] = f[k]
-    return reward, status
-
-
-@jit
-def reset_one(s, rng, cfg, options, f, obs):
-    """:func:`start_episode` of one copy; the observation, float32, into ``obs``."""
-    start_episode(s, rng, cfg, options, f)
-    for k in range(obs.shape[0]):
-        obs[k] = f[k]
+def first_bad_action(a, dash_params, turn_params, kick_params):
+    """The checks of a batch of actions: ``(i, 0)`` for the first copy whose discrete action is not 0, 1 or 2
+    (an integral float counts as its integer), else ``(i, 1)`` for the first whose chosen action has a parameter
+    that is not finite, else ``(-1, 0)``."""
+    for i in range(a.shape[0]):
+        if not (a[i] == DASH or a[i] == TURN or a[i] == KICK):
+            return i, 0
+    for i in range(a.shape[0]):
+        if a[i] == DASH:
+            x0, x1 = dash_params[i, 0], dash_params[i, 1]
+        elif a[i] == TURN:
+            x0 = x1 = turn_params[i, 0]
+        else:
+            x0, x1 = kick_params[i, 0], kick_params[i, 1]
+        if not (math.isfinite(x0) and math.isfinite(x1)):
+            return i, 1
+    return -1, 0
 
 
 @jit

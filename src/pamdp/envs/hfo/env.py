@@ -1,13 +1,48 @@
-"""The scalar Half Field Offense env: one copy of ``dynamics``, stepped by its compiled ``step_one``."""
+"""Half Field Offense 1v0 as a pamdp domain: its contract and its two envs (the task: ``pamdp.envs.hfo``).
+
+``info`` holds ``status`` ("IN_GAME", "GOAL", "OUT_OF_BOUNDS" or "OUT_OF_TIME"), ``step``, the number of
+actions taken this episode, and ``action_mask``, bool ``(3,)``: which of DASH, TURN and KICK have an effect
+in the returned state (KICK only when the agent's kickable test passes, as HFO's agent sends it); when an
+episode ends also ``is_success`` (True on a goal). The observation returned with a terminal status is the
+true terminal state. ``reset(options=...)`` accepts ``ball`` (x, y), ``player`` (x, y) and ``body``
+(degrees), in the server's metres (goal centre at (52.5, 0)), each once or one per copy (a leading axis of
+size N); missing ones are drawn as usual.
+
+Random numbers: each copy draws placements and actuator noise from a stream of its own (four 64-bit words,
+``copy_streams[i]``, ``dynamics.seed_stream``) seeded from its generator whenever that is a new one (a seeded
+reset, an assignment to ``np_random`` or ``np_randoms``); a seed also turns the player to face the goal, as
+a new server run does. ``state`` is the live state rows (indices in ``dynamics``), through which the
+recorded traces set the simulator's state.
+
+The settings (constructor arguments of the domain, the scalar and the batched env):
+    profile: feature set of an HFO release: ``"hfo2016"`` (58 features, Hausknecht & Stone), ``"hfo2017"``
+        (59, the seed paper's; default) or ``"hfo2019"`` (59, current HFO normalisers). The reward reads the
+        features, so it scales with the profile's Dmax.
+    deterministic: zero the actuator noise (HFO's ``--deterministic``); placements stay random.
+    timeout_terminal: report OUT_OF_TIME as ``terminated`` (as dqn-hfo and MP-DQN treated it) instead of
+        ``truncated``. The untouched and trial clocks are not in the observation, so by default they count as
+        truncation.
+    body_reset: ``"carry"`` keeps the body angle from the end of the previous episode, as the real server does
+        (the first episode faces the goal); ``"uniform"`` draws it in (-180, 180].
+    first_step_reward: difference the first transition against the reset state. H&S's and gym-soccer's code
+        start differencing after the first action, so by default the first transition pays only the goal bonus.
+    terminal_deltas: pay the distance and kick terms on the terminal transition too. dqn-hfo zeroes them
+        (only +5 for a goal survives), which is the default.
+"""
 
 from __future__ import annotations
 
-import gymnasium
 import numpy as np
 from gymnasium import spaces
 
 import pamdp.envs.hfo.dynamics as dyn
-from pamdp.envs.hfo.interface import check_settings, draw_half_field, hfo_action_space, parse_action, reset_options
+from pamdp.envs.hfo.interface import check_settings, draw_half_field, hfo_action_space, parse_actions, reset_options
+from pamdp.envs.scalar import env_classes
+from pamdp.envs.vector import Domain
+
+__all__ = ["HalfFieldOffense", "HalfFieldOffenseEnv", "HalfFieldOffenseVectorEnv", "kick_mask"]
+
+_STATUS_NAMES = np.array(dyn.STATUS_NAMES)
 
 
 def kick_mask(states: np.ndarray) -> np.ndarray:
@@ -18,52 +53,13 @@ def kick_mask(states: np.ndarray) -> np.ndarray:
     return mask
 
 
-class HalfFieldOffenseEnv(gymnasium.Env):
-    """HFO 1v0: score on an empty goal from a random start, with HFO's low-level actions and features.
-
-    The simulation of rcssserver 15.2.2 and of HFO's agent and referee in ``shared/specs/hfo.md``; actions
-    in HFO's units: DASH(power in [0, 100], direction in [-180, 180] degrees off the body, rounded to a
-    multiple of 45), TURN(direction in [-180, 180], compensated for the player's speed as HFO's agent
-    does), KICK(power in [0, 100], direction in [-180, 180], silently dropped when the ball is not
-    kickable). Finite parameters outside those boxes are handled as HFO handles them: dash power is
-    clamped to [-100, 100] (negative power dashes backwards at twice the stamina cost), kick power to
-    [0, 100], and directions to [-180, 180]. Malformed or non-finite actions raise ``ValueError``.
-
-    Args:
-        render_mode: ``None`` or ``"rgb_array"`` (the half field from above).
-        profile: feature set of an HFO release (spec 2.8): ``"hfo2016"`` (58 features, Hausknecht &
-            Stone), ``"hfo2017"`` (59, the seed paper's; default) or ``"hfo2019"`` (59, current HFO
-            normalisers). The reward reads the features, so it scales with the profile's Dmax.
-        deterministic: zero the actuator noise (HFO's ``--deterministic``); placements stay random.
-        timeout_terminal: report OUT_OF_TIME as ``terminated`` (as dqn-hfo and MP-DQN treated it)
-            instead of ``truncated``. The untouched and trial clocks are not in the observation, so by
-            default they count as truncation.
-        body_reset: ``"carry"`` keeps the body angle from the end of the previous episode, as the real
-            server does (the first episode faces the goal, and so does a reset with a seed, so that a
-            seed reproduces an episode); ``"uniform"`` draws it in (-180, 180].
-        first_step_reward: difference the first transition against the reset state. H&S's and
-            gym-soccer's code start differencing after the first action, so by default the first
-            transition pays only the goal bonus.
-        terminal_deltas: pay the distance and kick terms on the terminal transition too. dqn-hfo zeroes
-            them (only +5 for a goal survives), which is the default.
-
-    ``info`` holds ``status`` ("IN_GAME", "GOAL", "OUT_OF_BOUNDS" or "OUT_OF_TIME"), ``step``, the
-    number of actions taken this episode, and ``action_mask``, bool ``(3,)``: which of DASH, TURN and KICK
-    have an effect in the returned state (KICK only when the agent's kickable test passes, as HFO's agent
-    sends it); when an episode ends also ``is_success`` (True on a goal). The
-    observation returned with a terminal status is the true terminal state. ``reset(options=...)``
-    accepts ``ball`` (x, y), ``player`` (x, y) and ``body`` (degrees), in the server's metres (goal
-    centre at (52.5, 0)); missing ones are drawn as usual. Every random number (placements, actuator
-    noise) comes from a stream seeded from ``np_random`` (``dynamics.seed_stream``; again whenever
-    ``np_random`` is replaced, as by a seeded reset), as in each copy of :class:`HalfFieldOffenseVectorEnv`.
-    ``state`` is the copy's state vector (indices in ``dynamics``).
-    """
-
-    metadata = {"render_modes": ["rgb_array"], "render_fps": 10}
+class HalfFieldOffense(Domain):
+    name = "Half Field Offense"
+    state_size = dyn.STATE_SIZE
+    # The shell's buffers stay empty: the numbers come from the copies' own streams.
 
     def __init__(
         self,
-        render_mode: str | None = None,
         profile: str = "hfo2017",
         deterministic: bool = False,
         timeout_terminal: bool = False,
@@ -71,57 +67,74 @@ class HalfFieldOffenseEnv(gymnasium.Env):
         first_step_reward: bool = False,
         terminal_deltas: bool = False,
     ):
-        check_settings(profile, body_reset, render_mode)
-        self.render_mode = render_mode
+        check_settings(profile, body_reset)
         self.profile = dyn.PROFILES[profile]
         self.settings = dyn.settings(
             self.profile, deterministic, timeout_terminal, terminal_deltas, first_step_reward, body_reset == "uniform"
         )
-        n = self.profile.n_features
-        self.observation_space = spaces.Box(-1.0, 1.0, (n,), dtype=np.float32)
+        self.observation_space = spaces.Box(-1.0, 1.0, (self.profile.n_features,), dtype=np.float32)
         self.action_space = hfo_action_space()
-        self.state = np.zeros(dyn.STATE_SIZE)  # the first episode faces the goal (body 0)
-        self.stream = np.zeros(4, dtype=np.uint64)
-        self._stream_source = None  # the generator that seeded the stream
-        self._features = np.zeros(59)
-        self._started = False
 
-    def reset(self, *, seed: int | None = None, options: dict | None = None):
-        super().reset(seed=seed)
-        placement = reset_options(options, 1)[0]
-        if seed is not None:
-            self.state[dyn.BODY] = 0.0  # a seed starts a new server run, whose first episode faces the goal
-        self._follow_np_random()
-        obs = np.empty(self.profile.n_features, dtype=np.float32)
-        dyn.reset_one(self.state, self.stream, self.settings, placement, self._features, obs)
-        self._started = True
-        return obs, {"status": "IN_GAME", "step": 0, "action_mask": kick_mask(self.state)}
+    def initial_states(self, n):
+        self.copy_streams = np.zeros((n, 4), dtype=np.uint64)
+        self._sources: list = [None] * n  # the generator that seeded each copy's stream
+        self._seen = -1  # the streams' replacements when they were last followed
+        return np.zeros((n, self.state_size))  # the first episode faces the goal (body 0)
 
-    def step(self, action):
-        if not self._started:
-            raise gymnasium.error.ResetNeeded("call reset() before step()")
-        a, x0, x1 = parse_action(action)
-        self._follow_np_random()
-        obs = np.empty(self.profile.n_features, dtype=np.float32)
-        reward, status = dyn.step_one(self.state, self.stream, a, x0, x1, self.settings, self._features, obs)
-        terminated, truncated = dyn.ending(status, self.settings)
-        info = {
-            "status": dyn.STATUS_NAMES[status],
-            "step": int(self.state[dyn.STEPS]),
-            "action_mask": kick_mask(self.state),
+    def state(self, states):
+        return states
+
+    def parse(self, actions, n):
+        return parse_actions(actions, n)
+
+    def _follow(self, env) -> None:
+        """Seed the stream of every copy whose generator is a new one."""
+        if env.streams.replacements == self._seen:
+            return
+        self._seen = env.streams.replacements
+        for i, rng in enumerate(env.streams.generators):
+            if rng is not self._sources[i]:
+                dyn.seed_stream(self.copy_streams[i], rng.random(4))
+                self._sources[i] = rng
+
+    def reset(self, env, mask, options, seeded):
+        placements = reset_options(options, env.num_envs, shell_keys=("reset_mask",))
+        self._follow(env)
+        env._states[mask & seeded, dyn.BODY] = 0.0  # a new server run faces the goal
+        obs = np.empty((env.num_envs, self.profile.n_features), dtype=np.float32)
+        dyn.reset_batch(env._states, self.copy_streams, mask, self.settings, placements, obs)
+        return obs, self._infos(env)
+
+    def step(self, env, parsed, resetting):
+        (a, dash, turn, kick), n = parsed, env.num_envs
+        self._follow(env)
+        obs = np.empty((n, self.profile.n_features), dtype=np.float32)
+        reward, status = np.empty(n), np.empty(n, dtype=np.int64)
+        terminated, truncated = np.empty(n, dtype=bool), np.empty(n, dtype=bool)
+        dyn.step_batch(
+            env._states, self.copy_streams, a, dash, turn, kick, resetting, self.settings, obs, reward, status,
+            terminated, truncated,
+        )  # fmt: skip
+        infos = self._infos(env, status)
+        infos["is_success"], infos["_is_success"] = status == dyn.GOAL, terminated | truncated
+        return obs, reward, terminated, truncated, infos
+
+    def _infos(self, env, status=None) -> dict:
+        every = np.ones(env.num_envs, dtype=bool)
+        names = _STATUS_NAMES[status] if status is not None else np.full(env.num_envs, "IN_GAME")
+        return {
+            "status": names,
+            "_status": every,
+            "step": env._states[:, dyn.STEPS].astype(np.int64),
+            "_step": every,
+            "action_mask": kick_mask(env._states),
+            "_action_mask": every,
         }
-        if terminated or truncated:
-            info["is_success"] = status == dyn.GOAL
-        return obs, reward, terminated, truncated, info
 
-    def render(self):
-        if self.render_mode != "rgb_array":
-            return None
-        return draw_half_field(self.state)
+    def frame(self, env, i):
+        return draw_half_field(env._states[i])
 
-    def _follow_np_random(self) -> None:
-        """Seed the stream from ``np_random`` if that is a new generator (a seeded reset or an assignment)."""
-        rng = self.np_random
-        if rng is not self._stream_source:
-            dyn.seed_stream(self.stream, rng.random(4))
-            self._stream_source = rng
+
+HalfFieldOffenseEnv, HalfFieldOffenseVectorEnv = env_classes(
+    HalfFieldOffense, __name__, "HalfFieldOffenseEnv", "HalfFieldOffenseVectorEnv"
+)

@@ -1,5 +1,5 @@
-"""What the scalar and the batched HFO env share at their boundary: the action space and the checks of
-actions, settings and reset options, and the top-down drawing for ``render_mode="rgb_array"``."""
+"""The HFO domain's boundary: the action space and the checks of batched actions, settings and reset options,
+and the top-down drawing for ``render_mode="rgb_array"``."""
 
 from __future__ import annotations
 
@@ -30,42 +30,12 @@ def hfo_action_space() -> spaces.Tuple:
     return spaces.Tuple((spaces.Discrete(3), spaces.Tuple(boxes)))
 
 
-def check_settings(profile: str, body_reset: str, render_mode) -> None:
-    """Raise ``ValueError`` for an unknown feature profile, body-reset rule or render mode."""
+def check_settings(profile: str, body_reset: str) -> None:
+    """Raise ``ValueError`` for an unknown feature profile or body-reset rule (the shell checks the render mode)."""
     if profile not in dyn.PROFILES:
         raise ValueError(f"profile={profile!r} is not one of {sorted(dyn.PROFILES)}")
     if body_reset not in ("carry", "uniform"):
         raise ValueError(f"body_reset={body_reset!r}; expected 'carry' (HFO's behaviour) or 'uniform'")
-    if render_mode not in (None, "rgb_array"):
-        raise ValueError(f"render_mode={render_mode!r}; expected None or 'rgb_array'")
-
-
-def parse_action(action) -> tuple[int, float, float]:
-    """``(a, first parameter, second parameter)`` of one action; ranges are clamped later, as HFO does."""
-    try:
-        a_raw, params = action
-        a = int(a_raw)
-    except (TypeError, ValueError):
-        raise ValueError(f"action {action!r} is malformed; expected {ACTION_FORM}") from None
-    if a != a_raw or not 0 <= a <= 2:
-        raise ValueError(f"discrete action {a_raw!r} is not 0 (DASH), 1 (TURN) or 2 (KICK)")
-    try:
-        p = params[a] if len(params) == 3 else None
-        x = p.tolist() if isinstance(p, np.ndarray) else list(p)
-    except (TypeError, ValueError, IndexError):
-        x = None
-    if not isinstance(x, list) or len(x) != PARAM_SIZES[a]:
-        raise ValueError(
-            f"parameters {params!r} are malformed for {ACTION_NAMES[a]}; expected {ACTION_FORM}, "
-            f"{ACTION_NAMES[a]}'s entry holding {PARAM_SIZES[a]} number(s)"
-        )
-    try:
-        x0, x1 = float(x[0]), float(x[-1])
-    except (TypeError, ValueError):
-        x0 = x1 = math.nan
-    if not (math.isfinite(x0) and math.isfinite(x1)):
-        raise ValueError(f"{ACTION_NAMES[a]} parameters {x} must be finite numbers")
-    return a, x0, x1
 
 
 def parse_actions(actions, n: int):
@@ -80,19 +50,15 @@ def parse_actions(actions, n: int):
         raise ValueError(f"actions are malformed; expected {expected}") from None
     if a.shape != (n,) or len(boxes) != 3 or any(b.shape != (n, m) for b, m in zip(boxes, PARAM_SIZES)):
         shapes = (a.shape, tuple(b.shape for b in boxes)) if len(boxes) == 3 else a.shape
-        raise ValueError(f"actions have shapes {shapes}; expected {expected}")
-    if not (a.dtype.kind in "iu" or np.all(a == np.round(a))) or np.count_nonzero((a < 0) | (a > 2)):
-        raise ValueError(f"discrete actions {a.tolist()} must be integers 0 (DASH), 1 (TURN) or 2 (KICK)")
-    a = a.astype(np.int64, copy=False)
+        raise ValueError(f"malformed actions of shapes {shapes}; expected {expected}")
     dash, turn, kick = boxes
-    # A finite sum means every parameter is finite (an overflow only sends us to the exact check).
-    if not np.isfinite(dash.sum() + turn.sum() + kick.sum()):
-        x0 = np.choose(a, (dash[:, 0], turn[:, 0], kick[:, 0]))
-        x1 = np.choose(a, (dash[:, 1], turn[:, 0], kick[:, 1]))
-        bad = np.flatnonzero(~(np.isfinite(x0) & np.isfinite(x1)))
-        if bad.size:
-            i = int(bad[0])
-            raise ValueError(f"copy {i}: action {int(a[i])} has non-finite parameters ({x0[i]}, {x1[i]})")
+    i, what = dyn.first_bad_action(a, dash, turn, kick)  # one compiled pass: NumPy's were most of a scalar step
+    if what == 0 and i >= 0:
+        raise ValueError(f"discrete actions {a.tolist()}; expected integers 0 (DASH), 1 (TURN) or 2 (KICK)")
+    a = a.astype(np.int64, copy=False)
+    if i >= 0:
+        x0, x1 = (dash[i], turn[i, [0, 0]], kick[i])[a[i]]
+        raise ValueError(f"copy {i}: action {a[i]} ({ACTION_NAMES[a[i]]}) has non-finite parameters ({x0}, {x1})")
     return a, dash, turn, kick
 
 

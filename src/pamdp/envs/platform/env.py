@@ -1,25 +1,14 @@
-"""Platform (Masson, Ranchod & Konidaris, AAAI 2016) as a scalar Gymnasium env, from ``shared/specs/platform.md``.
+"""Platform as a pamdp domain: its contract and its two envs (the task: ``pamdp.envs.platform``).
 
-The agent is a box that must cross three platforms, separated by two gaps, to reach the right edge
-(``x = 1035``) while avoiding two enemies that patrol platforms 1 and 2. Every agent step is a
-*parameterised action* ``(a, p)``:
+Action ``(a, (p_run, p_hop, p_leap))``, batched ``a`` of shape ``(N,)`` and each ``p`` ``(N, 1)`` or
+``(N,)``; only ``p_a`` is read, after clipping into its box, and every ``p`` must be finite. Observation:
+the 9 features of ``physics.observe``, float64 in ``[0, 1]`` (the reference's sub-step count is
+``info["substeps"]``, 0 after a reset). ``state``: ``player`` = ``[x, y, vx, vy]`` and ``enemies`` =
+``[[x1, dx1], [x2, dx2]]``, one entry per copy.
 
-====  ======  ===============  ==========================================================
- a    name    parameter range  effect
-====  ======  ===============  ==========================================================
- 0    run     [0, 30]          20 physics sub-steps, each adding ``p`` to vx (ground cap 70)
- 1    hop     [0, 720]         jump with vy = 35 aiming at horizontal speed ``p / 8.14``
- 2    leap    [0, 430]         jump with vy = 25 aiming at horizontal speed ``p / 6.10``
-====  ======  ===============  ==========================================================
-
-A jump lasts until the player is standing on a platform again (or the episode ends), so one agent
-step runs a variable number of sub-steps (``info["substeps"]``, ~72 on average for a random policy).
-
-The reward of a step is the horizontal progress ``(x_end - x_start) / 1035`` so the episode return is
-the fraction of the course covered (exactly 1.0 at the goal). Falling into a gap or touching an
-enemy ends the episode (``terminated``); the 200-step limit of the registration is ``truncated``.
-
-The dynamics are ``physics.step`` (compiled), shared with the batched env ``batched.PlatformVectorEnv``.
+Noise: a step draws standard normals in the order of the reference implementation, so assigning
+``numpy.random.RandomState(S)`` to the scalar env's ``np_random`` after ``reset()`` replays the reference
+driven by the same generator, bit for bit, and :class:`ZeroNoise` gives the noise-free dynamics.
 """
 
 from __future__ import annotations
@@ -29,12 +18,12 @@ from gymnasium import spaces
 
 import pamdp.envs.platform.physics as physics
 from pamdp.envs.platform.render import RENDER_FPS, draw_platform
-from pamdp.envs.scalar import ScalarEnv, number, split_action
+from pamdp.envs.scalar import env_classes
+from pamdp.envs.vector import Domain, column, split_actions
 
-__all__ = ["PlatformEnv", "ZeroNoise", "platform_action_space", "parse_action", "BUFFER_SIZE"]
+__all__ = ["Platform", "PlatformEnv", "PlatformVectorEnv", "ZeroNoise", "platform_action_space"]
 
-BUFFER_SIZE = 2048
-"""Standard normals kept drawn ahead per copy (a step takes ~150, at most ``physics.MAX_DRAWS``)."""
+NO_TRACE = np.empty((0, physics.TRACE_SIZE))
 
 
 class ZeroNoise:
@@ -50,84 +39,85 @@ class ZeroNoise:
 
 
 def platform_action_space() -> spaces.Tuple:
-    """``Tuple(Discrete(3), Tuple(Box(1), Box(1), Box(1)))`` with boxes [0, 30], [0, 720], [0, 430] (§3)."""
+    """``Tuple(Discrete(3), Tuple(Box(1), Box(1), Box(1)))`` with boxes [0, 30], [0, 720], [0, 430]."""
     boxes = tuple(spaces.Box(np.float32(0.0), np.float32(hi), shape=(1,), dtype=np.float32) for hi in physics.PARAM_MAX)
     return spaces.Tuple((spaces.Discrete(3), spaces.Tuple(boxes)))
 
 
-class PlatformEnv(ScalarEnv):
-    """The Platform domain as a Gymnasium env (see the module docstring for the task).
+class Platform(Domain):
+    name = "Platform"
+    render_fps = RENDER_FPS
+    state_size = physics.STATE_SIZE
+    draw = "standard_normal"
+    step_draws = physics.MAX_DRAWS
+    buffer_size = scalar_buffer_size = 2048
+    """A step takes ~150 normals, at most ``physics.MAX_DRAWS``."""
+    max_episode_steps = 200
 
-    Action: ``(a, (p_run, p_hop, p_leap))`` with ``a`` in {0, 1, 2} and each ``p`` an array of shape
-    ``(1,)`` (a plain number is accepted too); only ``p_a`` is read, after clipping into its box.
-    Actions that are malformed, or contain NaN or infinite parameters, raise ``ValueError``.
+    def __init__(self):
+        self.action_space = platform_action_space()
+        self.observation_space = spaces.Box(0.0, 1.0, shape=(physics.OBS_SIZE,), dtype=np.float64)
+        self.trace = np.empty((physics.MAX_SUBSTEPS, physics.TRACE_SIZE))  # the scalar env's sub-steps
+        self.substeps = 0
 
-    Observation: the 9 features of ``physics.observe``, float64 in ``[0, 1]``. The reference's
-    observation is ``(s, k)`` with ``k`` the sub-steps of the last step; here ``k`` is
-    ``info["substeps"]`` (0 after reset).
+    def initial_states(self, n):
+        return np.tile(physics.INITIAL_STATE, (n, 1))
 
-    Internal state (read it for tests and plots, not to control the env): ``player`` =
-    ``[x, y, vx, vy]`` and ``enemies`` = ``[[x1, dx1], [x2, dx2]]`` via :attr:`state`.
+    def state(self, states):
+        return {
+            "player": states[:, physics.X : physics.VY + 1].copy(),
+            "enemies": states[:, physics.E1X :].reshape(-1, 2, 2).copy(),
+        }
 
-    Noise: the step draws standard normals from ``self.np_random`` in blocks and uses them in the
-    order of the spec's §9, so the numbers it consumes are exactly its generator's stream. Assign
-    ``numpy.random.RandomState(S)`` to ``np_random`` after ``reset()`` to replay the reference
-    implementation driven by the same generator, bit for bit, or :class:`ZeroNoise` for the noise-free
-    dynamics (the numbers drawn ahead from the previous generator are dropped); ``reset(seed=...)``
-    installs a fresh generator.
-
-    Args:
-        render_mode: ``None`` or ``"rgb_array"``: :meth:`render` draws the course now (see
-            ``render.draw_platform``) and :meth:`render_substeps` every sub-step of the last step.
-    """
-
-    metadata = {"render_modes": ["rgb_array"], "render_fps": RENDER_FPS}
-
-    observe = staticmethod(physics.observe)
-    obs_size = physics.OBS_SIZE
-
-    def __init__(self, render_mode: str | None = None):
-        obs_space = spaces.Box(0.0, 1.0, shape=(physics.OBS_SIZE,), dtype=np.float64)
-        states = physics.INITIAL_STATE[None].copy()  # one row: the batched env's layout at N = 1
-        super().__init__(render_mode, platform_action_space(), obs_space, states, "standard_normal", BUFFER_SIZE)
-        self._trace = np.empty((physics.MAX_SUBSTEPS if render_mode else 0, physics.TRACE_SIZE))
-        self._substeps = 0
-
-    @property
-    def state(self) -> dict[str, np.ndarray]:
-        """A copy of the internal state: ``player`` = [x, y, vx, vy], ``enemies`` = [[x, dx], [x, dx]]."""
-        s = self._states[0]
-        return {"player": s[physics.X : physics.VY + 1].copy(), "enemies": s[physics.E1X :].reshape(2, 2).copy()}
-
-    # -- Gymnasium API --------------------------------------------------------------------------
-    def reset(self, *, seed: int | None = None, options: dict | None = None):
-        super().reset(seed=seed)
-        self._states[0] = physics.INITIAL_STATE
-        self._substeps = 0
-        return self._observation(), {"substeps": 0}
-
-    def step(self, action):
-        a, p = parse_action(action)
-        streams = self._stream(physics.MAX_DRAWS)
-        reward, terminated, substeps, streams.cursors[0] = physics.step(
-            self._states[0], a, p, streams.buffers[0], streams.cursors[0], self._trace
+    def parse(self, actions, n):
+        """``a`` (n,) and the chosen parameters ``p`` (n,), float64, clipped into their boxes."""
+        expected = (
+            f"(a, (p_run, p_hop, p_leap)) with a an int array of shape ({n},) in 0..2 and each p a finite "
+            f"array of shape ({n}, 1) or ({n},)"
         )
-        self._substeps = substeps
-        return self._observation(), reward, terminated, False, {"substeps": substeps}
+        a, params = split_actions(actions, self.name, n, expected, 3, 3)
+        columns = np.empty((3, n))
+        for i, p in enumerate(params):
+            columns[i] = column(p, n, i, expected)
+        chosen = np.empty(n)
+        bad = physics.choose(a, columns, chosen)
+        if bad >= 0:
+            p = columns[bad]
+            raise ValueError(f"parameter {bad} contains {p[~np.isfinite(p)]}; expected {expected}")
+        return a.astype(np.int64, copy=False), chosen
 
-    def _frame(self):
-        s = self._states[0]
+    def reset(self, env, mask, options, seeded):
+        env._states[mask] = physics.INITIAL_STATE
+        self.substeps = 0
+        return self._observe(env), _info(np.zeros(env.num_envs, dtype=np.int64))
+
+    def step(self, env, parsed, resetting):
+        (a, p), n, streams = parsed, env.num_envs, env.streams
+        env._states[resetting] = physics.INITIAL_STATE
+        rewards, terminated, substeps = np.zeros(n), np.zeros(n, dtype=bool), np.zeros(n, dtype=np.int64)
+        trace = self.trace if n == 1 and env.render_mode else NO_TRACE
+        physics.step_copies(
+            env._states, a, p, ~resetting, streams.buffers, streams.cursors, rewards, terminated, substeps, trace
+        )
+        self.substeps = int(substeps[0])
+        return self._observe(env), rewards, terminated, np.zeros(n, dtype=bool), _info(substeps)
+
+    def _observe(self, env):
+        out = np.empty((env.num_envs, physics.OBS_SIZE))
+        physics.observe(env._states, out)
+        return out
+
+    def frame(self, env, i):
+        s = env._states[i]
         return draw_platform(s[physics.X], s[physics.Y], s[physics.E1X], s[physics.E2X])
 
-    def render_substeps(self) -> list[np.ndarray]:
-        """With ``render_mode="rgb_array"``: one frame per sub-step of the last step (none after a reset),
-        the last one equal to :meth:`render`'s. ``pamdp.envs.rendering.record_episode`` plays these."""
-        return self._substep_frames(draw_platform)
+    def substep_frames(self, env):
+        return [draw_platform(*row) for row in self.trace[: self.substeps]]
 
 
-def parse_action(action) -> tuple[int, float]:
-    """Check one Platform ``action``; return ``(a, p)``: ``p`` is ``p_a`` clipped into its box, a float64."""
-    expected = "(a, (p_run, p_hop, p_leap)) with a in {0, 1, 2} and each p a finite number or shape-(1,) array"
-    a, params = split_action(action, "Platform", 3, 3, expected)
-    values = [number(p, i, expected) for i, p in enumerate(params)]
-    return a, min(max(values[a], 0.0), physics.PARAM_MAX[a])
+def _info(substeps: np.ndarray) -> dict:
+    # Every copy reports its sub-steps (0 after a reset), hence an all-true "_substeps" mask.
+    return {"substeps": substeps, "_substeps": np.ones(substeps.shape, dtype=bool)}
+
+
+PlatformEnv, PlatformVectorEnv = env_classes(Platform, __name__, "PlatformEnv", "PlatformVectorEnv")

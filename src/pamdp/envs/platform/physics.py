@@ -1,9 +1,10 @@
-"""Platform's dynamics, written once from ``shared/specs/platform.md`` and compiled by Numba.
+"""Platform's dynamics (Masson, Ranchod & Konidaris 2016, as ``cycraig/gym-platform`` codes them), written once
+and compiled by Numba.
 
-:func:`step` advances one copy by one agent step; the scalar env calls it for its one copy and
-:func:`step_copies` loops it over the copies of the batched env. A copy's state is a float64 row of
+:func:`step` advances one copy by one agent step and :func:`step_copies` loops it over the copies (the scalar
+env's one copy included). A copy's state is a float64 row of
 :data:`STATE_SIZE` numbers (:data:`X` ... :data:`E2DX`), updated in place. Section numbers in comments
-(``§7.6``) refer to the spec.
+(``§7.6``) refer to the project's written account of that code.
 
 Noise: the step reads standard normals from ``draws``, starting at ``cursor``, in the spec's §9 order
 (the jump's two numbers at take-off, then in every sub-step the player's, then the enemy's), and returns
@@ -18,6 +19,8 @@ file alone, so a constant imported from elsewhere could go stale in the cache.
 """
 
 from __future__ import annotations
+
+import math
 
 import numba
 import numpy as np
@@ -203,15 +206,30 @@ def step(state, a, p, draws, cursor, trace):
 
 
 @jit
-def step_copies(states, a, p, stepping, draws, cursors, rewards, terminated, substeps):
+def step_copies(states, a, p, stepping, draws, cursors, rewards, terminated, substeps, trace):
     """:func:`step` for every copy ``i`` with ``stepping[i]``: row i of ``states``, ``draws`` and the
-    other arrays is copy i's; ``cursors``, ``rewards``, ``terminated`` and ``substeps`` are written."""
-    no_trace = np.empty((0, TRACE_SIZE))
+    other arrays is copy i's; ``cursors``, ``rewards``, ``terminated`` and ``substeps`` are written.
+    Copy 0 records its sub-steps in ``trace`` (the scalar env's rendering; no rows: nothing)."""
+    no_trace = trace[:0]
     for i in range(states.shape[0]):
         if stepping[i]:
             rewards[i], terminated[i], substeps[i], cursors[i] = step(
-                states[i], a[i], p[i], draws[i], cursors[i], no_trace
+                states[i], a[i], p[i], draws[i], cursors[i], trace if i == 0 else no_trace
             )
+
+
+@jit
+def choose(a, params, out):
+    """Each copy's parameter of its action ``a[i]``, ``params[a[i], i]``, clipped into its box, into ``out``.
+    Returns the first action whose parameter column holds a number that is not finite (checked in every
+    column, before anything is written), else -1."""
+    for j in range(params.shape[0]):
+        for i in range(params.shape[1]):
+            if not math.isfinite(params[j, i]):
+                return j
+    for i in range(a.shape[0]):
+        out[i] = clip(params[a[i], i], 0.0, PARAM_MAX[a[i]])
+    return -1
 
 
 @jit

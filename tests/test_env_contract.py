@@ -1,0 +1,137 @@
+"""The contract every registered env keeps, one parametrized test each over the registry: copy i of the batched
+env equals the scalar env seeded ``seed + i`` step for step (next-step autoresets and the time limit included),
+an ended copy's next step is its reset, the registration's time limit truncates, malformed actions are refused
+before anything moves, and the scalar env is the batched one at one copy."""
+
+import gymnasium
+import numpy as np
+import pytest
+from gymnasium.vector import SyncVectorEnv
+
+import pamdp  # noqa: F401  (registers the envs)
+from pamdp.envs import _REGISTRATIONS
+
+CASES = [(env_id, {}) for env_id in _REGISTRATIONS] + [("pamdp/HardMove-v0", {"n": 8})]
+IDS = [env_id.removeprefix("pamdp/") + "".join(f"-{k}{v}" for k, v in kw.items()) for env_id, kw in CASES]
+
+
+def make_vec(env_id, kwargs, n, **extra):
+    return gymnasium.make_vec(env_id, num_envs=n, vectorization_mode="vector_entry_point", **kwargs, **extra)
+
+
+def shared_info_keys(got: dict, want: dict) -> list[str]:
+    return [k for k in want if not k.startswith("_") and k in got]
+
+
+@pytest.mark.parametrize("env_id, kwargs", CASES, ids=IDS)
+def test_copy_i_equals_a_scalar_env_seeded_seed_plus_i(env_id, kwargs):
+    n, seed = 3, 11
+    venv = make_vec(env_id, kwargs, n, max_episode_steps=9)  # short episodes: autoresets and truncations
+    ref = SyncVectorEnv([lambda: gymnasium.make(env_id, max_episode_steps=9, **kwargs) for _ in range(n)])
+    got, want = venv.reset(seed=seed), ref.reset(seed=seed)
+    np.testing.assert_array_equal(got[0], want[0])
+    venv.action_space.seed(seed)
+    ended = 0
+    for t in range(30):
+        action = venv.action_space.sample()
+        got, want = venv.step(action), ref.step(action)
+        for k in range(4):
+            np.testing.assert_array_equal(got[k], want[k], err_msg=f"t={t}, output {k}")
+        for key in shared_info_keys(got[4], want[4]):
+            np.testing.assert_array_equal(got[4][key], want[4][key], err_msg=f"t={t}, info {key}")
+        ended += int(np.sum(got[2] | got[3]))
+    assert ended > 0  # the comparison went through autoresets
+
+
+@pytest.mark.parametrize("env_id, kwargs", CASES, ids=IDS)
+def test_an_ended_copy_is_reset_on_its_next_step_and_the_time_limit_truncates(env_id, kwargs):
+    venv = make_vec(env_id, kwargs, 4, max_episode_steps=2)
+    obs, _ = venv.reset(seed=0)
+    venv.action_space.seed(0)
+    _, _, terminated, truncated, _ = venv.step(venv.action_space.sample())
+    assert not truncated.any()
+    _, _, terminated2, truncated2, _ = venv.step(venv.action_space.sample())
+    assert (truncated2 | terminated2 | terminated).all()  # at step 2 every copy still running is truncated
+    ended = terminated2 | truncated2
+    obs, rewards, terminated3, truncated3, _ = venv.step(venv.action_space.sample())
+    assert (rewards[ended] == 0).all() and not (terminated3[ended] | truncated3[ended]).any()
+
+
+@pytest.mark.parametrize("env_id, kwargs", CASES, ids=IDS)
+def test_the_scalar_env_is_the_batched_one_at_one_copy(env_id, kwargs):
+    env, venv = gymnasium.make(env_id, **kwargs).unwrapped, make_vec(env_id, kwargs, 1, max_episode_steps=None)
+    obs, _ = env.reset(seed=5)
+    vobs, _ = venv.reset(seed=5)
+    np.testing.assert_array_equal(vobs[0], obs)
+    venv.action_space.seed(5)
+    for _ in range(20):
+        batch = venv.action_space.sample()
+        action = (int(batch[0][0]), tuple(p[0] for p in batch[1]))
+        step, vstep = env.step(action), venv.step(batch)
+        if vstep[2][0] or vstep[3][0]:
+            break
+        np.testing.assert_array_equal(vstep[0][0], step[0])
+        assert (vstep[1][0], vstep[2][0], vstep[3][0]) == step[1:4]
+
+
+@pytest.mark.parametrize("env_id, kwargs", CASES, ids=IDS)
+def test_malformed_actions_are_refused_before_anything_moves(env_id, kwargs):
+    env, venv = gymnasium.make(env_id, **kwargs).unwrapped, make_vec(env_id, kwargs, 2)
+    env.reset(seed=0)
+    venv.reset(seed=0)
+    k = env.action_space[0].n
+    params = tuple(np.zeros(box.shape, box.dtype) for box in env.action_space[1])
+    batched = tuple(np.zeros((2,) + box.shape, box.dtype) for box in env.action_space[1])
+    before, vbefore = env.unwrapped._states.copy(), venv.unwrapped._states.copy()
+    for bad in (5, (0, 1, 2), (k, params), (0, params[:-1])):
+        with pytest.raises(ValueError, match="expected"):
+            env.step(bad)
+    for bad in (5, (np.array([0, k]), batched), (np.array([0, 0]), batched[:-1]), (np.full(2, 0.5), batched)):
+        with pytest.raises(ValueError, match="expected"):
+            venv.step(bad)
+    np.testing.assert_array_equal(env.unwrapped._states, before)
+    np.testing.assert_array_equal(venv.unwrapped._states, vbefore)
+
+
+@pytest.mark.parametrize("env_id, kwargs", CASES, ids=IDS)
+def test_the_shells_arguments_and_order_are_checked(env_id, kwargs):
+    batched = entry_of(gymnasium.spec(env_id).vector_entry_point)
+    for bad in (dict(num_envs=0), dict(num_envs=2.5), dict(max_episode_steps=0), dict(max_episode_steps=True)):
+        with pytest.raises(ValueError, match="must be a positive integer"):
+            batched(**{"num_envs": 2, **bad}, **gymnasium.spec(env_id).kwargs, **kwargs)
+    scalar = entry_of(gymnasium.spec(env_id).entry_point)
+    for make in (scalar, batched):
+        with pytest.raises(ValueError, match="render_mode='human' is not supported"):
+            make(render_mode="human", **gymnasium.spec(env_id).kwargs, **kwargs)
+    env, venv = gymnasium.make(env_id, **kwargs).unwrapped, make_vec(env_id, kwargs, 2)
+    with pytest.raises(gymnasium.error.ResetNeeded):
+        env.step(env.action_space.sample())
+    with pytest.raises(gymnasium.error.ResetNeeded):
+        venv.step(venv.action_space.sample())
+
+
+def entry_of(entry):
+    return gymnasium.envs.registration.load_env_creator(entry) if isinstance(entry, str) else entry
+
+
+@pytest.mark.parametrize("env_id, kwargs", CASES, ids=IDS)
+def test_seeds_generators_and_reset_mask(env_id, kwargs):
+    venv = make_vec(env_id, kwargs, 3)
+    venv.reset(seed=None)  # fresh entropy for every copy: fine
+    assert all(isinstance(g, np.random.Generator) for g in venv.np_randoms)
+    for seed in (3.5, [1, 2], [1, 2, "x"], True):
+        with pytest.raises(ValueError, match="expected None, an int, or a list of 3 ints"):
+            venv.reset(seed=seed)
+    with pytest.raises(AttributeError, match="np_randoms"):
+        venv.np_random = np.random.default_rng(0)
+    with pytest.raises(AttributeError, match="np_randoms"):
+        _ = venv.unwrapped.np_random
+    with pytest.raises(ValueError, match="expected one per copy"):
+        venv.np_randoms = [np.random.default_rng(0)]
+    with pytest.raises(ValueError, match="has no"):
+        venv.np_randoms = [np.random.default_rng(0), np.random.default_rng(1), object()]
+    reset_obs, _ = venv.reset(seed=0)
+    venv.action_space.seed(0)
+    moved, *_ = venv.step(venv.action_space.sample())
+    obs, _ = venv.reset(seed=[None, 1, None], options={"reset_mask": np.array([False, True, False])})
+    np.testing.assert_array_equal(obs, [moved[0], reset_obs[1], moved[2]])
