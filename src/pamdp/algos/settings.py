@@ -115,7 +115,7 @@ class AlgoConfig:
     vector_mode: str = setting(
         "auto",
         "How env copies are stepped: batched (one compiled loop over copies), sync (scalar copies in turn) or auto "
-        "(batched from 2 copies on, where the env has a batched version).",
+        "(batched wherever the env has a batched version, even for one copy).",
         one_of(("auto", "batched", "sync")),
     )
     device: str = setting(

@@ -27,9 +27,9 @@ __all__ = [
     "VectorStepper",
 ]
 
-# A batched env steps its copies in one compiled loop and beats scalar copies stepped in turn from two copies on
-# (benchmarks/platform_speed.md, benchmarks/hfo_speed.md); a single copy is scalar.
-AUTO_BATCH_MIN = 2
+# A batched env steps its copies in one compiled loop; since the scalar env is the batched one at one copy, even a
+# single copy steps faster batched than through SyncVectorEnv's per-copy Python (benchmarks/platform_speed.md).
+AUTO_BATCH_MIN = 1
 
 
 def env_spec(env_id: str) -> gymnasium.envs.registration.EnvSpec:
