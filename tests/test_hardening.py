@@ -527,3 +527,39 @@ def test_the_docs_index_names_every_algorithm():
     index = (Path(__file__).resolve().parents[1] / "docs" / "index.md").read_text()
     names = [entry.help.split(":")[0].split(" (")[0] for entry in ALGORITHMS.values()]  # "P-DQN (Xiong ..."
     assert [n for n in names if n not in index] == []
+
+
+# -- issue 46: runs on other systems ----------------------------------------------------------------------------
+
+
+def test_the_cli_starts_where_the_system_has_no_fcntl():
+    """Windows has no ``fcntl``: the command must start (and take its lock) without it."""
+    import subprocess
+    import sys
+
+    code = "import sys; sys.modules['fcntl'] = None\nfrom pamdp.cli import main\nraise SystemExit(main(['--version']))"
+    done = subprocess.run([sys.executable, "-W", "ignore", "-c", code], capture_output=True, text=True)
+    assert done.returncode == 0 and done.stdout.startswith("pamdp "), done.stderr
+
+
+def test_a_second_process_is_refused_while_the_first_writes_and_goes_on_after_it_ends(tmp_path, capsys):
+    import subprocess
+    import sys
+
+    out = tmp_path / "run"
+    hold = (
+        "import sys\nfrom pamdp.experiments.runner import run_lock\n"
+        f"with run_lock({str(out)!r}):\n    print('held', flush=True)\n    sys.stdin.read()"
+    )
+    first = subprocess.Popen([sys.executable, "-c", hold], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+    try:
+        assert first.stdout.readline() == "held\n"
+        argv = ["train", "patrpo", "--total-steps", "300", "--eval-episodes", "0", "--out", str(out), *TINY]
+        message = refusal(argv, capsys)
+        assert f"{out} is in use: pamdp process {first.pid} on" in message
+        assert sorted(os.listdir(out)) == [".lock", ".lock-holder"]  # the refused run wrote nothing
+    finally:
+        first.stdin.close()
+        first.wait(timeout=60)
+    assert main(argv) == 0  # the first has ended: its lock went with it
+    assert (out / "final_model.pt").exists()
