@@ -6,6 +6,7 @@ import errno
 import json
 import os
 import shutil
+from pathlib import Path
 
 import gymnasium
 import numpy as np
@@ -563,3 +564,40 @@ def test_a_second_process_is_refused_while_the_first_writes_and_goes_on_after_it
         first.wait(timeout=60)
     assert main(argv) == 0  # the first has ended: its lock went with it
     assert (out / "final_model.pt").exists()
+
+
+# -- issue 46: raw tracebacks ---------------------------------------------------------------------------------
+
+
+def _unwritable(tmp_path) -> str:
+    """A directory this process cannot write into: a read-only one, or for root (whom modes do not stop) sysfs."""
+    for where in (tmp_path / "read-only", Path("/sys")):
+        if where != Path("/sys"):
+            where.mkdir()
+            where.chmod(0o555)
+        try:
+            (where / "probe").mkdir()
+        except OSError:
+            return str(where)
+        (where / "probe").rmdir()
+    pytest.skip("no unwritable directory here")
+
+
+def test_reproduce_into_an_unwritable_out_is_one_line_naming_it_before_any_run(tmp_path, capsys, monkeypatch):
+    from pamdp.experiments import runner
+
+    def no_run(*args, **kwargs):
+        raise AssertionError("a run was started")
+
+    monkeypatch.setattr(runner, "run_all", no_run)
+    out = os.path.join(_unwritable(tmp_path), "results")
+    message = refusal(["reproduce", "platform", "--scale", "0.001", "--seeds", "0", "--out", out], capsys)
+    assert f"pamdp reproduce: error: {out}: " in message and "no such directory" not in message
+    assert not os.path.exists(out)
+
+
+def test_render_refuses_an_env_of_another_package_naming_its_action_space(tmp_path, capsys):
+    message = refusal(["render", "CartPole-v1", "--out", str(tmp_path / "x.gif")], capsys)
+    expected = "env 'CartPole-v1' has the action space Discrete(2), not a parameterized one; expected a pamdp env"
+    assert expected in message
+    assert not (tmp_path / "x.gif").exists()

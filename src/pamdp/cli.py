@@ -15,6 +15,7 @@ import dataclasses
 import datetime as dt
 import json
 import math
+import os
 import sys
 import types
 import typing
@@ -351,6 +352,10 @@ def cmd_reproduce(args) -> int:
 
         print(format_status(exp.name, [run_status(spec, out) for spec, out in jobs], args.workers), end="")
         return 0
+    root = Path(args.out) / exp.name
+    root.mkdir(parents=True, exist_ok=True)  # else every run would fail alike: refused here in one line naming it
+    if not os.access(root, os.W_OK):
+        raise ValueError(f"--out {args.out}: {root} is not writable; expected a directory this user may write into")
     budgets = sorted({spec.total_steps for spec, _ in jobs})
     steps = f"{budgets[0]:,}" if len(budgets) == 1 else f"{budgets[0]:,} to {budgets[-1]:,}"
     print(f"{exp.name}: {exp.description}; {len(jobs)} runs of {steps} steps", file=sys.stderr)
@@ -426,6 +431,7 @@ def cmd_render(args) -> int:
     from pamdp.algos import load_model
     from pamdp.algos.vector_env import env_creator
     from pamdp.envs.rendering import record_episode
+    from pamdp.spaces import HybridActionSpace
 
     if args.source in gymnasium.registry:
         env_id, env_kwargs, policy = args.source, {}, None
@@ -435,8 +441,24 @@ def cmd_render(args) -> int:
     modes = getattr(env_creator(env_id), "metadata", {}).get("render_modes", [])
     if "rgb_array" not in modes:
         raise ValueError(f"env {env_id!r} draws no frames (render modes {modes}); expected one with 'rgb_array'")
-    env = gymnasium.make(env_id, render_mode="rgb_array", **env_kwargs)
-    path, total = record_episode(env, policy, args.out, seed=args.seed)
+    try:  # another package's env: its own errors (a missing drawing library) in one line too
+        env = gymnasium.make(env_id, render_mode="rgb_array", **env_kwargs)
+    except gymnasium.error.Error as exc:
+        raise ValueError(f"env {env_id!r} cannot be made ({exc})") from None
+    try:
+        HybridActionSpace.from_gym(env.action_space)
+    except ValueError:
+        env.close()
+        raise ValueError(
+            f"env {env_id!r} has the action space {env.action_space}, not a parameterized one; expected a pamdp env "
+            f"such as {', '.join(sorted(k for k in gymnasium.registry if k.startswith('pamdp/'))[:3])}"
+        ) from None
+    try:
+        path, total = record_episode(env, policy, args.out, seed=args.seed)
+    except gymnasium.error.Error as exc:
+        raise ValueError(f"env {env_id!r} cannot draw its frames ({exc})") from None
+    finally:
+        env.close()
     print(f"wrote {path} (return {total:.4f})")
     return 0
 
