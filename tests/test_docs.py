@@ -77,3 +77,9 @@ def test_relative_links_and_their_anchors_resolve():
             elif anchor and dest.suffix == ".md" and anchor not in _anchors(dest):
                 broken.append(f"{page.relative_to(ROOT)}: {target} (no such heading in {dest.name})")
     assert not broken, "\n".join(broken)
+
+
+def test_the_suite_table_in_the_results_page_is_the_generated_one():
+    results = ROOT / "docs" / "results.md"
+    generated = (ROOT / "docs" / "results" / "benchmark-suite" / "suite.md").read_text()
+    assert generated in results.read_text()
