@@ -83,3 +83,27 @@ def test_the_suite_table_in_the_results_page_is_the_generated_one():
     results = ROOT / "docs" / "results.md"
     generated = (ROOT / "docs" / "results" / "benchmark-suite" / "suite.md").read_text()
     assert generated in results.read_text()
+
+
+def test_the_generated_tables_of_the_docs_are_up_to_date():
+    """The commands, algorithms, experiments and env ids tables (docs/cli.md, docs/environments.md) are the code's."""
+    done = subprocess.run(
+        [sys.executable, str(ROOT / "docs" / "gen_cli_tables.py"), "--check"], capture_output=True, text=True
+    )
+    assert done.returncode == 0, f"run `python docs/gen_cli_tables.py`\n{done.stdout}{done.stderr}"
+
+
+def test_the_readme_names_every_algorithm_and_experiment_of_the_code():
+    from pamdp.algos import ALGORITHMS
+    from pamdp.experiments import available_experiments
+
+    readme = (ROOT / "README.md").read_text()
+    assert [f"`{name}`" for name in [*ALGORITHMS, *available_experiments()] if f"`{name}`" not in readme] == []
+
+
+def test_no_doc_cites_files_a_user_of_the_package_never_has():
+    """The docs and the command's own modules cite the public sources, not the project's private specs."""
+    pages = [ROOT / "README.md", ROOT / "docs" / "cli.md", ROOT / "docs" / "index.md", ROOT / "docs" / "results.md"]
+    code = [ROOT / "src" / "pamdp" / "cli.py", *sorted((ROOT / "src" / "pamdp" / "experiments").rglob("*.py"))]
+    citing = [str(p.relative_to(ROOT)) for p in [*pages, *code] if "shared/specs" in p.read_text()]
+    assert citing == []

@@ -24,6 +24,7 @@ from pathlib import Path
 from pamdp import __version__
 from pamdp._memory import keep_freed_memory
 from pamdp.algos import ALGORITHMS, algorithm_class
+from pamdp.experiments import available_experiments
 from pamdp.experiments.runner import RunSpec, train_run
 from pamdp.presets import default_preset, preset_names
 
@@ -188,7 +189,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"pamdp {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
 
-    train = sub.add_parser("train", help="train an algorithm (default: on Platform) and evaluate it")
+    names = [name for name in ALGORITHMS if algorithm_class(name) is not None]
+    train = sub.add_parser("train", help=f"train {', '.join(names)} (default env: Platform), then evaluate it")
     algos = train.add_subparsers(dest="algo", required=True, metavar="ALGO")
     for name in ALGORITHMS:
         cls = algorithm_class(name)
@@ -235,8 +237,10 @@ def build_parser() -> argparse.ArgumentParser:
     ev.add_argument("--stochastic", action="store_true", help="sample actions instead of the greedy ones")
     ev.add_argument("--json", action="store_true", help="print one JSON object")
 
-    rp = sub.add_parser("reproduce", help="run one of the paper's experiments (all settings and seeds) and plot it")
-    rp.add_argument("name", help="platform, step-size, kl-estimators, soccer, or an experiment TOML file")
+    rp = sub.add_parser(
+        "reproduce", help="run an experiment (the paper's figures, the benchmark suite) and plot it: all runs and seeds"
+    )
+    rp.add_argument("name", help=f"{', '.join(available_experiments())}, or an experiment TOML file")
     rp.add_argument("--seeds", type=_seed_list, default=None, help="comma-separated seeds (default: the experiment's)")
     rp.add_argument(
         "--runs", type=_items, default=None, help="comma-separated run labels to run (default: all), e.g. --runs PATRPO"
@@ -454,12 +458,13 @@ def cmd_render(args) -> int:
             f"such as {', '.join(sorted(k for k in gymnasium.registry if k.startswith('pamdp/'))[:3])}"
         ) from None
     try:
-        path, total = record_episode(env, policy, args.out, seed=args.seed)
+        fps = env.metadata.get("render_fps") or 20  # the env's real time (Goal's sub-steps: 30 a second)
+        path, total = record_episode(env, policy, args.out, seed=args.seed, fps=fps)
     except gymnasium.error.Error as exc:
         raise ValueError(f"env {env_id!r} cannot draw its frames ({exc})") from None
     finally:
         env.close()
-    print(f"wrote {path} (return {total:.4f})")
+    print(f"wrote {path} (return {total:.4f}, {fps:g} frames a second)")
     return 0
 
 
