@@ -601,3 +601,15 @@ def test_render_refuses_an_env_of_another_package_naming_its_action_space(tmp_pa
     expected = "env 'CartPole-v1' has the action space Discrete(2), not a parameterized one; expected a pamdp env"
     assert expected in message
     assert not (tmp_path / "x.gif").exists()
+
+
+def test_a_run_resumed_with_its_envs_default_arguments_spelt_out_goes_on_and_another_shape_is_refused(tmp_path, capsys):
+    """Hard Move's ``{"n": 4}`` is its default ``{}``: the same run. ``{"n": 6}`` is an env of another shape, refused in
+    one line naming both (loading the model into it would be torch's "size mismatch")."""
+    out = tmp_path / "run"
+    argv = ["train", "patrpo", "--env", "pamdp/HardMove-v0", "--eval-episodes", "0", "--out", str(out), *TINY]
+    assert main([*argv, "--total-steps", "500"]) == 0
+    message = refusal([*argv, "--total-steps", "1000", "--env-kwargs", '{"n": 6}'], capsys)
+    assert "env_kwargs: {} in the run, {'n': 6} asked" in message
+    assert main([*argv, "--total-steps", "1000", "--env-kwargs", '{"n": 4}']) == 0
+    assert "resuming" in capsys.readouterr().err

@@ -160,13 +160,30 @@ def _read_run_json(path: Path) -> dict:
     return recorded
 
 
+def env_defaults(env: str) -> dict:
+    """The arguments of ``env``'s constructor that have defaults (``{"n": 4, ...}`` for Hard Move; ``{}`` for an
+    unregistered env or a constructor without a signature)."""
+    import inspect
+
+    from pamdp.algos.vector_env import env_creator
+
+    try:
+        params = inspect.signature(env_creator(env)).parameters.values()
+    except (ValueError, TypeError):
+        return {}
+    return {p.name: p.default for p in params if p.default is not inspect.Parameter.empty}
+
+
 def _differences(recorded: dict, asked: dict) -> list[str]:
     """What differs between a recorded run and the one asked for, setting by setting: ``delta: 0.01 in the
-    run, 0.05 asked``."""
+    run, 0.05 asked``. Env arguments count with their defaults: Hard Move's ``{"n": 4}`` is its ``{}``."""
     differ = []
-    for key in ("env", "env_kwargs"):
-        if recorded.get(key) != asked[key]:
-            differ.append(f"{key}: {recorded.get(key)!r} in the run, {asked[key]!r} asked")
+    if recorded.get("env") != asked["env"]:
+        differ.append(f"env: {recorded.get('env')!r} in the run, {asked['env']!r} asked")
+    else:
+        defaults = env_defaults(asked["env"])
+        if {**defaults, **(recorded.get("env_kwargs") or {})} != {**defaults, **asked["env_kwargs"]}:
+            differ.append(f"env_kwargs: {recorded.get('env_kwargs')!r} in the run, {asked['env_kwargs']!r} asked")
     old, new = recorded.get("config", {}), asked["config"]
     for name in sorted(set(old) | set(new)):
         if old.get(name) != new.get(name):

@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from pamdp.algos.logger import success_of
+from pamdp.experiments.runner import env_defaults
 
 __all__ = [
     "DOMAINS",
@@ -67,26 +68,13 @@ HYAR_TABLE: dict[str, dict[str, str]] = {
 }
 
 
-def _env_defaults(env: str) -> dict:
-    """The env's constructor arguments that have defaults (``{"n": 4, ...}`` for Hard Move; ``{}`` if unknown)."""
-    import inspect
-
-    from pamdp.algos.vector_env import env_creator
-
-    try:
-        params = inspect.signature(env_creator(env)).parameters.values()
-    except (ValueError, TypeError):  # an unregistered env, or a creator without a signature
-        return {}
-    return {p.name: p.default for p in params if p.default is not inspect.Parameter.empty}
-
-
 def domain_of(recorded: dict) -> str | None:
     """The suite domain a run's ``run.json`` describes (``None`` for an env outside it). The env's arguments count
     with its defaults: a Hard Move run that gave no ``n`` is a run of its default ``n = 4``."""
     env = recorded.get("env")
     if env not in {e for _, e, _ in DOMAINS}:
         return None
-    defaults = _env_defaults(env)
+    defaults = env_defaults(env)
     given = {**defaults, **(recorded.get("env_kwargs") or {})}
     for name, domain_env, kwargs in DOMAINS:
         if env == domain_env and given == {**defaults, **kwargs}:
