@@ -34,8 +34,8 @@ class _Rounds:
 
 
 def _tree(directory: Path) -> list[Path]:
-    """The files, less the lock file that each side holds for itself."""
-    return sorted(p for p in directory.rglob("*") if p.is_file() and p.name != ".lock")
+    """The files, less the lock file and its holder's name, which each side keeps for itself."""
+    return sorted(p for p in directory.rglob("*") if p.is_file() and p.name not in (".lock", ".lock-holder"))
 
 
 def _same_files(a: Path, b: Path) -> None:
