@@ -576,6 +576,12 @@ def test_the_suite_table_counts_as_seeds_only_runs_of_one_budget_and_settings(tm
     assert len(digest) == 1 and rows[digest[0]] == "0.70 +- 0.00 (1 seed)"
     assert list(rows).index("Goal") == 1 + 3  # the other settings' rows follow their domain's
     assert len(json.loads(report["suite_finals"].read_text())) == 6  # every run kept, none overwritten
+    # results.md groups the runs alike: the two tables agree on what a seed of a setting is
+    groups = [line.split(" | ")[:3] for line in report["table"].read_text().splitlines()[2:]]
+    assert sorted(seeds for _, seeds, _ in groups) == ["1", "1", "1", "3"]
+    full = next(greedy for _, seeds, greedy in groups if seeds == "3")
+    assert full.startswith(f"0.900 +- {np.std([1.0, 0.9, 0.8]):.3f} (3 evaluated")
+    assert [name for name, _, _ in groups if "2,000 steps" in name] == ["| PATRPO on Platform (2,000 steps)"]
 
 
 def test_the_suite_table_takes_hard_move_without_n_as_its_default_n(tmp_path):
