@@ -614,3 +614,14 @@ def test_the_committed_suite_table_is_the_one_its_archive_gives():
     results = Path(__file__).resolve().parents[1] / "docs" / "results" / "benchmark-suite"
     table = suite_table(load_finals(results / "suite-finals.json"))
     assert (results / "suite.md").read_text() == table + "\n"
+
+
+def test_a_run_recorded_before_a_setting_existed_is_a_seed_of_one_recorded_after():
+    from pamdp.algos.patrpo import PATRPOConfig
+    from pamdp.experiments.suite import setting_of
+
+    now = {**PATRPOConfig.preset("tuned").to_dict(), "seed": 1}
+    before = {k: v for k, v in now.items() if k != "device"}  # written before the device setting was added
+    run = {"algo": "patrpo", "total_steps": 1000, "preset": "tuned"}
+    assert setting_of({**run, "config": before}) == setting_of({**run, "config": {**now, "seed": 2}})
+    assert setting_of({**run, "config": before}) != setting_of({**run, "config": {**now, "delta": 0.5}})

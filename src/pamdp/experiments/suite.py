@@ -89,6 +89,19 @@ def method_of(label: str, domain: str) -> str:
     return label[: -len(suffix)] if label.endswith(suffix) and len(label) > len(suffix) else label
 
 
+def _with_defaults(algo, config: dict) -> dict:
+    """A recorded config with the settings added since it was written at their defaults (as a resume counts them),
+    so that a run recorded before a setting existed is a seed of one recorded after; as recorded where the
+    algorithm is unknown or the config no longer loads."""
+    from pamdp.algos import algorithm_class
+
+    try:
+        cls = algorithm_class(algo) if isinstance(algo, str) else None
+        return config if cls is None else cls.config_class.from_dict(config).to_dict()
+    except (ValueError, TypeError):  # an unknown algorithm, or settings it no longer takes
+        return config
+
+
 def setting_of(recorded: dict) -> dict:
     """What tells apart runs that are not seeds of one another: the budget, the preset and a digest of the algorithm
     and all its settings but the seed (``None`` where the run's ``run.json`` does not record them)."""
@@ -97,6 +110,7 @@ def setting_of(recorded: dict) -> dict:
     config = recorded.get("config")
     digest = None
     if isinstance(config, dict):
+        config = _with_defaults(recorded.get("algo"), config)
         text = json.dumps([recorded.get("algo"), {k: v for k, v in config.items() if k != "seed"}], sort_keys=True)
         digest = hashlib.sha256(text.encode()).hexdigest()[:8]
     steps = recorded.get("total_steps")
