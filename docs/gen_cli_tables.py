@@ -1,10 +1,12 @@
-"""Regenerate the tables of ``docs/cli.md`` that restate code: each algorithm's command-line name, default budget
-and presets (from :data:`pamdp.algos.ALGORITHMS` and :mod:`pamdp.presets`: the configs' own, then the envs').
+"""Regenerate the tables of the docs that restate code: the commands (from the parser of ``pamdp``), each
+algorithm's command-line name, default budget and presets (from :data:`pamdp.algos.ALGORITHMS` and
+:mod:`pamdp.presets`: the configs' own, then the envs'), the experiments of ``pamdp reproduce`` (from their files)
+in ``docs/cli.md``, and the registered env ids in ``docs/environments.md``.
 
 Each table sits between ``<!-- cli:NAME start -->`` and ``<!-- cli:NAME end -->``; everything between the
 markers is replaced.
 
-    python docs/gen_cli_tables.py            # rewrite docs/cli.md in place
+    python docs/gen_cli_tables.py            # rewrite the docs in place
     python docs/gen_cli_tables.py --check    # exit 1 if a table is out of date (for CI and the tests)
 """
 
@@ -13,13 +15,33 @@ from __future__ import annotations
 import argparse
 import re
 import sys
+import warnings
 from pathlib import Path
 
 from pamdp.algos import ALGORITHMS, algorithm_class
 from pamdp.presets import default_preset, preset_names
 
-DOC = Path(__file__).with_name("cli.md")
+DOCS = [Path(__file__).with_name("cli.md"), Path(__file__).with_name("environments.md")]
 BLOCK = re.compile(r"(<!-- cli:([\w-]+) start -->\n)(.*?)(<!-- cli:\2 end -->)", re.DOTALL)
+
+
+def commands_block() -> str:
+    """Each command of ``pamdp``, its arguments and its ``--help`` line."""
+    from pamdp.cli import build_parser
+
+    sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
+    helps = {action.dest: action.help for action in sub._choices_actions}
+    lines = []
+    for name, parser in sub.choices.items():
+        args = []
+        for action in parser._actions:
+            if action.option_strings or action.dest == "help":
+                continue
+            word = (action.metavar or action.dest).upper()
+            args.append(word + "..." if action.nargs == "+" else word)
+        lines.append((f"pamdp {name} {' '.join(args)}", helps[name]))
+    width = max(len(usage) for usage, _ in lines) + 2
+    return "```\n" + "".join(f"{usage:<{width}}{text}\n" for usage, text in lines) + "```\n"
 
 
 def algorithms_table() -> str:
@@ -35,14 +57,72 @@ def algorithms_table() -> str:
     return "\n".join(rows) + "\n"
 
 
-TABLES = {"algorithms": algorithms_table}
+def experiments_table() -> str:
+    """The experiments ``pamdp reproduce NAME`` knows: their description, runs, seeds and budgets."""
+    from pamdp.experiments import available_experiments, load_experiment
+
+    rows = ["| `NAME` | experiment | runs | seeds | steps a run |", "|---|---|---|---|---|"]
+    for name in available_experiments():
+        exp = load_experiment(name)
+        budgets = sorted({run.get("total_steps", exp.total_steps) for run in exp.runs})
+        steps = " to ".join(f"{b:,}" for b in (budgets[0], budgets[-1])[: 1 + (len(budgets) > 1)])
+        seeds = ", ".join(map(str, exp.seeds))
+        rows.append(f"| `{name}` | {exp.description} | {len(exp.runs)} | {seeds} | {steps} |")
+    return "\n".join(rows) + "\n"
 
 
-def render(text: str) -> str:
+def _space(space) -> str:
+    """A parameterized action space in short: ``Tuple(Discrete(3), Tuple(Box(1), Box(1), Box(1)))``, with runs of
+    equal boxes counted (``Box(4) x 16``)."""
+    from pamdp.spaces import HybridActionSpace
+
+    sizes = HybridActionSpace.from_gym(space).param_sizes
+    runs: list[list[int]] = []
+    for size in sizes:
+        if runs and runs[-1][0] == size:
+            runs[-1][1] += 1
+        else:
+            runs.append([size, 1])
+    boxes = ", ".join(f"Box({size})" + (f" x {count}" if count > 1 else "") for size, count in runs)
+    return f"Tuple(Discrete({len(sizes)}), Tuple({boxes}))"
+
+
+def envs_table() -> str:
+    """Every env ``import pamdp`` registers: its classes, its action space (default arguments) and GIF frame rate."""
+    import gymnasium
+
+    import pamdp  # noqa: F401  (registers the envs)
+
+    rows = [
+        "| id | scalar | batched (`vector_entry_point`) | action space (default arguments) | GIF frames a second |",
+        "|---|---|---|---|---|",
+    ]
+    for env_id, spec in gymnasium.registry.items():
+        if not env_id.startswith("pamdp/"):
+            continue
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            env = gymnasium.make(env_id)
+        scalar, batched = (str(e).replace(":", ".") for e in (spec.entry_point, spec.vector_entry_point))
+        fps = env.metadata.get("render_fps", "-")
+        rows.append(f"| `{env_id}` | `{scalar}` | `{batched}` | `{_space(env.action_space)}` | {fps} |")
+        env.close()
+    return "\n".join(rows) + "\n"
+
+
+TABLES = {
+    "commands": commands_block,
+    "algorithms": algorithms_table,
+    "experiments": experiments_table,
+    "envs": envs_table,
+}
+
+
+def render(text: str, doc: Path = DOCS[0]) -> str:
     def fill(match: re.Match) -> str:
         name = match.group(2)
         if name not in TABLES:
-            raise SystemExit(f"{DOC}: no generator for table {name!r}; expected one of {', '.join(TABLES)}")
+            raise SystemExit(f"{doc}: no generator for table {name!r}; expected one of {', '.join(TABLES)}")
         return match.group(1) + TABLES[name]() + match.group(4)
 
     return BLOCK.sub(fill, text)
@@ -50,15 +130,18 @@ def render(text: str) -> str:
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--check", action="store_true", help="exit 1 if docs/cli.md is out of date")
+    parser.add_argument("--check", action="store_true", help="exit 1 if a doc is out of date")
     args = parser.parse_args()
-    text = DOC.read_text()
-    new = render(text)
-    if new != text and args.check:
-        print(f"{DOC} is out of date: run python docs/gen_cli_tables.py", file=sys.stderr)
-    elif new != text:
-        DOC.write_text(new)
-    return int(new != text and args.check)
+    stale = []
+    for doc in DOCS:
+        text = doc.read_text()
+        new = render(text, doc)
+        if new != text and args.check:
+            stale.append(doc)
+            print(f"{doc} is out of date: run python docs/gen_cli_tables.py", file=sys.stderr)
+        elif new != text:
+            doc.write_text(new)
+    return int(bool(stale))
 
 
 if __name__ == "__main__":

@@ -10,6 +10,7 @@ import time
 
 import pytest
 
+from pamdp.algos import ALGORITHMS
 from pamdp.cli import main
 
 TINY = ["--hidden-sizes", "16", "--vf-hidden-sizes", "16", "--batch-size", "500", "--num-envs", "4", "--no-progress"]
@@ -258,3 +259,28 @@ def test_train_resolves_its_config_once(tmp_path, monkeypatch):
     argv = ["train", "patrpo", "--total-steps", "500", "--eval-episodes", "0", "--out", str(tmp_path / "run")]
     assert main([*argv, *TINY]) == 0
     assert len(calls) == 1
+
+
+def test_help_lists_every_algorithm_and_every_experiment(capsys):
+    """Issue 46: ``hsac`` and ``benchmark-suite`` were missing from the help, written out by hand."""
+    from pamdp.experiments import available_experiments
+
+    with pytest.raises(SystemExit):
+        main(["--help"])
+    top = capsys.readouterr().out
+    with pytest.raises(SystemExit):
+        main(["reproduce", "--help"])
+    reproduce = " ".join(capsys.readouterr().out.split())  # argparse wraps the lines
+    assert [name for name in ALGORITHMS if name not in top] == []
+    assert [name for name in available_experiments() if name not in reproduce] == []
+
+
+@pytest.mark.parametrize("env_id, fps", [("pamdp/Goal-v0", 30), ("pamdp/CatchPoint-v0", 10)])
+def test_render_writes_the_gif_at_the_envs_own_frame_rate(env_id, fps, tmp_path, capsys):
+    from PIL import Image
+
+    out = tmp_path / "x.gif"
+    assert main(["render", env_id, "--out", str(out)]) == 0
+    assert capsys.readouterr().out.rstrip().endswith(f", {fps} frames a second)")
+    with Image.open(out) as gif:
+        assert abs(gif.info["duration"] - 1000 / fps) < 10  # GIFs keep hundredths of a second

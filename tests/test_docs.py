@@ -77,3 +77,79 @@ def test_relative_links_and_their_anchors_resolve():
             elif anchor and dest.suffix == ".md" and anchor not in _anchors(dest):
                 broken.append(f"{page.relative_to(ROOT)}: {target} (no such heading in {dest.name})")
     assert not broken, "\n".join(broken)
+
+
+def test_the_suite_table_in_the_results_page_is_the_generated_one():
+    results = ROOT / "docs" / "results.md"
+    generated = (ROOT / "docs" / "results" / "benchmark-suite" / "suite.md").read_text()
+    assert generated in results.read_text()
+
+
+def test_the_generated_tables_of_the_docs_are_up_to_date():
+    """The commands, algorithms, experiments and env ids tables (docs/cli.md, docs/environments.md) are the code's."""
+    done = subprocess.run(
+        [sys.executable, str(ROOT / "docs" / "gen_cli_tables.py"), "--check"], capture_output=True, text=True
+    )
+    assert done.returncode == 0, f"run `python docs/gen_cli_tables.py`\n{done.stdout}{done.stderr}"
+
+
+def test_the_readme_names_every_algorithm_and_experiment_of_the_code():
+    from pamdp.algos import ALGORITHMS
+    from pamdp.experiments import available_experiments
+
+    readme = (ROOT / "README.md").read_text()
+    assert [f"`{name}`" for name in [*ALGORITHMS, *available_experiments()] if f"`{name}`" not in readme] == []
+
+
+def test_no_doc_cites_files_a_user_of_the_package_never_has():
+    """The docs and the command's own modules cite the public sources, not the project's private specs."""
+    pages = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+    code = [ROOT / "src" / "pamdp" / "cli.py", *sorted((ROOT / "src" / "pamdp" / "experiments").rglob("*.py"))]
+    citing = [str(p.relative_to(ROOT)) for p in [*pages, *code] if "shared/specs" in p.read_text()]
+    assert citing == []
+
+
+def _documented_commands():
+    """Every ``pamdp ...`` line of a ```bash block of the README and docs/*.md, as pytest params named FILE:LINE."""
+    params = []
+    for path in [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]:
+        lang = None  # the open block's language; None outside blocks
+        lines = path.read_text().replace("\\\n", " ").splitlines()
+        for number, line in enumerate(lines, 1):
+            if line.startswith("```"):
+                lang = line[3:].strip() if lang is None else None
+            elif lang == "bash" and line.startswith("pamdp "):
+                params.append(pytest.param(line, id=f"{path.relative_to(ROOT)}:{number}"))
+    return params
+
+
+def _argv(line: str, runs: Path) -> list[str]:
+    """A documented command's arguments, with ``$PAMDP_RUNS`` (where the project keeps its runs) in ``runs`` and
+    a trailing ``...`` (settings left out of the line) dropped."""
+    import shlex
+
+    argv = shlex.split(line.replace("$PAMDP_RUNS", str(runs)), comments=True)[1:]
+    return argv[:-1] if argv[-1] == "..." else argv
+
+
+@pytest.mark.parametrize("line", _documented_commands())
+def test_documented_commands_are_valid_and_the_short_ones_run(line, tmp_path, monkeypatch, capsys):
+    """Issue 46: every documented command parses as the code has it; a reproduce command's experiment, runs and seeds
+    exist (its --status, which trains nothing, is run); a render of an env id runs as written. Commands that train
+    for minutes are checked, not run."""
+    from pamdp.cli import build_parser, main
+
+    monkeypatch.chdir(tmp_path)
+    for path in [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]:  # the files the docs show, written out
+        for name, text in re.findall(r"^```toml\n# ([\w.-]+\.toml)\b.*?\n(.*?)^```", path.read_text(), re.S | re.M):
+            (tmp_path / name).write_text(text)
+    argv = _argv(line, tmp_path / "runs")
+    if argv[0] == "reproduce" and argv[1].startswith("benchmarks/"):
+        monkeypatch.chdir(ROOT)  # an experiment file of the repository, named from its root
+    args = build_parser().parse_args(argv)
+    if args.command == "reproduce":
+        status = [a for a in argv if a not in ("--backend", "ray")]
+        assert main([*status, "--status"] if "--status" not in status else status) == 0, capsys.readouterr().err
+    elif args.command == "render" and args.source.startswith("pamdp/"):  # an env id: random actions
+        assert main(argv) == 0, capsys.readouterr().err
+        assert Path(args.out).exists()

@@ -9,6 +9,7 @@ import signal
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -542,3 +543,85 @@ def test_a_bad_suite_archive_is_refused_with_the_entry_and_what_was_expected(tmp
     assert main(["plot", str(runs), "--out", str(tmp_path / "fig"), "--suite-archive", str(archive)]) == 2
     assert re.search(f"suite archive {re.escape(str(archive))}.*{message}", capsys.readouterr().err)
     assert not (tmp_path / "fig").exists()  # refused before anything was written
+
+
+def _recorded_suite_run(root, label, env, seed, value, total_steps, preset="tuned", env_kwargs=None, **settings):
+    """A finished suite run whose run.json records its budget, preset and settings, as pamdp train writes it."""
+    run = root / label.replace(" ", "_") / f"seed{seed}"
+    _suite_run(root, label, env, seed, env_kwargs, evaluation={"success_rate": value, "mean_return": value})
+    recorded = json.loads((run / "run.json").read_text())
+    recorded.update(total_steps=total_steps, preset=preset, config={"seed": seed, "delta": 0.01, **settings})
+    (run / "run.json").write_text(json.dumps(recorded))
+    return run
+
+
+def test_the_suite_table_counts_as_seeds_only_runs_of_one_budget_and_settings(tmp_path):
+    """Issue 46: a smoke test at another budget, or a run of another preset or setting, is a row of its own, never a
+    seed of the full runs (nor does it replace a full run's figure of the same seed)."""
+    from pamdp.experiments.report import write_report
+
+    full, smoke = tmp_path / "full" / "benchmark-suite", tmp_path / "smoke" / "benchmark-suite"
+    for seed, value in enumerate((1.0, 0.9, 0.8)):
+        _recorded_suite_run(full, "PATRPO on Platform", "pamdp/Platform-v0", seed, value, 200_000)
+    _recorded_suite_run(smoke, "PATRPO on Platform", "pamdp/Platform-v0", 0, 0.29, 2_000)
+    _recorded_suite_run(tmp_path / "paper", "PATRPO on Platform", "pamdp/Platform-v0", 1, 0.5, 200_000, "paper")
+    _recorded_suite_run(tmp_path / "delta", "PATRPO on Platform", "pamdp/Platform-v0", 2, 0.7, 200_000, delta=0.05)
+    report = write_report([full, smoke, tmp_path / "paper", tmp_path / "delta"], tmp_path / "fig")
+    table = [line for line in report["suite"].read_text().splitlines() if line.startswith("| ")]
+    rows = {line.split(" | ")[0][2:]: line.split(" | ")[1] for line in table[1:]}
+    assert rows["Platform"] == f"0.90 +- {np.std([1.0, 0.9, 0.8]):.2f} (3 seeds)"
+    assert rows["Platform: 2,000 steps"] == "0.29 +- 0.00 (1 seed)"
+    assert rows["Platform: 200,000 steps, preset paper"] == "0.50 +- 0.00 (1 seed)"
+    digest = [label for label in rows if "settings" in label]
+    assert len(digest) == 1 and rows[digest[0]] == "0.70 +- 0.00 (1 seed)"
+    assert list(rows).index("Goal") == 1 + 3  # the other settings' rows follow their domain's
+    assert len(json.loads(report["suite_finals"].read_text())) == 6  # every run kept, none overwritten
+    # results.md groups the runs alike: the two tables agree on what a seed of a setting is
+    groups = [line.split(" | ")[:3] for line in report["table"].read_text().splitlines()[2:]]
+    assert sorted(seeds for _, seeds, _ in groups) == ["1", "1", "1", "3"]
+    full = next(greedy for _, seeds, greedy in groups if seeds == "3")
+    assert full.startswith(f"0.900 +- {np.std([1.0, 0.9, 0.8]):.3f} (3 evaluated")
+    assert [name for name, _, _ in groups if "2,000 steps" in name] == ["| PATRPO on Platform (2,000 steps)"]
+
+
+def test_the_suite_table_takes_hard_move_without_n_as_its_default_n(tmp_path):
+    from pamdp.experiments.report import write_report
+
+    root = tmp_path / "benchmark-suite"
+    _suite_run(root, "PATRPO on Hard Move", "pamdp/HardMove-v0", 0, evaluation={"success_rate": 0.8})  # no n given
+    _suite_run(root, "PATRPO on Hard Move n=6", "pamdp/HardMove-v0", 0, {"n": 6}, evaluation={"success_rate": 0.6})
+    lines = write_report([root], tmp_path / "fig")["suite"].read_text().splitlines()
+    rows = {line.split(" | ")[0][2:]: line.split(" | ")[1:3] for line in lines[2:10]}
+    assert lines[0].startswith("| domain | pamdp PATRPO on Hard Move | pamdp PATRPO |")
+    assert rows["Hard Move n=4"] == ["0.80 +- 0.00 (1 seed)", "-"]
+    assert rows["Hard Move n=6"] == ["-", "0.60 +- 0.00 (1 seed)"]
+
+
+def test_the_suite_tables_method_labels_are_not_cut(tmp_path):
+    from pamdp.experiments.report import write_report
+
+    root = tmp_path / "mine"
+    label = "PATRPO (trust region on KL) on Goal"
+    _suite_run(root, label, "pamdp/Goal-v0", 0, evaluation={"success_rate": 0.5})
+    _suite_run(root, "a run on its own", "pamdp/Goal-v0", 0, evaluation={"success_rate": 0.25})
+    head = write_report([root], tmp_path / "fig")["suite"].read_text().splitlines()[0]
+    assert head.startswith("| domain | pamdp PATRPO (trust region on KL) | pamdp a run on its own | HyAR's")
+
+
+def test_the_committed_suite_table_is_the_one_its_archive_gives():
+    from pamdp.experiments.suite import load_finals, suite_table
+
+    results = Path(__file__).resolve().parents[1] / "docs" / "results" / "benchmark-suite"
+    table = suite_table(load_finals(results / "suite-finals.json"))
+    assert (results / "suite.md").read_text() == table + "\n"
+
+
+def test_a_run_recorded_before_a_setting_existed_is_a_seed_of_one_recorded_after():
+    from pamdp.algos.patrpo import PATRPOConfig
+    from pamdp.experiments.suite import setting_of
+
+    now = {**PATRPOConfig.preset("tuned").to_dict(), "seed": 1}
+    before = {k: v for k, v in now.items() if k != "device"}  # written before the device setting was added
+    run = {"algo": "patrpo", "total_steps": 1000, "preset": "tuned"}
+    assert setting_of({**run, "config": before}) == setting_of({**run, "config": {**now, "seed": 2}})
+    assert setting_of({**run, "config": before}) != setting_of({**run, "config": {**now, "delta": 0.5}})

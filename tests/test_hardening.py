@@ -6,6 +6,7 @@ import errno
 import json
 import os
 import shutil
+from pathlib import Path
 
 import gymnasium
 import numpy as np
@@ -527,3 +528,88 @@ def test_the_docs_index_names_every_algorithm():
     index = (Path(__file__).resolve().parents[1] / "docs" / "index.md").read_text()
     names = [entry.help.split(":")[0].split(" (")[0] for entry in ALGORITHMS.values()]  # "P-DQN (Xiong ..."
     assert [n for n in names if n not in index] == []
+
+
+# -- issue 46: runs on other systems ----------------------------------------------------------------------------
+
+
+def test_the_cli_starts_where_the_system_has_no_fcntl():
+    """Windows has no ``fcntl``: the command must start (and take its lock) without it."""
+    import subprocess
+    import sys
+
+    code = "import sys; sys.modules['fcntl'] = None\nfrom pamdp.cli import main\nraise SystemExit(main(['--version']))"
+    done = subprocess.run([sys.executable, "-W", "ignore", "-c", code], capture_output=True, text=True)
+    assert done.returncode == 0 and done.stdout.startswith("pamdp "), done.stderr
+
+
+def test_a_second_process_is_refused_while_the_first_writes_and_goes_on_after_it_ends(tmp_path, capsys):
+    import subprocess
+    import sys
+
+    out = tmp_path / "run"
+    hold = (
+        "import sys\nfrom pamdp.experiments.runner import run_lock\n"
+        f"with run_lock({str(out)!r}):\n    print('held', flush=True)\n    sys.stdin.read()"
+    )
+    first = subprocess.Popen([sys.executable, "-c", hold], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+    try:
+        assert first.stdout.readline() == "held\n"
+        argv = ["train", "patrpo", "--total-steps", "300", "--eval-episodes", "0", "--out", str(out), *TINY]
+        message = refusal(argv, capsys)
+        assert f"{out} is in use: pamdp process {first.pid} on" in message
+        assert sorted(os.listdir(out)) == [".lock", ".lock-holder"]  # the refused run wrote nothing
+    finally:
+        first.stdin.close()
+        first.wait(timeout=60)
+    assert main(argv) == 0  # the first has ended: its lock went with it
+    assert (out / "final_model.pt").exists()
+
+
+# -- issue 46: raw tracebacks ---------------------------------------------------------------------------------
+
+
+def _unwritable(tmp_path) -> str:
+    """A directory this process cannot write into: a read-only one, or for root (whom modes do not stop) sysfs."""
+    for where in (tmp_path / "read-only", Path("/sys")):
+        if where != Path("/sys"):
+            where.mkdir()
+            where.chmod(0o555)
+        try:
+            (where / "probe").mkdir()
+        except OSError:
+            return str(where)
+        (where / "probe").rmdir()
+    pytest.skip("no unwritable directory here")
+
+
+def test_reproduce_into_an_unwritable_out_is_one_line_naming_it_before_any_run(tmp_path, capsys, monkeypatch):
+    from pamdp.experiments import runner
+
+    def no_run(*args, **kwargs):
+        raise AssertionError("a run was started")
+
+    monkeypatch.setattr(runner, "run_all", no_run)
+    out = os.path.join(_unwritable(tmp_path), "results")
+    message = refusal(["reproduce", "platform", "--scale", "0.001", "--seeds", "0", "--out", out], capsys)
+    assert f"pamdp reproduce: error: {out}: " in message and "no such directory" not in message
+    assert not os.path.exists(out)
+
+
+def test_render_refuses_an_env_of_another_package_naming_its_action_space(tmp_path, capsys):
+    message = refusal(["render", "CartPole-v1", "--out", str(tmp_path / "x.gif")], capsys)
+    expected = "env 'CartPole-v1' has the action space Discrete(2), not a parameterized one; expected a pamdp env"
+    assert expected in message
+    assert not (tmp_path / "x.gif").exists()
+
+
+def test_a_run_resumed_with_its_envs_default_arguments_spelt_out_goes_on_and_another_shape_is_refused(tmp_path, capsys):
+    """Hard Move's ``{"n": 4}`` is its default ``{}``: the same run. ``{"n": 6}`` is an env of another shape, refused in
+    one line naming both (loading the model into it would be torch's "size mismatch")."""
+    out = tmp_path / "run"
+    argv = ["train", "patrpo", "--env", "pamdp/HardMove-v0", "--eval-episodes", "0", "--out", str(out), *TINY]
+    assert main([*argv, "--total-steps", "500"]) == 0
+    message = refusal([*argv, "--total-steps", "1000", "--env-kwargs", '{"n": 6}'], capsys)
+    assert "env_kwargs: {} in the run, {'n': 6} asked" in message
+    assert main([*argv, "--total-steps", "1000", "--env-kwargs", '{"n": 4}']) == 0
+    assert "resuming" in capsys.readouterr().err

@@ -15,6 +15,7 @@ import dataclasses
 import datetime as dt
 import json
 import math
+import os
 import sys
 import types
 import typing
@@ -23,6 +24,7 @@ from pathlib import Path
 from pamdp import __version__
 from pamdp._memory import keep_freed_memory
 from pamdp.algos import ALGORITHMS, algorithm_class
+from pamdp.experiments import available_experiments
 from pamdp.experiments.runner import RunSpec, train_run
 from pamdp.presets import default_preset, preset_names
 
@@ -187,7 +189,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"pamdp {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
 
-    train = sub.add_parser("train", help="train an algorithm (default: on Platform) and evaluate it")
+    names = [name for name in ALGORITHMS if algorithm_class(name) is not None]
+    train = sub.add_parser("train", help=f"train {', '.join(names)} (default env: Platform), then evaluate it")
     algos = train.add_subparsers(dest="algo", required=True, metavar="ALGO")
     for name in ALGORITHMS:
         cls = algorithm_class(name)
@@ -234,8 +237,10 @@ def build_parser() -> argparse.ArgumentParser:
     ev.add_argument("--stochastic", action="store_true", help="sample actions instead of the greedy ones")
     ev.add_argument("--json", action="store_true", help="print one JSON object")
 
-    rp = sub.add_parser("reproduce", help="run one of the paper's experiments (all settings and seeds) and plot it")
-    rp.add_argument("name", help="platform, step-size, kl-estimators, soccer, or an experiment TOML file")
+    rp = sub.add_parser(
+        "reproduce", help="run an experiment (the paper's figures, the benchmark suite) and plot it: all runs and seeds"
+    )
+    rp.add_argument("name", help=f"{', '.join(available_experiments())}, or an experiment TOML file")
     rp.add_argument("--seeds", type=_seed_list, default=None, help="comma-separated seeds (default: the experiment's)")
     rp.add_argument(
         "--runs", type=_items, default=None, help="comma-separated run labels to run (default: all), e.g. --runs PATRPO"
@@ -351,6 +356,10 @@ def cmd_reproduce(args) -> int:
 
         print(format_status(exp.name, [run_status(spec, out) for spec, out in jobs], args.workers), end="")
         return 0
+    root = Path(args.out) / exp.name
+    root.mkdir(parents=True, exist_ok=True)  # else every run would fail alike: refused here in one line naming it
+    if not os.access(root, os.W_OK):
+        raise ValueError(f"--out {args.out}: {root} is not writable; expected a directory this user may write into")
     budgets = sorted({spec.total_steps for spec, _ in jobs})
     steps = f"{budgets[0]:,}" if len(budgets) == 1 else f"{budgets[0]:,} to {budgets[-1]:,}"
     print(f"{exp.name}: {exp.description}; {len(jobs)} runs of {steps} steps", file=sys.stderr)
@@ -426,6 +435,7 @@ def cmd_render(args) -> int:
     from pamdp.algos import load_model
     from pamdp.algos.vector_env import env_creator
     from pamdp.envs.rendering import record_episode
+    from pamdp.spaces import HybridActionSpace
 
     if args.source in gymnasium.registry:
         env_id, env_kwargs, policy = args.source, {}, None
@@ -435,9 +445,26 @@ def cmd_render(args) -> int:
     modes = getattr(env_creator(env_id), "metadata", {}).get("render_modes", [])
     if "rgb_array" not in modes:
         raise ValueError(f"env {env_id!r} draws no frames (render modes {modes}); expected one with 'rgb_array'")
-    env = gymnasium.make(env_id, render_mode="rgb_array", **env_kwargs)
-    path, total = record_episode(env, policy, args.out, seed=args.seed)
-    print(f"wrote {path} (return {total:.4f})")
+    try:  # another package's env: its own errors (a missing drawing library) in one line too
+        env = gymnasium.make(env_id, render_mode="rgb_array", **env_kwargs)
+    except gymnasium.error.Error as exc:
+        raise ValueError(f"env {env_id!r} cannot be made ({exc})") from None
+    try:
+        HybridActionSpace.from_gym(env.action_space)
+    except ValueError:
+        env.close()
+        raise ValueError(
+            f"env {env_id!r} has the action space {env.action_space}, not a parameterized one; expected a pamdp env "
+            f"such as {', '.join(sorted(k for k in gymnasium.registry if k.startswith('pamdp/'))[:3])}"
+        ) from None
+    try:
+        fps = env.metadata.get("render_fps") or 20  # the env's real time (Goal's sub-steps: 30 a second)
+        path, total = record_episode(env, policy, args.out, seed=args.seed, fps=fps)
+    except gymnasium.error.Error as exc:
+        raise ValueError(f"env {env_id!r} cannot draw its frames ({exc})") from None
+    finally:
+        env.close()
+    print(f"wrote {path} (return {total:.4f}, {fps:g} frames a second)")
     return 0
 
 

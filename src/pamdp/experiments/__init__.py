@@ -84,7 +84,8 @@ def _slug(label: str) -> str:
 
 
 def load_experiment(name_or_path: str | os.PathLike) -> Experiment:
-    """An experiment by name (``platform``, ``step-size``, ``kl-estimators``, ``soccer``) or TOML path."""
+    """An experiment by name (one of :func:`available_experiments`: ``platform``, ``benchmark-suite``, ...) or TOML
+    path."""
     try:
         import tomllib
     except ModuleNotFoundError:  # Python 3.10

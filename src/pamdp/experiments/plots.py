@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from pamdp.algos.logger import RENAMED, success_of
+from pamdp.experiments.suite import setting_of
 
 __all__ = [
     "find_groups",
@@ -52,10 +53,12 @@ def find_groups(roots: list[str | os.PathLike]) -> dict[str, list[Path]]:
 
     A run's label is the one its ``run.json`` records (an experiment's ``PASVG(0)``, whose directory is
     ``PASVG_0_``), else the name of the directory holding its seeds (or its own name, for a run given alone).
-    Runs are averaged together only if they share their label, algorithm and env (with its arguments): where
-    runs of one label differ in those, each kind is a group of its own, named ``label (algo on env)``.
+    Runs are averaged together only if they share their label, algorithm and env (with its arguments), and their
+    budget, preset and settings (:func:`pamdp.experiments.suite.setting_of`; a smoke test is no seed of a full
+    run): where runs of one label differ in those, each kind is a group of its own, named ``label (algo on env)``
+    or ``label (2,000 steps, preset paper)`` by what tells them apart.
     """
-    found: dict[tuple[str, tuple[str, str]], list[Path]] = {}
+    found: dict[tuple[str, tuple], list[Path]] = {}
     for root in map(Path, roots):
         if not root.exists():
             raise FileNotFoundError(f"no such directory: {root}")
@@ -63,16 +66,30 @@ def find_groups(roots: list[str | os.PathLike]) -> dict[str, list[Path]]:
         for run in runs:
             recorded = _recorded(run)
             label = str(recorded.get("label") or "") or (run.parent.name if run != root else run.name)
-            found.setdefault((label, _kind(recorded)), []).append(run)
+            found.setdefault((label, (*_kind(recorded), *setting_of(recorded).values())), []).append(run)
     if not found:
         raise FileNotFoundError(f"no run directories (with progress.csv) under {', '.join(map(str, roots))}")
-    kinds: dict[str, int] = {}
-    for label, _ in found:
-        kinds[label] = kinds.get(label, 0) + 1
-    return {
-        (label if kinds[label] == 1 else f"{label} ({' on '.join(kind)})"): runs
-        for (label, kind), runs in found.items()
-    }
+    kinds: dict[str, list[tuple]] = {}
+    for label, kind in found:
+        kinds.setdefault(label, []).append(kind)
+    return {_group_name(label, kind, kinds[label]): runs for (label, kind), runs in found.items()}
+
+
+def _group_name(label: str, kind: tuple, kinds: list[tuple]) -> str:
+    """``label``, or where runs of that label are of several kinds, ``label (what tells this kind apart)``."""
+    if len(kinds) == 1:
+        return label
+    algo, env, steps, preset, digest = kind
+    parts = []
+    if any(k[:2] != (algo, env) for k in kinds):
+        parts.append(f"{algo} on {env}")
+    if any(k[2] != steps for k in kinds):
+        parts.append(f"{steps:,} steps" if steps is not None else "budget not recorded")
+    if any(k[:3] == kind[:3] and k[3] != preset for k in kinds):
+        parts.append(f"preset {preset}")
+    if any(k[:4] == kind[:4] and k[4] != digest for k in kinds):
+        parts.append(f"settings {digest}")
+    return f"{label} ({', '.join(parts)})"
 
 
 def _run_dirs(root: Path) -> list[Path]:

@@ -15,7 +15,6 @@ import concurrent.futures as cf
 import contextlib
 import csv
 import dataclasses
-import fcntl
 import json
 import multiprocessing
 import os
@@ -27,6 +26,8 @@ import warnings
 from pathlib import Path
 from typing import Any, NamedTuple
 
+import filelock
+
 from pamdp.algos import algorithm_class
 from pamdp.algos.vector_env import check_env_kwargs
 from pamdp.presets import choose
@@ -34,9 +35,10 @@ from pamdp.presets import choose
 __all__ = ["RunConfig", "RunSpec", "train_run", "run_lock", "is_finished", "run_all"]
 
 LOCK_FILE = ".lock"
+HOLDER_FILE = ".lock-holder"  # who holds the lock: beside it, since a locked file is not readable on every system
 _CUT_SHORT = ".cut-short"  # a first epoch's log kept aside when its checkpoint was cut short by a kill
 # What a run directory holds before its first checkpoint: starting it again from step 0 loses nothing.
-_BEFORE_FIRST_CHECKPOINT = {"run.json", "progress.csv", "tb", "stdout.log", LOCK_FILE}
+_BEFORE_FIRST_CHECKPOINT = {"run.json", "progress.csv", "tb", "stdout.log", LOCK_FILE, HOLDER_FILE}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -86,43 +88,43 @@ class RunConfig(NamedTuple):
 
 @contextlib.contextmanager
 def run_lock(out: str | os.PathLike):
-    """Hold ``out``'s lock file (``out/.lock``, an exclusive ``flock``) for the block: one writer per run directory.
+    """Hold ``out``'s lock (``out/.lock``, an exclusive lock of the operating system's, through :mod:`filelock`) for
+    the block: one writer per run directory.
 
-    A second process asking for it is refused at once with a ``ValueError`` naming the holder. The directory
-    (and its missing parents) is created; if the block fails before writing anything into it, they are removed
-    again, so a refused run leaves nothing behind. The lock goes with its process, however that ends.
+    A second process (or a second holder in this one) asking for it is refused at once with a ``ValueError`` naming
+    the holder, whom ``out/.lock-holder`` records. The directory (and its missing parents) is created; if the block
+    fails before writing anything into it, they are removed again, so a refused run leaves nothing behind. The
+    lock goes with its process, however that ends.
     """
     out = Path(out)
     if out.exists() and not out.is_dir():
         raise ValueError(f"{out} is a file; expected a run directory (a new one, or one to resume)")
     created = [p for p in (out, *out.parents) if not p.exists()]  # deepest first
     out.mkdir(parents=True, exist_ok=True)
-    lock_existed = (out / LOCK_FILE).exists()
-    lock = open(out / LOCK_FILE, "a+")
+    made = [name for name in (LOCK_FILE, HOLDER_FILE) if not (out / name).exists()]
+    lock = filelock.FileLock(out / LOCK_FILE, timeout=0)
     try:
-        fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except BlockingIOError:
-        lock.seek(0)
-        holder = lock.read().strip() or "another process"
-        lock.close()
+        lock.acquire()
+    except filelock.Timeout:
+        holder = (out / HOLDER_FILE).read_text().strip() if (out / HOLDER_FILE).exists() else ""
         raise ValueError(
-            f"{out} is in use: {holder} is writing that run; wait for it to end or use another directory"
+            f"{out} is in use: {holder or 'another process'} is writing that run; wait for it to end or use "
+            "another directory"
         ) from None
     try:
-        lock.seek(0)
-        lock.truncate()
-        lock.write(f"pamdp process {os.getpid()} on {socket.gethostname()}\n")
-        lock.flush()
+        (out / HOLDER_FILE).write_text(f"pamdp process {os.getpid()} on {socket.gethostname()}\n")
         yield
     except BaseException:  # what this made and nothing has written into goes again
-        if not lock_existed:
-            os.remove(out / LOCK_FILE)
+        lock.release()
+        for name in made:
+            with contextlib.suppress(OSError):
+                os.remove(out / name)
         for directory in created:
             with contextlib.suppress(OSError):  # not empty: the run wrote into it
                 directory.rmdir()
         raise
     finally:
-        lock.close()
+        lock.release()  # (a second release of a released lock does nothing)
 
 
 def is_finished(out: str | Path, spec: RunSpec) -> bool:
@@ -158,13 +160,30 @@ def _read_run_json(path: Path) -> dict:
     return recorded
 
 
+def env_defaults(env: str) -> dict:
+    """The arguments of ``env``'s constructor that have defaults (``{"n": 4, ...}`` for Hard Move; ``{}`` for an
+    unregistered env or a constructor without a signature)."""
+    import inspect
+
+    from pamdp.algos.vector_env import env_creator
+
+    try:
+        params = inspect.signature(env_creator(env)).parameters.values()
+    except (ValueError, TypeError):
+        return {}
+    return {p.name: p.default for p in params if p.default is not inspect.Parameter.empty}
+
+
 def _differences(recorded: dict, asked: dict) -> list[str]:
     """What differs between a recorded run and the one asked for, setting by setting: ``delta: 0.01 in the
-    run, 0.05 asked``."""
+    run, 0.05 asked``. Env arguments count with their defaults: Hard Move's ``{"n": 4}`` is its ``{}``."""
     differ = []
-    for key in ("env", "env_kwargs"):
-        if recorded.get(key) != asked[key]:
-            differ.append(f"{key}: {recorded.get(key)!r} in the run, {asked[key]!r} asked")
+    if recorded.get("env") != asked["env"]:
+        differ.append(f"env: {recorded.get('env')!r} in the run, {asked['env']!r} asked")
+    else:
+        defaults = env_defaults(asked["env"])
+        if {**defaults, **(recorded.get("env_kwargs") or {})} != {**defaults, **asked["env_kwargs"]}:
+            differ.append(f"env_kwargs: {recorded.get('env_kwargs')!r} in the run, {asked['env_kwargs']!r} asked")
     old, new = recorded.get("config", {}), asked["config"]
     for name in sorted(set(old) | set(new)):
         if old.get(name) != new.get(name):

@@ -1,7 +1,9 @@
 """The benchmark suite's table and curves: each domain's measured success rates beside HyAR's published ones.
 
 ``pamdp reproduce benchmark-suite`` names its runs ``"METHOD on DOMAIN"``; :func:`suite_table` finds each run's
-domain from the env (and its arguments) its ``run.json`` records, and its method from the label. A finished run
+domain from the env (and its arguments, with the constructor's defaults) its ``run.json`` records, and its method
+from the label. A cell averages the seeds of one setting (budget, preset and settings, :func:`setting_of`): runs of
+another setting get rows of their own, never counted as seeds of it. A finished run
 counts with its final evaluation (1000 greedy episodes); a run still training with its last greedy evaluation
 during training (100 episodes), marked as such. Platform's figure is the return, as in HyAR's table; the
 others' the success rate (``info["is_success"]``).
@@ -20,15 +22,21 @@ from pathlib import Path
 import numpy as np
 
 from pamdp.algos.logger import success_of
+from pamdp.experiments.runner import env_defaults
 
 __all__ = [
     "DOMAINS",
     "HYAR_TABLE",
     "domain_of",
+    "method_of",
+    "setting_of",
     "suite_finals",
     "load_finals",
     "merge_finals",
+    "suite_groups",
+    "suite_rows",
     "suite_cells",
+    "format_cell",
     "suite_table",
     "plot_domains",
 ]
@@ -61,11 +69,56 @@ HYAR_TABLE: dict[str, dict[str, str]] = {
 
 
 def domain_of(recorded: dict) -> str | None:
-    """The suite domain a run's ``run.json`` describes (``None`` for an env outside it)."""
-    for name, env, kwargs in DOMAINS:
-        if recorded.get("env") == env and (recorded.get("env_kwargs") or {}) == kwargs:
+    """The suite domain a run's ``run.json`` describes (``None`` for an env outside it). The env's arguments count
+    with its defaults: a Hard Move run that gave no ``n`` is a run of its default ``n = 4``."""
+    env = recorded.get("env")
+    if env not in {e for _, e, _ in DOMAINS}:
+        return None
+    defaults = env_defaults(env)
+    given = {**defaults, **(recorded.get("env_kwargs") or {})}
+    for name, domain_env, kwargs in DOMAINS:
+        if env == domain_env and given == {**defaults, **kwargs}:
             return name
     return None
+
+
+def method_of(label: str, domain: str) -> str:
+    """What the suite table calls a run's method: its label without the ``" on DOMAIN"`` the suite's labels end
+    with (``"MP-DQN on Hard Move n=4"``: ``MP-DQN``); any other label whole."""
+    suffix = f" on {domain}"
+    return label[: -len(suffix)] if label.endswith(suffix) and len(label) > len(suffix) else label
+
+
+def _with_defaults(algo, config: dict) -> dict:
+    """A recorded config with the settings added since it was written at their defaults (as a resume counts them),
+    so that a run recorded before a setting existed is a seed of one recorded after; as recorded where the
+    algorithm is unknown or the config no longer loads."""
+    from pamdp.algos import algorithm_class
+
+    try:
+        cls = algorithm_class(algo) if isinstance(algo, str) else None
+        return config if cls is None else cls.config_class.from_dict(config).to_dict()
+    except (ValueError, TypeError):  # an unknown algorithm, or settings it no longer takes
+        return config
+
+
+def setting_of(recorded: dict) -> dict:
+    """What tells apart runs that are not seeds of one another: the budget, the preset and a digest of the algorithm
+    and all its settings but the seed (``None`` where the run's ``run.json`` does not record them)."""
+    import hashlib
+
+    config = recorded.get("config")
+    digest = None
+    if isinstance(config, dict):
+        config = _with_defaults(recorded.get("algo"), config)
+        text = json.dumps([recorded.get("algo"), {k: v for k, v in config.items() if k != "seed"}], sort_keys=True)
+        digest = hashlib.sha256(text.encode()).hexdigest()[:8]
+    steps = recorded.get("total_steps")
+    return {
+        "total_steps": steps if isinstance(steps, int) and not isinstance(steps, bool) else None,
+        "preset": recorded.get("preset") if isinstance(recorded.get("preset"), str) else None,
+        "settings": digest,
+    }
 
 
 def _figure(run: Path, domain: str) -> tuple[float, bool] | None:
@@ -97,7 +150,8 @@ def _seed_of(run: Path, recorded: dict) -> int | None:
 
 def suite_finals(groups: dict[str, list[Path]]) -> list[dict]:
     """One entry per run of the groups (:func:`plots.find_groups`) on a suite domain with a figure:
-    ``{"domain", "method", "seed", "value", "final", "source"}`` (``final``: its evaluation of 1000 episodes, else
+    ``{"domain", "method", "seed", "value", "final", "source", "total_steps", "preset", "settings"}`` (the last three:
+    :func:`setting_of`; ``final``: its evaluation of 1000 episodes, else
     its last greedy evaluation during training; ``source``: the run's directory, its last three parts, as
     ``benchmark-suite/PATRPO_on_Goal/seed0``: where it lies under the runs' root, without a machine's own path)."""
     from pamdp.experiments.plots import _recorded
@@ -109,15 +163,19 @@ def suite_finals(groups: dict[str, list[Path]]) -> list[dict]:
             domain = domain_of(recorded)
             figure = None if domain is None else _figure(run, domain)
             if figure is not None:
-                method = str(recorded.get("label") or label).split(" on ")[0]
+                method = method_of(str(recorded.get("label") or label), domain)
                 seed = _seed_of(run, recorded)
                 finals.append(dict(domain=domain, method=method, seed=seed, value=figure[0], final=figure[1]))
                 finals[-1]["source"] = Path(*Path(run).resolve().parts[-3:]).as_posix()
+                finals[-1].update(setting_of(recorded))
     return finals
 
 
 FINALS_KEYS = {"domain": str, "method": str, "seed": int, "value": float, "final": bool, "source": str}
 """The keys of a suite-finals entry and their types."""
+SETTING_KEYS = {"total_steps": int, "preset": str, "settings": str}
+"""The keys of :func:`setting_of`: in entries since issue 46 (``None`` where the run did not record them, and in
+older archives' entries, which lack them)."""
 
 
 def load_finals(path: str | os.PathLike) -> list[dict]:
@@ -132,13 +190,16 @@ def load_finals(path: str | os.PathLike) -> list[dict]:
     names = [d[0] for d in DOMAINS]
     for i, entry in enumerate(entries):
         where = f"suite archive {path}, entry {i}"
-        if not isinstance(entry, dict) or set(entry) != set(FINALS_KEYS):
+        if not isinstance(entry, dict) or not set(FINALS_KEYS) <= set(entry) <= set(FINALS_KEYS) | set(SETTING_KEYS):
             got = sorted(entry) if isinstance(entry, dict) else entry
-            raise ValueError(f"{where}: {got!r}; expected an object with the keys {sorted(FINALS_KEYS)}")
-        for key, kind in FINALS_KEYS.items():
-            value = entry[key]
+            raise ValueError(
+                f"{where}: {got!r}; expected an object with the keys {sorted(FINALS_KEYS)} "
+                f"(and optionally {sorted(SETTING_KEYS)})"
+            )
+        for key, kind in {**FINALS_KEYS, **SETTING_KEYS}.items():
+            value = entry.get(key)
             ok = isinstance(value, kind) and not (kind is int and isinstance(value, bool))
-            ok = ok or (key == "seed" and value is None)  # a run whose seed was not recorded
+            ok = ok or (key in ("seed", *SETTING_KEYS) and value is None)  # not recorded
             if kind is float:
                 ok = isinstance(value, (int, float)) and not isinstance(value, bool) and np.isfinite(value)
             if not ok:
@@ -147,51 +208,109 @@ def load_finals(path: str | os.PathLike) -> list[dict]:
                 )
         if entry["domain"] not in names:
             raise ValueError(f"{where}: domain = {entry['domain']!r}; expected one of {names}")
-    return entries
+    return [{**dict.fromkeys(SETTING_KEYS), **entry} for entry in entries]
+
+
+def _setting_key(entry: dict) -> tuple:
+    return tuple(entry.get(key) for key in SETTING_KEYS)
 
 
 def merge_finals(at_hand: list[dict], archived: list[dict]) -> list[dict]:
     """``archived`` entries with those of ``at_hand`` over them (a run at hand replaces the archived entry of its
-    domain, method and seed), in the table's domain order, then by method and seed."""
-    merged = {(e["domain"], e["method"], e["seed"]): e for e in [*archived, *at_hand]}
+    domain, method, seed and setting, or of an archived entry that recorded no setting), in the table's domain
+    order, then by method, setting and seed. Runs of another setting are kept beside: they are no seeds of it."""
+    unrecorded = _setting_key({})
+    merged = {(e["domain"], e["method"], e["seed"], _setting_key(e)): e for e in archived}
+    for e in at_hand:
+        merged.pop((e["domain"], e["method"], e["seed"], unrecorded), None)
+        merged[(e["domain"], e["method"], e["seed"], _setting_key(e))] = e
     order = {d[0]: i for i, d in enumerate(DOMAINS)}
     return sorted(
-        merged.values(), key=lambda e: (order[e["domain"]], e["method"], -1 if e["seed"] is None else e["seed"])
+        merged.values(),
+        key=lambda e: (order[e["domain"]], e["method"], repr(_setting_key(e)), -1 if e["seed"] is None else e["seed"]),
     )
 
 
-def suite_cells(finals: list[dict]) -> dict[tuple[str, str], str]:
-    """``{(domain, method): "0.93 +- 0.02 (3 seeds)"}`` from entries of :func:`suite_finals`."""
-    found: dict[tuple[str, str], list[tuple[float, bool]]] = {}
+def format_cell(values: np.ndarray, partial: int) -> str:
+    """A cell of the table: mean +- std over the seeds' figures, how many seeds, and how many are still training."""
+    text = f"{values.mean():.2f} +- {values.std():.2f} ({len(values)} seed{'s' * (len(values) > 1)}"
+    return text + (f", {partial} partial*)" if partial else ")")
+
+
+def suite_groups(finals: list[dict]) -> dict[tuple[str, str, tuple], list[dict]]:
+    """The entries of each ``(domain, method, setting)``: the seeds of one setting, whose figures a cell shows."""
+    groups: dict[tuple[str, str, tuple], list[dict]] = {}
     for e in finals:
-        found.setdefault((e["domain"], e["method"]), []).append((float(e["value"]), bool(e["final"])))
-    cells = {}
-    for key, figures in found.items():
-        values = np.array([v for v, _ in figures])
-        partial = sum(not final for _, final in figures)
-        text = f"{values.mean():.2f} +- {values.std():.2f} ({len(values)} seed{'s' * (len(values) > 1)}"
-        cells[key] = text + (f", {partial} partial*)" if partial else ")")
-    return cells
+        groups.setdefault((e["domain"], e["method"], _setting_key(e)), []).append(e)
+    return groups
+
+
+def _describe(setting: tuple, others: list[tuple]) -> str:
+    """A setting's row label: its budget, and its preset and settings' digest where they tell it from ``others``
+    (the other settings of its domain and method)."""
+    steps, preset, digest = setting
+    parts = [f"{steps:,} steps" if steps is not None else "budget not recorded"]
+    if any(o[0] == steps and o[1] != preset for o in others) or (preset is not None and not others):
+        parts.append(f"preset {preset}")
+    if any(o[:2] == setting[:2] and o[2] != digest for o in others):
+        parts.append(f"settings {digest}")
+    return ", ".join(parts)
+
+
+def suite_rows(finals: list[dict]) -> list[tuple[str, dict[str, str]]]:
+    """The table's rows, ``(row label, {method: cell})``: per domain, in HyAR's order, a first row with each method's
+    main setting (its largest budget, then the one of most seeds), then a row per other setting, labelled
+    ``"Platform: 2,000 steps"``; no run is counted as a seed of another setting."""
+    groups = suite_groups(finals)
+    rows = []
+    for domain, _, _ in DOMAINS:
+        by_method: dict[str, list[tuple]] = {}
+        for d, method, setting in groups:
+            if d == domain:
+                by_method.setdefault(method, []).append(setting)
+        main: dict[str, str] = {}
+        extra: dict[str, dict[str, str]] = {}
+        for method, settings in by_method.items():
+            settings.sort(key=lambda st: (st[0] or 0, len(groups[(domain, method, st)])), reverse=True)
+            for i, setting in enumerate(settings):
+                entries = groups[(domain, method, setting)]
+                values = np.array([float(e["value"]) for e in entries])
+                cell = format_cell(values, sum(not e["final"] for e in entries))
+                if i == 0:
+                    main[method] = cell
+                else:
+                    others = [st for st in settings if st != setting]
+                    extra.setdefault(f"{domain}: {_describe(setting, others)}", {})[method] = cell
+        rows.append((domain, main))
+        rows += sorted(extra.items())
+    return rows
+
+
+def suite_cells(finals: list[dict]) -> dict[tuple[str, str], str]:
+    """``{(row label, method): "0.93 +- 0.02 (3 seeds)"}`` from entries of :func:`suite_finals` (see
+    :func:`suite_rows`)."""
+    return {(label, method): cell for label, cells in suite_rows(finals) for method, cell in cells.items()}
 
 
 def suite_table(finals: list[dict]) -> str:
     """A markdown table: each domain's measured figure per method (entries of :func:`suite_finals`), then HyAR's
     published ones ("" without entries)."""
-    cells = suite_cells(finals)
-    if not cells:
+    rows = suite_rows(finals)
+    methods = list(dict.fromkeys(method for _, cells in rows for method in cells))
+    if not methods:
         return ""
-    methods = list(dict.fromkeys(method for _, method in cells))
     head = ["domain", *(f"pamdp {m}" for m in methods), *(f"HyAR's {m}" for m in HYAR_TABLE)]
     lines = ["| " + " | ".join(head) + " |", "|---" * len(head) + "|"]
-    for domain, _, _ in DOMAINS:
-        row = [domain, *(cells.get((domain, m), "-") for m in methods), *(t[domain] for t in HYAR_TABLE.values())]
-        lines.append("| " + " | ".join(row) + " |")
+    for label, cells in rows:
+        hyar = [t[label] if label in t else "" for t in HYAR_TABLE.values()]
+        lines.append("| " + " | ".join([label, *(cells.get(m, "-") for m in methods), *hyar]) + " |")
     lines += [
         "",
         "Success rate (Platform: return), mean +- std over seeds, each seed's final greedy evaluation over 1000 "
-        "episodes; * a run still training, counted with its last greedy evaluation (100 episodes). HyAR's columns: "
-        "its Table 2 (5 runs, 100 evaluation episodes). Per seed, with where each figure comes from: "
-        "`suite-finals.json` beside this table.",
+        "episodes; * a run still training, counted with its last greedy evaluation (100 episodes). A domain's first "
+        "row holds each method's runs of its largest budget; runs of another budget, preset or settings have rows of "
+        "their own below it and are never counted as seeds of another. HyAR's columns: its Table 2 (5 runs, 100 "
+        "evaluation episodes). Per seed, with where each figure comes from: `suite-finals.json` beside this table.",
     ]
     return "\n".join(lines)
 
@@ -205,7 +324,7 @@ def plot_domains(groups: dict[str, list[Path]], out: str | os.PathLike) -> list[
     for label, runs in groups.items():
         domain = domain_of(_recorded(runs[0]))
         if domain is not None:
-            by_domain.setdefault(domain, {})[label.split(" on ")[0]] = runs
+            by_domain.setdefault(domain, {})[method_of(label, domain)] = runs
     written = []
     for domain, methods in by_domain.items():
         metric = GREEDY_METRIC if domain == "Platform" else GREEDY_SUCCESS_METRIC
