@@ -618,7 +618,7 @@ def test_the_committed_suite_table_is_the_one_its_archive_gives():
 
 def test_a_run_recorded_before_a_setting_existed_is_a_seed_of_one_recorded_after():
     from pamdp.algos.patrpo import PATRPOConfig
-    from pamdp.experiments.suite import setting_of
+    from pamdp.experiments.plots import setting_of
 
     now = {**PATRPOConfig.preset("tuned").to_dict(), "seed": 1}
     before = {k: v for k, v in now.items() if k != "device"}  # written before the device setting was added

@@ -17,7 +17,6 @@ from pathlib import Path
 import numpy as np
 
 from pamdp.algos.logger import RENAMED, success_of
-from pamdp.experiments.suite import setting_of
 
 __all__ = [
     "find_groups",
@@ -54,7 +53,7 @@ def find_groups(roots: list[str | os.PathLike]) -> dict[str, list[Path]]:
     A run's label is the one its ``run.json`` records (an experiment's ``PASVG(0)``, whose directory is
     ``PASVG_0_``), else the name of the directory holding its seeds (or its own name, for a run given alone).
     Runs are averaged together only if they share their label, algorithm and env (with its arguments), and their
-    budget, preset and settings (:func:`pamdp.experiments.suite.setting_of`; a smoke test is no seed of a full
+    budget, preset and settings (:func:`setting_of`; a smoke test is no seed of a full
     run): where runs of one label differ in those, each kind is a group of its own, named ``label (algo on env)``
     or ``label (2,000 steps, preset paper)`` by what tells them apart.
     """
@@ -108,6 +107,38 @@ def _run_dirs(root: Path) -> list[Path]:
         if "progress.csv" in files:
             runs.append(Path(path))
     return sorted(runs)
+
+
+def _with_defaults(algo, config: dict) -> dict:
+    """A recorded config with the settings added since it was written at their defaults (as a resume counts them),
+    so that a run recorded before a setting existed is a seed of one recorded after; as recorded where the
+    algorithm is unknown or the config no longer loads."""
+    from pamdp.algos import algorithm_class
+
+    try:
+        cls = algorithm_class(algo) if isinstance(algo, str) else None
+        return config if cls is None else cls.config_class.from_dict(config).to_dict()
+    except (ValueError, TypeError):  # an unknown algorithm, or settings it no longer takes
+        return config
+
+
+def setting_of(recorded: dict) -> dict:
+    """What tells apart runs that are not seeds of one another: the budget, the preset and a digest of the algorithm
+    and all its settings but the seed (``None`` where the run's ``run.json`` does not record them)."""
+    import hashlib
+
+    config = recorded.get("config")
+    digest = None
+    if isinstance(config, dict):
+        config = _with_defaults(recorded.get("algo"), config)
+        text = json.dumps([recorded.get("algo"), {k: v for k, v in config.items() if k != "seed"}], sort_keys=True)
+        digest = hashlib.sha256(text.encode()).hexdigest()[:8]
+    steps = recorded.get("total_steps")
+    return {
+        "total_steps": steps if isinstance(steps, int) and not isinstance(steps, bool) else None,
+        "preset": recorded.get("preset") if isinstance(recorded.get("preset"), str) else None,
+        "settings": digest,
+    }
 
 
 def _recorded(run: Path) -> dict:

@@ -2,7 +2,7 @@
 
 ``pamdp reproduce benchmark-suite`` names its runs ``"METHOD on DOMAIN"``; :func:`suite_table` finds each run's
 domain from the env (and its arguments, with the constructor's defaults) its ``run.json`` records, and its method
-from the label. A cell averages the seeds of one setting (budget, preset and settings, :func:`setting_of`): runs of
+from the label. A cell averages the seeds of one setting (budget, preset and settings, :func:`~pamdp.experiments.plots.setting_of`): runs of
 another setting get rows of their own, never counted as seeds of it. A finished run
 counts with its final evaluation (1000 greedy episodes); a run still training with its last greedy evaluation
 during training (100 episodes), marked as such. Platform's figure is the return, as in HyAR's table; the
@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from pamdp.algos.logger import success_of
+from pamdp.experiments.plots import setting_of
 from pamdp.experiments.runner import env_defaults
 
 __all__ = [
@@ -29,7 +30,6 @@ __all__ = [
     "HYAR_TABLE",
     "domain_of",
     "method_of",
-    "setting_of",
     "suite_finals",
     "load_finals",
     "merge_finals",
@@ -89,38 +89,6 @@ def method_of(label: str, domain: str) -> str:
     return label[: -len(suffix)] if label.endswith(suffix) and len(label) > len(suffix) else label
 
 
-def _with_defaults(algo, config: dict) -> dict:
-    """A recorded config with the settings added since it was written at their defaults (as a resume counts them),
-    so that a run recorded before a setting existed is a seed of one recorded after; as recorded where the
-    algorithm is unknown or the config no longer loads."""
-    from pamdp.algos import algorithm_class
-
-    try:
-        cls = algorithm_class(algo) if isinstance(algo, str) else None
-        return config if cls is None else cls.config_class.from_dict(config).to_dict()
-    except (ValueError, TypeError):  # an unknown algorithm, or settings it no longer takes
-        return config
-
-
-def setting_of(recorded: dict) -> dict:
-    """What tells apart runs that are not seeds of one another: the budget, the preset and a digest of the algorithm
-    and all its settings but the seed (``None`` where the run's ``run.json`` does not record them)."""
-    import hashlib
-
-    config = recorded.get("config")
-    digest = None
-    if isinstance(config, dict):
-        config = _with_defaults(recorded.get("algo"), config)
-        text = json.dumps([recorded.get("algo"), {k: v for k, v in config.items() if k != "seed"}], sort_keys=True)
-        digest = hashlib.sha256(text.encode()).hexdigest()[:8]
-    steps = recorded.get("total_steps")
-    return {
-        "total_steps": steps if isinstance(steps, int) and not isinstance(steps, bool) else None,
-        "preset": recorded.get("preset") if isinstance(recorded.get("preset"), str) else None,
-        "settings": digest,
-    }
-
-
 def _figure(run: Path, domain: str) -> tuple[float, bool] | None:
     """A run's success rate (Platform: return) and whether it is final: its evaluation's, else its last greedy
     evaluation during training, else ``None``."""
@@ -151,7 +119,7 @@ def _seed_of(run: Path, recorded: dict) -> int | None:
 def suite_finals(groups: dict[str, list[Path]]) -> list[dict]:
     """One entry per run of the groups (:func:`plots.find_groups`) on a suite domain with a figure:
     ``{"domain", "method", "seed", "value", "final", "source", "total_steps", "preset", "settings"}`` (the last three:
-    :func:`setting_of`; ``final``: its evaluation of 1000 episodes, else
+    :func:`~pamdp.experiments.plots.setting_of`; ``final``: its evaluation of 1000 episodes, else
     its last greedy evaluation during training; ``source``: the run's directory, its last three parts, as
     ``benchmark-suite/PATRPO_on_Goal/seed0``: where it lies under the runs' root, without a machine's own path)."""
     from pamdp.experiments.plots import _recorded
@@ -174,7 +142,7 @@ def suite_finals(groups: dict[str, list[Path]]) -> list[dict]:
 FINALS_KEYS = {"domain": str, "method": str, "seed": int, "value": float, "final": bool, "source": str}
 """The keys of a suite-finals entry and their types."""
 SETTING_KEYS = {"total_steps": int, "preset": str, "settings": str}
-"""The keys of :func:`setting_of`: in entries since issue 46 (``None`` where the run did not record them, and in
+"""The keys of :func:`~pamdp.experiments.plots.setting_of`: in entries since issue 46 (``None`` where the run did not record them, and in
 older archives' entries, which lack them)."""
 
 
