@@ -2,7 +2,7 @@
 
 ``pamdp reproduce benchmark-suite`` names its runs ``"METHOD on DOMAIN"``; :func:`suite_table` finds each run's
 domain from the env (and its arguments, with the constructor's defaults) its ``run.json`` records, and its method
-from the label. A cell averages the seeds of one setting (budget, preset and settings, :func:`~pamdp.experiments.plots.setting_of`): runs of
+from the label. A cell averages the seeds of one setting (budget, preset and settings, :func:`.plots.setting_of`): runs of
 another setting get rows of their own, never counted as seeds of it. A finished run
 counts with its final evaluation (1000 greedy episodes); a run still training with its last greedy evaluation
 during training (100 episodes), marked as such. Platform's figure is the return, as in HyAR's table; the
@@ -119,7 +119,7 @@ def _seed_of(run: Path, recorded: dict) -> int | None:
 def suite_finals(groups: dict[str, list[Path]]) -> list[dict]:
     """One entry per run of the groups (:func:`plots.find_groups`) on a suite domain with a figure:
     ``{"domain", "method", "seed", "value", "final", "source", "total_steps", "preset", "settings"}`` (the last three:
-    :func:`~pamdp.experiments.plots.setting_of`; ``final``: its evaluation of 1000 episodes, else
+    :func:`.plots.setting_of`; ``final``: its evaluation of 1000 episodes, else
     its last greedy evaluation during training; ``source``: the run's directory, its last three parts, as
     ``benchmark-suite/PATRPO_on_Goal/seed0``: where it lies under the runs' root, without a machine's own path)."""
     from pamdp.experiments.plots import _recorded
@@ -142,7 +142,7 @@ def suite_finals(groups: dict[str, list[Path]]) -> list[dict]:
 FINALS_KEYS = {"domain": str, "method": str, "seed": int, "value": float, "final": bool, "source": str}
 """The keys of a suite-finals entry and their types."""
 SETTING_KEYS = {"total_steps": int, "preset": str, "settings": str}
-"""The keys of :func:`~pamdp.experiments.plots.setting_of`: in entries since issue 46 (``None`` where the run did not record them, and in
+"""The keys of :func:`.plots.setting_of`: in entries since issue 46 (``None`` where the run did not record them, and in
 older archives' entries, which lack them)."""
 
 
