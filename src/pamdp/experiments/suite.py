@@ -2,8 +2,8 @@
 
 ``pamdp reproduce benchmark-suite`` names its runs ``"METHOD on DOMAIN"``; :func:`suite_table` finds each run's
 domain from the env (and its arguments, with the constructor's defaults) its ``run.json`` records, and its method
-from the label. A cell averages the seeds of one setting (budget, preset and settings, :func:`.plots.setting_of`): runs of
-another setting get rows of their own, never counted as seeds of it. A finished run
+from the label. A cell averages the seeds of one setting (budget, preset and settings,
+:func:`.plots.setting_of`): runs of another setting get rows of their own, never counted as seeds of it. A finished run
 counts with its final evaluation (1000 greedy episodes); a run still training with its last greedy evaluation
 during training (100 episodes), marked as such. Platform's figure is the return, as in HyAR's table; the
 others' the success rate (``info["is_success"]``).
