@@ -7,8 +7,8 @@
 # ones continue from their last checkpoint; the off-policy runs keep their replay buffer in it), so a
 # session simply starts this again. Outputs go outside the work tree: the soccer figure's runs under
 # $SOCCER_OUT, the benchmark suite's under $SUITE_OUT, HFO's other algorithms under $HFO_OUT (defaults under
-# $PAMDP_RUNS, itself /root/pamdp-runs by default). On 2026-12-02 they were /work/runs/soccer/results,
-# /work/runs/suite/results and /work/runs/hfo/results: set the three variables to go on with those runs.
+# $PAMDP_RUNS, itself ~/pamdp-runs by default). On 2026-12-02 they were $PAMDP_RUNS/soccer/results,
+# $PAMDP_RUNS/suite/results and $PAMDP_RUNS/hfo/results: set the three variables to go on with those runs.
 # A session that starts on a new machine has none of them: everything starts from scratch.
 #
 # Costs on this 2-core machine (CPU time a sample; docs/results.md, benchmarks/hfo_learning.md):
@@ -19,7 +19,7 @@
 #   HFO:    PAPPO 0.46 ms (~40 min a run)
 set -euo pipefail
 cd "$(dirname "$0")"
-RUNS=${PAMDP_RUNS:-/root/pamdp-runs}
+RUNS=${PAMDP_RUNS:-$HOME/pamdp-runs}
 SOCCER_OUT=${SOCCER_OUT:-$RUNS/repro}
 SUITE_OUT=${SUITE_OUT:-$RUNS/suite}
 HFO_OUT=${HFO_OUT:-$RUNS/hfo}

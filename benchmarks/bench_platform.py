@@ -6,8 +6,8 @@ its copies) at several sizes. Writes ``benchmarks/platform_speed.md``, keeping t
 
 The peer is installed in its own virtual environment, never in pamdp's dependencies::
 
-    python3 -m venv /tmp/peer && /tmp/peer/bin/pip install hybrid-platform numba
-    .venv/bin/python benchmarks/bench_platform.py --peer-python /tmp/peer/bin/python
+    python3 -m venv peer-venv && peer-venv/bin/pip install hybrid-platform numba
+    .venv/bin/python benchmarks/bench_platform.py --peer-python peer-venv/bin/python
 
 Every measurement runs in a fresh subprocess pinned to one core (``taskset -c 0``, where available);
 the configurations are interleaved within each repeat, so a slow spell of a shared machine hits all of
@@ -202,7 +202,7 @@ def _cpu_model() -> str:
 
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--peer-python", default="/tmp/peer/bin/python", help="python of the venv with hybrid-platform")
+    parser.add_argument("--peer-python", default="peer-venv/bin/python", help="python of the venv with hybrid-platform")
     parser.add_argument("--repeats", type=int, default=5, help="measurements per configuration (medians reported)")
     parser.add_argument("--seconds", type=float, default=3.0, help="timed duration of one measurement")
     parser.add_argument("--check-seeds", type=int, default=200, help="episodes of the dynamics check")
