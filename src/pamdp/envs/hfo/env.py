@@ -35,6 +35,7 @@ from __future__ import annotations
 import numpy as np
 from gymnasium import spaces
 
+import pamdp.envs.hfo.defense as defense
 import pamdp.envs.hfo.dynamics as dyn
 from pamdp.envs.hfo.interface import check_settings, draw_half_field, hfo_action_space, parse_actions, reset_options
 from pamdp.envs.scalar import env_classes
@@ -60,6 +61,7 @@ class HalfFieldOffense(Domain):
 
     def __init__(
         self,
+        defense_npcs: int = 0,
         profile: str = "hfo2017",
         deterministic: bool = False,
         timeout_terminal: bool = False,
@@ -67,19 +69,30 @@ class HalfFieldOffense(Domain):
         first_step_reward: bool = False,
         terminal_deltas: bool = False,
     ):
-        check_settings(profile, body_reset)
+        check_settings(profile, body_reset, defense_npcs)
         self.profile = dyn.PROFILES[profile]
         self.settings = dyn.settings(
             self.profile, deterministic, timeout_terminal, terminal_deltas, first_step_reward, body_reset == "uniform"
         )
-        self.observation_space = spaces.Box(-1.0, 1.0, (self.profile.n_features,), dtype=np.float32)
+        self.goalie = defense_npcs == 1
+        # The goalie's block (8 features) and its uniform number come before the last-action flag.
+        self.n_features = self.profile.n_features + (9 if self.profile.n_features == 59 else 8) * self.goalie
+        if self.goalie:
+            self.state_size = defense.STATE_SIZE
+            self.name = "Half Field Offense 1v1"
+        self._step_batch = defense.step_batch if self.goalie else dyn.step_batch
+        self._reset_batch = defense.reset_batch if self.goalie else dyn.reset_batch
+        self.observation_space = spaces.Box(-1.0, 1.0, (self.n_features,), dtype=np.float32)
         self.action_space = hfo_action_space()
 
     def initial_states(self, n):
         self.copy_streams = np.zeros((n, 4), dtype=np.uint64)
         self._sources: list = [None] * n  # the generator that seeded each copy's stream
         self._seen = -1  # the streams' replacements when they were last followed
-        return np.zeros((n, self.state_size))  # the first episode faces the goal (body 0)
+        states = np.zeros((n, self.state_size))  # the first episode faces the goal (body 0)
+        for row in states if self.goalie else ():
+            defense.new_goalie(row)
+        return states
 
     def state(self, states):
         return states
@@ -98,20 +111,22 @@ class HalfFieldOffense(Domain):
                 self._sources[i] = rng
 
     def reset(self, env, mask, options, seeded):
-        placements = reset_options(options, env.num_envs, shell_keys=("reset_mask",))
+        placements = reset_options(options, env.num_envs, shell_keys=("reset_mask",), goalie=self.goalie)
         self._follow(env)
         env._states[mask & seeded, dyn.BODY] = 0.0  # a new server run faces the goal
-        obs = np.empty((env.num_envs, self.profile.n_features), dtype=np.float32)
-        dyn.reset_batch(env._states, self.copy_streams, mask, self.settings, placements, obs)
+        for i in np.flatnonzero(mask & seeded) if self.goalie else ():
+            defense.new_goalie(env._states[i])  # and starts a new goalie program
+        obs = np.empty((env.num_envs, self.n_features), dtype=np.float32)
+        self._reset_batch(env._states, self.copy_streams, mask, self.settings, placements, obs)
         return obs, self._infos(env)
 
     def step(self, env, parsed, resetting):
         (a, dash, turn, kick), n = parsed, env.num_envs
         self._follow(env)
-        obs = np.empty((n, self.profile.n_features), dtype=np.float32)
+        obs = np.empty((n, self.n_features), dtype=np.float32)
         reward, status = np.empty(n), np.empty(n, dtype=np.int64)
         terminated, truncated = np.empty(n, dtype=bool), np.empty(n, dtype=bool)
-        dyn.step_batch(
+        self._step_batch(
             env._states, self.copy_streams, a, dash, turn, kick, resetting, self.settings, obs, reward, status,
             terminated, truncated,
         )  # fmt: skip
