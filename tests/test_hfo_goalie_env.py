@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import pamdp  # noqa: F401
-from pamdp.envs.hfo import defense, goalie, scripted_scorer
+from pamdp.envs.hfo import defense, goalie, scripted_scorer, scripted_scorer_batch
 from pamdp.envs.hfo import dynamics as dyn
 
 #: Episodes whose ending turns on the post-catch collision, decided by the last bits of the positions (the server
@@ -115,3 +115,30 @@ def test_1v1_places_ball_and_agent_as_1v0_with_the_same_seed():
         ob, _ = b.reset(seed=seed)
         sa, sb = a.unwrapped.state, b.unwrapped.state
         assert np.array_equal(sa[[dyn.PX, dyn.PY, dyn.BX, dyn.BY]], sb[[dyn.PX, dyn.PY, dyn.BX, dyn.BY]])
+
+
+def test_batched_copy_i_is_the_scalar_env_seeded_seed_plus_i_through_captures_and_dead_cycles():
+    """With noise on and the scorer's actions, so that episodes end by HFO's own endings (captures, goals), whose
+    dead cycles and hidden cycles draw from each copy's stream."""
+    n, seed = 4, 21
+    venv = gym.make_vec("pamdp/HalfFieldOffenseGoalie-v0", num_envs=n, vectorization_mode="vector_entry_point")
+    envs = [gym.make("pamdp/HalfFieldOffenseGoalie-v0") for _ in range(n)]
+    obs, _ = venv.reset(seed=seed)
+    singles = [env.reset(seed=seed + i)[0] for i, env in enumerate(envs)]
+    np.testing.assert_array_equal(obs, np.stack(singles))
+    ended = np.zeros(n, dtype=int)
+    pending = np.zeros(n, dtype=bool)
+    for _ in range(300):
+        obs, reward, terminated, truncated, info = venv.step(scripted_scorer_batch(obs))
+        for i, env in enumerate(envs):
+            if pending[i]:
+                single, r = env.reset()[0], 0.0
+            else:
+                single, r, te, tr, inf = env.step(scripted_scorer(singles[i]))
+                assert (te, tr, inf["status"]) == (terminated[i], truncated[i], info["status"][i])
+            np.testing.assert_array_equal(obs[i], single)
+            assert reward[i] == r
+            singles[i] = single
+        pending = terminated | truncated
+        ended += pending
+    assert (ended >= 2).all()

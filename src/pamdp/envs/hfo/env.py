@@ -1,12 +1,14 @@
-"""Half Field Offense 1v0 as a pamdp domain: its contract and its two envs (the task: ``pamdp.envs.hfo``).
+"""Half Field Offense 1v0 and 1v1 as a pamdp domain: its contract and its two envs (the task: ``pamdp.envs.hfo``).
 
-``info`` holds ``status`` ("IN_GAME", "GOAL", "OUT_OF_BOUNDS" or "OUT_OF_TIME"), ``step``, the number of
+``info`` holds ``status`` ("IN_GAME", "GOAL", "OUT_OF_BOUNDS", "OUT_OF_TIME" or, with the goalie,
+"CAPTURED_BY_DEFENSE"), ``step``, the number of
 actions taken this episode, and ``action_mask``, bool ``(3,)``: which of DASH, TURN and KICK have an effect
 in the returned state (KICK only when the agent's kickable test passes, as HFO's agent sends it); when an
 episode ends also ``is_success`` (True on a goal). The observation returned with a terminal status is the
 true terminal state. ``reset(options=...)`` accepts ``ball`` (x, y), ``player`` (x, y) and ``body``
 (degrees), in the server's metres (goal centre at (52.5, 0)), each once or one per copy (a leading axis of
-size N); missing ones are drawn as usual.
+size N); missing ones are drawn as usual. With the goalie also ``goalie_body`` (degrees), its body at its
+placement; any option given starts the goalie's memory neutral (``defense``).
 
 Random numbers: each copy draws placements and actuator noise from a stream of its own (four 64-bit words,
 ``copy_streams[i]``, ``dynamics.seed_stream``) seeded from its generator whenever that is a new one (a seeded
@@ -15,6 +17,8 @@ a new server run does. ``state`` is the live state rows (indices in ``dynamics``
 recorded traces set the simulator's state.
 
 The settings (constructor arguments of the domain, the scalar and the batched env):
+    defense_npcs: 0 (default) for 1v0 on an empty goal; 1 for HFO's goalie (``defense``; 68 features, 66 with
+        ``hfo2016``), the task registered as ``pamdp/HalfFieldOffenseGoalie-v0``.
     profile: feature set of an HFO release: ``"hfo2016"`` (58 features, Hausknecht & Stone), ``"hfo2017"``
         (59, the seed paper's; default) or ``"hfo2019"`` (59, current HFO normalisers). The reward reads the
         features, so it scales with the profile's Dmax.
