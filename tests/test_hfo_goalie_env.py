@@ -142,3 +142,23 @@ def test_batched_copy_i_is_the_scalar_env_seeded_seed_plus_i_through_captures_an
         pending = terminated | truncated
         ended += pending
     assert (ended >= 2).all()
+
+
+def test_the_worked_catch_example_moves_the_goalie_and_the_capture_ends_the_same_step():
+    """Spec example (server frame): goalie at (50, 0) facing 180, ball at rest at (49, -0.7). The goalie catches
+    (catch 57.612): the server moves it to (49.31540, -0.47922), facing -145.008 degrees, at rest; the ball is not
+    held, but it now lies 0.385 m from the goalie, so the referee ends the episode in that same step."""
+    env = make()
+    env.reset(options={"ball": (10.0, 0.0), "player": (30.0, 20.0), "body": 0.0, "goalie_body": 180.0})
+    s = env.unwrapped.state
+    s[[defense.GX, defense.GY, defense.GVX, defense.GVY, defense.GBODY]] = 50.0, 0.0, 0.0, 0.0, 180.0
+    s[[dyn.BX, dyn.BY, dyn.PREV_BX, dyn.PREV_BY]] = 49.0, -0.7, 49.0, -0.7
+    dyn.sense(s)
+    _, reward, terminated, _, info = env.step((1, (np.zeros(2), np.zeros(1), np.zeros(2))))
+    assert info["status"] == "CAPTURED_BY_DEFENSE" and terminated
+    assert s[defense.GX] == pytest.approx(49.31540, abs=1e-5) and s[defense.GY] == pytest.approx(-0.47922, abs=1e-5)
+    assert s[defense.GVX] == s[defense.GVY] == 0.0
+    # The dead cycle after a catch-then-capture: the goalie, believing it holds the ball, turns to face the
+    # centre spot (at rest, so in one turn); that body, not the catch's -145.008, starts the next episode.
+    assert s[defense.MEMORY + goalie.M_CATCH_MODE] == 1.0
+    assert s[defense.GBODY] == pytest.approx(np.degrees(np.arctan2(0.47922, -49.31540)), abs=2e-3)
