@@ -19,6 +19,10 @@ observation. Its body angle is never reset (180 degrees at a new server run). Th
 (turn noise, tackle outcomes) come from the copy's own stream, after the agent's.
 
 The state row extends the 1v0 one (indices of ``dynamics`` first, then the goalie's below).
+
+Numba's on-disk cache is keyed by each module's own file, and these functions inline ``dynamics``, ``goalie``
+and ``two_player``: after editing one of those, clear the cache (``__pycache__/*.nbi``, ``*.nbc``) before timing
+or replaying the 1v1 env.
 """
 
 from __future__ import annotations
