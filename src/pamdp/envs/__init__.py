@@ -2,6 +2,7 @@
 
 - ``pamdp/Platform-v0``: Masson, Ranchod & Konidaris' Platform (``platform/``).
 - ``pamdp/HalfFieldOffense-v0``: Half Field Offense 1v0, empty goal (``hfo/``).
+- ``pamdp/HalfFieldOffenseGoalie-v0``: Half Field Offense 1v1 against HFO's goalie (``hfo/``, ``defense_npcs=1``).
 - ``pamdp/Goal-v0`` and ``pamdp/HardGoal-v0``: Robot Soccer Goal and HyAR's Hard Goal (``goal/``).
 - ``pamdp/CatchPoint-v0``: HyAR's Catch Point (``catch_point/``).
 - ``pamdp/HardMove-v0``: HyAR's Hard Move with ``n`` actuators, 4 to 10 (``hard_move/``).
@@ -26,6 +27,11 @@ _REGISTRATIONS = {
     "pamdp/HalfFieldOffense-v0": dict(
         entry_point="pamdp.envs.hfo.env:HalfFieldOffenseEnv",
         vector_entry_point="pamdp.envs.hfo.env:HalfFieldOffenseVectorEnv",
+    ),
+    "pamdp/HalfFieldOffenseGoalie-v0": dict(
+        entry_point="pamdp.envs.hfo.env:HalfFieldOffenseEnv",
+        vector_entry_point="pamdp.envs.hfo.env:HalfFieldOffenseVectorEnv",
+        kwargs={"defense_npcs": 1},
     ),
     # Goal, Hard Goal, Moving and Sliding end their episodes by their own step limits (the specs: no TimeLimit).
     "pamdp/Goal-v0": dict(

@@ -1,10 +1,12 @@
-"""Half Field Offense 1v0, empty goal (Hausknecht & Stone, ICLR 2016; ``LARG/HFO``):
-``pamdp/HalfFieldOffense-v0``.
+"""Half Field Offense 1v0, empty goal (Hausknecht & Stone, ICLR 2016; ``LARG/HFO``): ``pamdp/HalfFieldOffense-v0``;
+and 1v1 against HFO's goalie (``defense_npcs=1``): ``pamdp/HalfFieldOffenseGoalie-v0``.
 
 - ``dynamics``: one copy's physics, referee, features and shaped reward, compiled by Numba, and their loops
   over the copies.
 - ``env``: the domain contract, :class:`HalfFieldOffense` (its settings are constructor arguments), and its envs
   ``HalfFieldOffenseEnv`` (scalar) and ``HalfFieldOffenseVectorEnv`` (batched).
+- ``defense``, ``goalie``, ``two_player``: the 1v1 cycle, the goalie's decision (agent2d's goalie, written from
+  a description of its rules) and the server rules a second player brings (catch, tackle, collisions).
 - ``interface``: the action space, the checks of actions and reset options, the drawing.
 - ``scorer``: a hand-written agent that scores almost always, the benchmarks' reference row.
 

@@ -94,7 +94,9 @@ START_SPREAD = 10.5
 START_X_MIN = -0.1
 
 IN_GAME, GOAL, OUT_OF_BOUNDS, OUT_OF_TIME = 0, 1, 2, 3
-STATUS_NAMES = ("IN_GAME", "GOAL", "OUT_OF_BOUNDS", "OUT_OF_TIME")
+#: Only with the goalie (``defense``): the defense took the ball.
+CAPTURED_BY_DEFENSE = 4
+STATUS_NAMES = ("IN_GAME", "GOAL", "OUT_OF_BOUNDS", "OUT_OF_TIME", "CAPTURED_BY_DEFENSE")
 DASH, TURN, KICK = 0, 1, 2
 
 # --- One copy's state vector ---------------------------------------------------------------------
@@ -333,15 +335,21 @@ def dash(s, power, direction):
             v_perp2 = svx * svx + svy * svy - v_par * v_par
             accel = max(math.sqrt(max(PLAYER_SPEED_MAX * PLAYER_SPEED_MAX - v_perp2, 0.0)) - v_par, 0.0)
             power = math.copysign(accel / accel_rate, power)
-    power = round_command(power)
-    # The server's side: pay stamina, then accelerate along body + direction.
+    s[STAMINA], ax, ay = server_dash(s[STAMINA], s[EFFORT], s[BODY], round_command(power), direction, rate)
+    return ax, ay
+
+
+@jit
+def server_dash(stamina, effort, body, power, direction, rate):
+    """The server's dash of any player (``direction`` on the 45-degree grid, its efficiency ``rate``): pay the
+    stamina, then accelerate along body + direction. Returns ``(stamina, ax, ay)``."""
     backward = power < 0.0
-    need = min(-2.0 * power if backward else power, s[STAMINA] + EXTRA_STAMINA)
-    s[STAMINA] = max(s[STAMINA] - need, 0.0)
+    need = min(-2.0 * power if backward else power, stamina + EXTRA_STAMINA)
+    stamina = max(stamina - need, 0.0)
     power = -need / 2.0 if backward else need
-    accel = abs(s[EFFORT] * power * rate * DASH_POWER_RATE)
-    phi = math.radians(s[BODY] + direction + (180.0 if backward else 0.0))
-    return accel * math.cos(phi), accel * math.sin(phi)
+    accel = abs(effort * power * rate * DASH_POWER_RATE)
+    phi = math.radians(body + direction + (180.0 if backward else 0.0))
+    return stamina, accel * math.cos(phi), accel * math.sin(phi)
 
 
 @jit
@@ -516,22 +524,26 @@ def referee(s):
 @jit
 def update_stamina(s):
     """Spec 2.6: recovery and effort decay below 30% stamina, effort recovers above 60%."""
-    stamina = s[STAMINA]
-    if stamina <= RECOVER_DEC_THR * STAMINA_MAX:
-        s[RECOVERY] = max(s[RECOVERY] - RECOVER_DEC, RECOVER_MIN)
-    if stamina <= EFFORT_DEC_THR * STAMINA_MAX:
-        s[EFFORT] = max(s[EFFORT] - EFFORT_DEC, EFFORT_MIN)
-    if stamina >= EFFORT_INC_THR * STAMINA_MAX and s[EFFORT] < EFFORT_MAX:
-        s[EFFORT] = min(s[EFFORT] + EFFORT_INC, EFFORT_MAX)
-    inc = min(s[RECOVERY] * STAMINA_INC_MAX, STAMINA_MAX - stamina, s[CAPACITY])
-    s[STAMINA] = stamina + inc
-    s[CAPACITY] -= inc
+    s[STAMINA], s[EFFORT], s[RECOVERY], s[CAPACITY] = stamina_model(s[STAMINA], s[EFFORT], s[RECOVERY], s[CAPACITY])
 
 
 @jit
-def simulate(s, rng, a, x0, x1, cfg):
-    """One agent action (``DASH(x0, x1)``, ``TURN(x0)`` or ``KICK(x0, x1)``) and one server cycle after it:
-    movement, collisions, referee, stamina, the agent's new view. Returns the referee's status."""
+def stamina_model(stamina, effort, recovery, capacity):
+    """One cycle of the stamina model for any player: ``(stamina, effort, recovery, capacity)`` after it."""
+    if stamina <= RECOVER_DEC_THR * STAMINA_MAX:
+        recovery = max(recovery - RECOVER_DEC, RECOVER_MIN)
+    if stamina <= EFFORT_DEC_THR * STAMINA_MAX:
+        effort = max(effort - EFFORT_DEC, EFFORT_MIN)
+    if stamina >= EFFORT_INC_THR * STAMINA_MAX and effort < EFFORT_MAX:
+        effort = min(effort + EFFORT_INC, EFFORT_MAX)
+    inc = min(recovery * STAMINA_INC_MAX, STAMINA_MAX - stamina, capacity)
+    return stamina + inc, effort, recovery, capacity - inc
+
+
+@jit
+def agent_command(s, rng, a, x0, x1, cfg):
+    """The agent's action as the server applies it when it arrives: a turn at once; returns the accelerations
+    ``(player x, y, ball x, y)`` of a dash or a kick for the movement phase."""
     pax = pay = bax = bay = 0.0
     sent = True
     if a == DASH:
@@ -544,6 +556,14 @@ def simulate(s, rng, a, x0, x1, cfg):
         sent = False  # HFO sends (turn 0) instead: no effect on the state (spec 2.12.3)
     s[KICKED] = a == KICK and sent
     s[LAST_ACTION_OK] = sent
+    return pax, pay, bax, bay
+
+
+@jit
+def simulate(s, rng, a, x0, x1, cfg):
+    """One agent action (``DASH(x0, x1)``, ``TURN(x0)`` or ``KICK(x0, x1)``) and one server cycle after it:
+    movement, collisions, referee, stamina, the agent's new view. Returns the referee's status."""
+    pax, pay, bax, bay = agent_command(s, rng, a, x0, x1, cfg)
     rand = cfg[_PLAYER_RAND]
     s[COLLIDED_POST] = move(s, rng, PX, pax, pay, PLAYER_ACCEL_MAX, PLAYER_SPEED_MAX, rand, PLAYER_DECAY, PLAYER_SIZE)
     move(s, rng, BX, bax, bay, BALL_ACCEL_MAX, BALL_SPEED_MAX, cfg[_BALL_RAND], BALL_DECAY, BALL_SIZE)
@@ -691,6 +711,12 @@ def step_copy(s, rng, a, x0, x1, cfg, f):
     status = simulate(s, rng, a, x0, x1, cfg)
     s[STEPS] += 1
     features(s, cfg, f)
+    return shaped_reward(s, cfg, f, status), status
+
+
+@jit
+def shaped_reward(s, cfg, f, status):
+    """The reward of a transition whose new features are ``f`` (spec 2.9); keeps what the next one differences."""
     to_goal = ball_to_goal(f)
     goal = status == GOAL
     if (status != IN_GAME and not cfg[_TERMINAL_DELTAS]) or (s[STEPS] == 1 and not cfg[_FIRST_STEP_REWARD]):
@@ -703,7 +729,7 @@ def step_copy(s, rng, a, x0, x1, cfg, f):
         reward += 3.0 * (s[PREV_TO_GOAL] - to_goal) if s[HOLDER] else 0.0
         reward += 5.0 if goal else 0.0
     s[PREV_KICKABLE], s[PREV_BALL_PROXIMITY], s[PREV_TO_GOAL] = f[KICKABLE], f[BALL_PROXIMITY], to_goal
-    return reward, status
+    return reward
 
 
 @jit
@@ -711,7 +737,8 @@ def ending(status, cfg):
     """``(terminated, truncated)`` of a status: a timeout is a truncation unless the settings say terminal."""
     timeout = status == OUT_OF_TIME
     timeout_terminal = cfg[_TIMEOUT_TERMINAL] != 0.0
-    return status == GOAL or status == OUT_OF_BOUNDS or (timeout and timeout_terminal), timeout and not timeout_terminal
+    ended = status == GOAL or status == OUT_OF_BOUNDS or status == CAPTURED_BY_DEFENSE
+    return ended or (timeout and timeout_terminal), timeout and not timeout_terminal
 
 
 # --- Entry points: the loops over the copies ----------------------------------------------------

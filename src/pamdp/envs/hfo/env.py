@@ -1,12 +1,14 @@
-"""Half Field Offense 1v0 as a pamdp domain: its contract and its two envs (the task: ``pamdp.envs.hfo``).
+"""Half Field Offense 1v0 and 1v1 as a pamdp domain: its contract and its two envs (the task: ``pamdp.envs.hfo``).
 
-``info`` holds ``status`` ("IN_GAME", "GOAL", "OUT_OF_BOUNDS" or "OUT_OF_TIME"), ``step``, the number of
+``info`` holds ``status`` ("IN_GAME", "GOAL", "OUT_OF_BOUNDS", "OUT_OF_TIME" or, with the goalie,
+"CAPTURED_BY_DEFENSE"), ``step``, the number of
 actions taken this episode, and ``action_mask``, bool ``(3,)``: which of DASH, TURN and KICK have an effect
 in the returned state (KICK only when the agent's kickable test passes, as HFO's agent sends it); when an
 episode ends also ``is_success`` (True on a goal). The observation returned with a terminal status is the
 true terminal state. ``reset(options=...)`` accepts ``ball`` (x, y), ``player`` (x, y) and ``body``
 (degrees), in the server's metres (goal centre at (52.5, 0)), each once or one per copy (a leading axis of
-size N); missing ones are drawn as usual.
+size N); missing ones are drawn as usual. With the goalie also ``goalie_body`` (degrees), its body at its
+placement; any option given starts the goalie's memory neutral (``defense``).
 
 Random numbers: each copy draws placements and actuator noise from a stream of its own (four 64-bit words,
 ``copy_streams[i]``, ``dynamics.seed_stream``) seeded from its generator whenever that is a new one (a seeded
@@ -15,6 +17,8 @@ a new server run does. ``state`` is the live state rows (indices in ``dynamics``
 recorded traces set the simulator's state.
 
 The settings (constructor arguments of the domain, the scalar and the batched env):
+    defense_npcs: 0 (default) for 1v0 on an empty goal; 1 for HFO's goalie (``defense``; 68 features, 66 with
+        ``hfo2016``), the task registered as ``pamdp/HalfFieldOffenseGoalie-v0``.
     profile: feature set of an HFO release: ``"hfo2016"`` (58 features, Hausknecht & Stone), ``"hfo2017"``
         (59, the seed paper's; default) or ``"hfo2019"`` (59, current HFO normalisers). The reward reads the
         features, so it scales with the profile's Dmax.
@@ -35,6 +39,7 @@ from __future__ import annotations
 import numpy as np
 from gymnasium import spaces
 
+import pamdp.envs.hfo.defense as defense
 import pamdp.envs.hfo.dynamics as dyn
 from pamdp.envs.hfo.interface import check_settings, draw_half_field, hfo_action_space, parse_actions, reset_options
 from pamdp.envs.scalar import env_classes
@@ -60,6 +65,7 @@ class HalfFieldOffense(Domain):
 
     def __init__(
         self,
+        defense_npcs: int = 0,
         profile: str = "hfo2017",
         deterministic: bool = False,
         timeout_terminal: bool = False,
@@ -67,19 +73,30 @@ class HalfFieldOffense(Domain):
         first_step_reward: bool = False,
         terminal_deltas: bool = False,
     ):
-        check_settings(profile, body_reset)
+        check_settings(profile, body_reset, defense_npcs)
         self.profile = dyn.PROFILES[profile]
         self.settings = dyn.settings(
             self.profile, deterministic, timeout_terminal, terminal_deltas, first_step_reward, body_reset == "uniform"
         )
-        self.observation_space = spaces.Box(-1.0, 1.0, (self.profile.n_features,), dtype=np.float32)
+        self.goalie = defense_npcs == 1
+        # The goalie's block (8 features) and its uniform number come before the last-action flag.
+        self.n_features = self.profile.n_features + (9 if self.profile.n_features == 59 else 8) * self.goalie
+        if self.goalie:
+            self.state_size = defense.STATE_SIZE
+            self.name = "Half Field Offense 1v1"
+        self._step_batch = defense.step_batch if self.goalie else dyn.step_batch
+        self._reset_batch = defense.reset_batch if self.goalie else dyn.reset_batch
+        self.observation_space = spaces.Box(-1.0, 1.0, (self.n_features,), dtype=np.float32)
         self.action_space = hfo_action_space()
 
     def initial_states(self, n):
         self.copy_streams = np.zeros((n, 4), dtype=np.uint64)
         self._sources: list = [None] * n  # the generator that seeded each copy's stream
         self._seen = -1  # the streams' replacements when they were last followed
-        return np.zeros((n, self.state_size))  # the first episode faces the goal (body 0)
+        states = np.zeros((n, self.state_size))  # the first episode faces the goal (body 0)
+        for row in states if self.goalie else ():
+            defense.new_goalie(row)
+        return states
 
     def state(self, states):
         return states
@@ -98,20 +115,22 @@ class HalfFieldOffense(Domain):
                 self._sources[i] = rng
 
     def reset(self, env, mask, options, seeded):
-        placements = reset_options(options, env.num_envs, shell_keys=("reset_mask",))
+        placements = reset_options(options, env.num_envs, shell_keys=("reset_mask",), goalie=self.goalie)
         self._follow(env)
         env._states[mask & seeded, dyn.BODY] = 0.0  # a new server run faces the goal
-        obs = np.empty((env.num_envs, self.profile.n_features), dtype=np.float32)
-        dyn.reset_batch(env._states, self.copy_streams, mask, self.settings, placements, obs)
+        for i in np.flatnonzero(mask & seeded) if self.goalie else ():
+            defense.new_goalie(env._states[i])  # and starts a new goalie program
+        obs = np.empty((env.num_envs, self.n_features), dtype=np.float32)
+        self._reset_batch(env._states, self.copy_streams, mask, self.settings, placements, obs)
         return obs, self._infos(env)
 
     def step(self, env, parsed, resetting):
         (a, dash, turn, kick), n = parsed, env.num_envs
         self._follow(env)
-        obs = np.empty((n, self.profile.n_features), dtype=np.float32)
+        obs = np.empty((n, self.n_features), dtype=np.float32)
         reward, status = np.empty(n), np.empty(n, dtype=np.int64)
         terminated, truncated = np.empty(n, dtype=bool), np.empty(n, dtype=bool)
-        dyn.step_batch(
+        self._step_batch(
             env._states, self.copy_streams, a, dash, turn, kick, resetting, self.settings, obs, reward, status,
             terminated, truncated,
         )  # fmt: skip

@@ -17,8 +17,9 @@ PARAM_SIZES = (2, 1, 2)
 PARAM_LOW = (np.array([0.0, -180.0]), np.array([-180.0]), np.array([0.0, -180.0]))
 PARAM_HIGH = (np.array([100.0, 180.0]), np.array([180.0]), np.array([100.0, 180.0]))
 ACTION_FORM = "(a, (dash[power, direction], turn[direction], kick[power, direction])) with a in {0, 1, 2}"
-#: Order of the reset options in the vector the compiled reset reads (NaN where not given).
-OPTION_SLOTS = {"ball": slice(0, 2), "player": slice(2, 4), "body": slice(4, 5)}
+#: Order of the reset options in the vector the compiled reset reads (NaN where not given); ``goalie_body``
+#: only with the goalie (``defense_npcs=1``).
+OPTION_SLOTS = {"ball": slice(0, 2), "player": slice(2, 4), "body": slice(4, 5), "goalie_body": slice(5, 6)}
 
 
 def hfo_action_space() -> spaces.Tuple:
@@ -30,8 +31,11 @@ def hfo_action_space() -> spaces.Tuple:
     return spaces.Tuple((spaces.Discrete(3), spaces.Tuple(boxes)))
 
 
-def check_settings(profile: str, body_reset: str) -> None:
-    """Raise ``ValueError`` for an unknown feature profile or body-reset rule (the shell checks the render mode)."""
+def check_settings(profile: str, body_reset: str, defense_npcs: int = 0) -> None:
+    """Raise ``ValueError`` for an unknown feature profile, body-reset rule or number of defense NPCs (the shell
+    checks the render mode)."""
+    if isinstance(defense_npcs, bool) or defense_npcs not in (0, 1):
+        raise ValueError(f"defense_npcs={defense_npcs!r}; expected 0 (empty goal) or 1 (HFO's goalie)")
     if profile not in dyn.PROFILES:
         raise ValueError(f"profile={profile!r} is not one of {sorted(dyn.PROFILES)}")
     if body_reset not in ("carry", "uniform"):
@@ -62,23 +66,27 @@ def parse_actions(actions, n: int):
     return a, dash, turn, kick
 
 
-def reset_options(options, n: int, shell_keys: tuple[str, ...] = ()) -> np.ndarray:
-    """``reset(options=...)`` as an ``(n, 5)`` array (ball x, y, player x, y, body; NaN where not given).
+def reset_options(options, n: int, shell_keys: tuple[str, ...] = (), goalie: bool = False) -> np.ndarray:
+    """``reset(options=...)`` as an ``(n, 6)`` array (ball x, y, player x, y, body, goalie body; NaN where not
+    given).
 
-    Any of ``ball`` (x, y), ``player`` (x, y), ``body`` (degrees), each once for every copy or one per copy
-    (a leading axis of size n). The ball must lie in HFO's play area (0 <= x <= 52.5, |y| <= 34), the
-    player on the pitch (|x| <= 52.5, |y| <= 34). ``shell_keys`` (the batched env's ``reset_mask``) are
-    let through for the caller.
+    Any of ``ball`` (x, y), ``player`` (x, y), ``body`` (degrees) and, with the goalie (``goalie``),
+    ``goalie_body`` (degrees), each once for every copy or one per copy (a leading axis of size n). The ball
+    must lie in HFO's play area (0 <= x <= 52.5, |y| <= 34), the player on the pitch (|x| <= 52.5, |y| <= 34).
+    ``shell_keys`` (the batched env's ``reset_mask``) are let through for the caller.
     """
-    out = np.full((n, 5), np.nan)
+    out = np.full((n, OPTION_SLOTS["goalie_body"].stop), np.nan)
     if options is None:
         return out
     if not isinstance(options, dict):
         raise ValueError(f"reset options must be a dict, got {type(options).__name__}")
-    unknown = set(options) - {*OPTION_SLOTS, *shell_keys}
+    keys = [k for k in OPTION_SLOTS if goalie or k != "goalie_body"]
+    unknown = set(options) - {*keys, *shell_keys}
     if unknown:
-        raise ValueError(f"unknown reset option(s) {sorted(unknown)}; expected any of 'ball', 'player', 'body'")
-    for key, slots in OPTION_SLOTS.items():
+        expected = ", ".join(repr(k) for k in keys)
+        raise ValueError(f"unknown reset option(s) {sorted(unknown)}; expected any of {expected}")
+    for key in keys:
+        slots = OPTION_SLOTS[key]
         if key in options:
             out[:, slots] = _option(key, options[key], n).reshape(-1, slots.stop - slots.start)
     return out
@@ -86,7 +94,7 @@ def reset_options(options, n: int, shell_keys: tuple[str, ...] = ()) -> np.ndarr
 
 def _option(key: str, value, n: int) -> np.ndarray:
     """One reset option, checked, as an array of shape (2,) or () or, given per copy, (n, 2) or (n,)."""
-    point = key != "body"
+    point = key in ("ball", "player")
     try:
         arr = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError):
@@ -95,7 +103,7 @@ def _option(key: str, value, n: int) -> np.ndarray:
     if arr is None or arr.shape not in shapes or not np.all(np.isfinite(arr)):
         if point:
             raise ValueError(f"reset option {key}={value!r}; expected a pair of finite numbers (x, y) in metres")
-        raise ValueError(f"reset option body={value!r}; expected one finite angle in degrees")
+        raise ValueError(f"reset option {key}={value!r}; expected one finite angle in degrees")
     if point:
         x_lo = 0.0 if key == "ball" else -dyn.PITCH_HALF_LENGTH
         for x, y in arr.reshape(-1, 2):
