@@ -56,9 +56,9 @@ from pamdp.algos.offpolicy import (
     temperature_gradient,
 )
 from pamdp.algos.optim import apply_gradients, descend
-from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
+from pamdp.algos.settings import NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
 from pamdp.distributions import LOG_STD_MAX, LOG_STD_MIN, MASKED, SquashedHybrid, masked_logits
-from pamdp.policies import ACTIVATIONS, every_action_mlp, hierarchical_mlps, mlp, small_init_
+from pamdp.policies import every_action_mlp, hierarchical_mlps, mlp, small_init_
 from pamdp.spaces import HybridActionSpace
 
 if TYPE_CHECKING:
@@ -81,10 +81,7 @@ class HybridSACConfig(OffPolicyConfig, AlgoConfig):
         "(pi_c(x|s,a) on [s, onehot(a)], the seed paper's).",
         one_of(FORMS),
     )
-    hidden_sizes: tuple[int, ...] = setting(
-        (256, 256), "Hidden layers of each policy network and each critic (SAC's: 256-256; assumed).", LAYERS
-    )
-    activation: str = setting("relu", "Hidden activation: relu, leaky_relu, tanh or elu.", one_of(ACTIVATIONS))
+    hidden_sizes: tuple[int, ...] = shared_setting("hidden_sizes", (256, 256), "SAC's: 256-256; assumed")
     actor_lr: float = setting(3e-4, "Adam learning rate of the policy (SAC: 3e-4; assumed).", POSITIVE)
     critic_lr: float = setting(3e-4, "Adam learning rate of the twin critics (SAC: 3e-4; assumed).", POSITIVE)
     alpha_lr: float = setting(

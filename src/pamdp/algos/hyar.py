@@ -84,10 +84,7 @@ class HyARConfig(OffPolicyConfig, AlgoConfig):
     vae_hidden_sizes: tuple[int, ...] = setting(
         (256, 256), "Hidden layers of the VAE's encoder and decoder (assumed).", LAYERS
     )
-    hidden_sizes: tuple[int, ...] = setting(
-        (256, 256), "Hidden layers of the actor and each critic (TD3's: 256-256).", LAYERS
-    )
-    activation: str = setting("relu", "Hidden activation: relu, leaky_relu, tanh or elu.", one_of(ACTIVATIONS))
+    hidden_sizes: tuple[int, ...] = shared_setting("hidden_sizes", (256, 256), "TD3's: 256-256")
     bound: str = setting(
         "squash",
         "Keeping the actor's output in [-1, 1]: squash (Tanh, the paper) or invert (a linear output and Hausknecht "

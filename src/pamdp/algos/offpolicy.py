@@ -34,14 +34,15 @@ import torch
 from torch import nn
 
 from pamdp.algos.replay import ReplayBuffer, transition_fields
-from pamdp.algos.settings import NON_NEGATIVE, POSITIVE, at_least, interval, setting
+from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, at_least, interval, one_of, redeclared, setting
 from pamdp.algos.subnormals import subnormals_flushed
 from pamdp.algos.vector_env import Step, VectorStepper
 from pamdp.distributions import masked_logits
-from pamdp.policies import mlp
+from pamdp.policies import ACTIVATIONS, mlp
 
 __all__ = [
     "OffPolicyConfig",
+    "DeterministicActorConfig",
     "shared_setting",
     "OffPolicyLoop",
     "TwinQ",
@@ -104,13 +105,55 @@ class OffPolicyConfig:
         "script: 1/50); logged returns and evaluations stay the env's.",
         POSITIVE,
     )
+    hidden_sizes: tuple[int, ...] = setting(
+        (256, 256), "Hidden layers of the actor (or policy) and the critics.", LAYERS
+    )
+    activation: str = setting("relu", "Hidden activation: relu, leaky_relu, tanh or elu.", one_of(ACTIVATIONS))
 
 
-def shared_setting(name: str, default, source: str):
-    """:class:`OffPolicyConfig`'s setting ``name`` with an algorithm's own ``default``; ``source`` says where the
-    value comes from and joins the help ("Transitions per gradient update (Hausknecht & Stone: 32).")."""
-    help = OffPolicyConfig.__dataclass_fields__[name].metadata["help"]
-    return setting(default, f"{help.rstrip('.')} ({source}).")
+@dataclasses.dataclass(frozen=True)
+class DeterministicActorConfig:
+    """The settings of a deterministic actor with outputs in ``[-1, 1]`` (PADDPG's and P-DQN's), declared once as
+    :class:`OffPolicyConfig`'s are: how the outputs are kept in bounds, the Monte-Carlo part of the target, and
+    the exploration, epsilon-greedy with Ornstein-Uhlenbeck noise. The defaults are PADDPG's, Hausknecht & Stone's.
+    """
+
+    bound: str = setting(
+        "invert",
+        "Keeping the actor's outputs in [-1, 1]: invert (inverting gradients, Hausknecht & Stone), squash (Tanh) "
+        "or zero.",
+        one_of(BOUNDS),
+    )
+    beta: float = setting(
+        0.2,
+        "Weight of the Monte-Carlo return in the target (Hausknecht & Stone: 0.2 to 0.5); 0 gives DDPG's pure "
+        "one-step TD target.",
+        interval(0, 1),
+    )
+    epsilon_start: float = setting(
+        1.0, "Exploration rate at the start: the chance of a uniformly random action.", interval(0, 1)
+    )
+    epsilon_end: float = setting(0.1, "Exploration rate after the annealing.", interval(0, 1))
+    epsilon_steps: int = setting(
+        100_000, "Environment samples over which epsilon falls linearly to epsilon_end.", at_least(1)
+    )
+    ou_sigma: float = setting(
+        0.0,
+        "Scale of Ornstein-Uhlenbeck noise on the actor's parameters, in [-1, 1] units; 0 turns it off.",
+        NON_NEGATIVE,
+    )
+    ou_theta: float = setting(
+        0.15,
+        "Mean reversion of the Ornstein-Uhlenbeck noise (DDPG's 0.15); 1 gives i.i.d. Gaussian noise.",
+        interval(0, 1, low_open=True),
+    )
+
+
+def shared_setting(name: str, default, source: str | None = None):
+    """The family's setting ``name`` (of :class:`OffPolicyConfig` or :class:`DeterministicActorConfig`) declared
+    again with an algorithm's own ``default``, its help and check kept (:func:`~pamdp.algos.settings.redeclared`)."""
+    base = OffPolicyConfig if name in OffPolicyConfig.__dataclass_fields__ else DeterministicActorConfig
+    return redeclared(base, name, default, source)
 
 
 # act(obs (N, d) tensor, global step, episode_start (N,) bool, mask (N, K) bool tensor or None)

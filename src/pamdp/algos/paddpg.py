@@ -39,7 +39,7 @@ from torch import nn
 from pamdp.algos.base import Algorithm
 from pamdp.algos.dense import Dense
 from pamdp.algos.offpolicy import (
-    BOUNDS,
+    DeterministicActorConfig,
     OffPolicyConfig,
     OffPolicyLoop,
     OUNoise,
@@ -50,9 +50,9 @@ from pamdp.algos.offpolicy import (
     soft_updater,
 )
 from pamdp.algos.optim import apply_gradients
-from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, at_least, interval, one_of, setting
+from pamdp.algos.settings import POSITIVE, AlgoConfig, at_least, interval, setting
 from pamdp.distributions import masked_logits
-from pamdp.policies import ACTIVATIONS, mlp
+from pamdp.policies import mlp
 from pamdp.spaces import HybridActionSpace
 
 if TYPE_CHECKING:
@@ -62,20 +62,13 @@ __all__ = ["PADDPG", "PADDPGConfig"]
 
 
 @dataclasses.dataclass(frozen=True)
-class PADDPGConfig(OffPolicyConfig, AlgoConfig):
+class PADDPGConfig(DeterministicActorConfig, OffPolicyConfig, AlgoConfig):
     """PADDPG's settings. The defaults are the seed paper's preset: Hausknecht & Stone's settings with the
     hidden layers {400, 300} of DDPG (the paper used {400, 300, 200} on Half Field Offense: preset
     ``paper_hfo``; Hausknecht & Stone's own 1024-512-256-128 towers: preset ``hausknecht_stone``)."""
 
-    hidden_sizes: tuple[int, ...] = setting(
-        (400, 300), "Hidden layers of the actor and the critic (paper: {400, 300}).", LAYERS
-    )
-    activation: str = setting(
-        "leaky_relu", "Hidden activation: leaky_relu (slope 0.01, Hausknecht & Stone), relu, ...", one_of(ACTIVATIONS)
-    )
-    bound: str = setting(
-        "invert", "Keeping outputs in [-1, 1]: invert (inverting gradients), squash (Tanh) or zero.", one_of(BOUNDS)
-    )
+    hidden_sizes: tuple[int, ...] = shared_setting("hidden_sizes", (400, 300), "paper: {400, 300}")
+    activation: str = shared_setting("activation", "leaky_relu", "Hausknecht & Stone: leaky_relu, slope 0.01")
     actor_lr: float = setting(1e-5, "Adam learning rate of the actor (Hausknecht & Stone: 1e-5).", POSITIVE)
     critic_lr: float = setting(1e-3, "Adam learning rate of the critic (Hausknecht & Stone: 1e-3).", POSITIVE)
     adam_beta1: float = setting(
@@ -85,24 +78,6 @@ class PADDPGConfig(OffPolicyConfig, AlgoConfig):
     batch_size: int = shared_setting("batch_size", 32, "Hausknecht & Stone: 32")
     tau: float = setting(
         0.001, "Soft target-update rate: target <- tau * online + (1 - tau) * target.", interval(0, 1, low_open=True)
-    )
-    beta: float = setting(
-        0.2,
-        "Weight of the Monte-Carlo return in the target (H&S: 0.2 to 0.5); 0 gives DDPG's pure TD target.",
-        interval(0, 1),
-    )
-    epsilon_start: float = setting(
-        1.0, "Exploration rate at the start: the chance of a uniformly random output.", interval(0, 1)
-    )
-    epsilon_end: float = setting(0.1, "Exploration rate after the annealing.", interval(0, 1))
-    epsilon_steps: int = setting(
-        100_000, "Environment samples over which epsilon falls linearly to epsilon_end.", at_least(1)
-    )
-    ou_sigma: float = setting(
-        0.0, "Scale of Ornstein-Uhlenbeck noise on the actor's parameters; 0 turns it off.", NON_NEGATIVE
-    )
-    ou_theta: float = setting(
-        0.15, "Mean reversion of the Ornstein-Uhlenbeck noise (DDPG's 0.15).", interval(0, 1, low_open=True)
     )
     buffer_size: int = shared_setting("buffer_size", 500_000, "Hausknecht & Stone: 500 000")
     learning_starts: int = setting(

@@ -48,9 +48,9 @@ from pamdp.algos.offpolicy import (
     uniform_actions,
 )
 from pamdp.algos.optim import apply_gradients, descend
-from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
+from pamdp.algos.settings import NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
 from pamdp.distributions import LOG_STD_MAX, LOG_STD_MIN, masked_logits
-from pamdp.policies import ACTIVATIONS, every_action_linear, every_action_mlp, hierarchical_mlps, mlp
+from pamdp.policies import every_action_linear, every_action_mlp, hierarchical_mlps, mlp
 from pamdp.spaces import HybridActionSpace
 
 if TYPE_CHECKING:
@@ -63,10 +63,10 @@ __all__ = ["PASVG0", "PASVG0Config", "GumbelHybridPolicy", "expected_q", "gumbel
 class PASVG0Config(OffPolicyConfig, AlgoConfig):
     """PASVG(0)'s settings; the defaults are the paper's preset (DDPG's where the paper says nothing)."""
 
-    hidden_sizes: tuple[int, ...] = setting(
-        (400, 300), "Hidden layers of pi_d, pi_c and the critic (paper: {400, 300}).", LAYERS
+    hidden_sizes: tuple[int, ...] = shared_setting(
+        "hidden_sizes", (400, 300), "pi_d, pi_c and the critic; paper: {400, 300}"
     )
-    activation: str = setting("relu", "Hidden activation: relu (paper), tanh, leaky_relu or elu.", one_of(ACTIVATIONS))
+    activation: str = shared_setting("activation", "relu", "paper: relu")
     temperature: float = setting(
         1.0, "Gumbel-Softmax temperature t (paper: 1.0, fixed); lower is less biased, higher less noisy.", POSITIVE
     )

@@ -41,7 +41,7 @@ from torch import nn
 
 from pamdp.algos.base import Algorithm
 from pamdp.algos.offpolicy import (
-    BOUNDS,
+    DeterministicActorConfig,
     OffPolicyConfig,
     OffPolicyLoop,
     OUNoise,
@@ -54,18 +54,15 @@ from pamdp.algos.offpolicy import (
 )
 from pamdp.algos.optim import apply_gradients, descend
 from pamdp.algos.settings import (
-    LAYERS,
-    NON_NEGATIVE,
     POSITIVE,
     AlgoConfig,
     Check,
     at_least,
     interval,
-    one_of,
     setting,
 )
 from pamdp.distributions import masked_logits
-from pamdp.policies import ACTIVATIONS, in_chunks, mlp
+from pamdp.policies import in_chunks, mlp
 from pamdp.spaces import HybridActionSpace
 
 if TYPE_CHECKING:
@@ -75,7 +72,7 @@ __all__ = ["PDQN", "PDQNConfig", "ParamActor", "QNetwork", "param_blocks"]
 
 
 @dataclasses.dataclass(frozen=True)
-class PDQNConfig(OffPolicyConfig, AlgoConfig):
+class PDQNConfig(DeterministicActorConfig, OffPolicyConfig, AlgoConfig):
     """P-DQN's and MP-DQN's settings. The defaults are the ``paper`` preset: Bester et al.'s Platform settings,
     recalled from their paper rather than checked against its text (provisional); values it does not give are
     marked as assumptions in the help."""
@@ -83,14 +80,8 @@ class PDQNConfig(OffPolicyConfig, AlgoConfig):
     multi_pass: bool = setting(
         False, "MP-DQN: Q_k from a pass that sees only action k's parameters; false: P-DQN's joint input."
     )
-    hidden_sizes: tuple[int, ...] = setting(
-        (128,), "Hidden layers of the actor and the Q-network (Bester et al. on Platform: one layer of 128).", LAYERS
-    )
-    activation: str = setting("relu", "Hidden activation: relu, leaky_relu, tanh or elu.", one_of(ACTIVATIONS))
-    bound: str = setting(
-        "invert",
-        "Keeping parameters in [-1, 1]: invert (inverting gradients, Bester et al.), squash (Tanh) or zero.",
-        one_of(BOUNDS),
+    hidden_sizes: tuple[int, ...] = shared_setting(
+        "hidden_sizes", (128,), "Bester et al. on Platform: one layer of 128"
     )
     param_passthrough: tuple[float, ...] = setting(
         (),
@@ -117,36 +108,17 @@ class PDQNConfig(OffPolicyConfig, AlgoConfig):
     tau_actor: float = setting(
         0.001, "Soft target-update rate of the actor (Bester et al.: 0.001).", interval(0, 1, low_open=True)
     )
-    beta: float = setting(
-        0.0,
-        "Weight of the Monte-Carlo return in the Q target, as PADDPG's; 0 (Platform) is the one-step TD target.",
-        interval(0, 1),
-    )
-    epsilon_start: float = setting(
-        1.0, "Exploration rate at the start: the chance of a uniformly random action.", interval(0, 1)
-    )
-    epsilon_end: float = setting(0.01, "Exploration rate after the annealing (Bester et al.: 0.01).", interval(0, 1))
-    epsilon_steps: int = setting(
-        5_000,
-        "Environment samples over which epsilon falls linearly to epsilon_end (Bester et al.: 1000 episodes; "
-        "Platform's early episodes last 2 to 5 steps).",
-        at_least(1),
+    beta: float = shared_setting("beta", 0.0, "0 on Platform")
+    epsilon_end: float = shared_setting("epsilon_end", 0.01, "Bester et al.: 0.01")
+    epsilon_steps: int = shared_setting(
+        "epsilon_steps", 5_000, "Bester et al.: 1000 episodes; Platform's early episodes last 2 to 5 steps"
     )
     explore_params: bool = setting(
         False,
         "With an epsilon draw, also draw that action's parameters uniformly in [-1, 1] (Xiong et al.); false "
         "keeps the actor's, noise included (assumed for Bester et al.).",
     )
-    ou_sigma: float = setting(
-        0.0001,
-        "Scale of Ornstein-Uhlenbeck noise on the parameters, in [-1, 1] units (Bester et al.: 1e-4); 0: off.",
-        NON_NEGATIVE,
-    )
-    ou_theta: float = setting(
-        0.15,
-        "Mean reversion of the Ornstein-Uhlenbeck noise; 1 gives i.i.d. Gaussian noise.",
-        interval(0, 1, low_open=True),
-    )
+    ou_sigma: float = shared_setting("ou_sigma", 0.0001, "Bester et al.: 1e-4")
     buffer_size: int = shared_setting("buffer_size", 10_000, "Bester et al. on Platform: 10 000")
     learning_starts: int = setting(
         500, "Samples in the replay buffer before the first update (assumed: 500).", at_least(0)

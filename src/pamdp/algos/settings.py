@@ -28,6 +28,7 @@ if TYPE_CHECKING:
 __all__ = [
     "AlgoConfig",
     "setting",
+    "redeclared",
     "Check",
     "at_least",
     "interval",
@@ -93,6 +94,15 @@ def setting(default: Any, help: str, check: Check | None = None) -> Any:
     if isinstance(default, (list, dict)):
         raise TypeError("use tuples for sequence settings, so that configs stay immutable")
     return dataclasses.field(default=default, metadata={"help": help, "check": check})
+
+
+def redeclared(base: type, name: str, default: Any, source: str | None = None) -> Any:
+    """Setting ``name`` of the family config ``base`` declared again with an algorithm's own ``default``, with the
+    help and the check written there; ``source`` says where the value comes from and joins the help ("Transitions
+    per gradient update (Hausknecht & Stone: 32).")."""
+    meta = base.__dataclass_fields__[name].metadata
+    help = meta["help"] if source is None else f"{meta['help'].rstrip('.')} ({source})."
+    return setting(default, help, meta["check"])
 
 
 @dataclasses.dataclass(frozen=True)
