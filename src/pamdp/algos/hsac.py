@@ -38,7 +38,6 @@ from __future__ import annotations
 import copy
 import dataclasses
 import math
-from typing import TYPE_CHECKING
 
 import numpy as np
 import torch
@@ -60,9 +59,6 @@ from pamdp.algos.settings import NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_l
 from pamdp.distributions import LOG_STD_MAX, LOG_STD_MIN, MASKED, SquashedHybrid, masked_logits
 from pamdp.policies import every_action_mlp, hierarchical_mlps, mlp, small_init_
 from pamdp.spaces import HybridActionSpace
-
-if TYPE_CHECKING:
-    from typing_extensions import Self
 
 __all__ = ["HybridSAC", "HybridSACConfig", "HybridSACActor"]
 
@@ -108,31 +104,29 @@ class HybridSACConfig(OffPolicyConfig, AlgoConfig):
         10_000, "Samples in the replay buffer before the first update (SAC: 10 000; assumed).", at_least(0)
     )
 
-    @classmethod
-    def presets(cls) -> dict[str, Self]:
-        # "tuned" (the command line's default): sized for a laptop CPU, with 64 batched env copies, networks of
-        # 64-64, a tenth of an update per sample on batches of 128 (an update costs about the same at 64 or 128 here),
-        # lower initial temperatures (Platform's returns sum to at most 1, so an entropy bonus of 1 nat a step would
-        # dominate them) and a discrete target entropy of half the uniform's; how it learns:
-        # benchmarks/hsac_platform.md.
-        return {
-            "paper": cls(),
-            "tuned": cls(
-                num_envs=64,
-                hidden_sizes=(64, 64),
-                batch_size=128,
-                updates_per_step=0.1,
-                target_entropy_d=0.5,
-                learning_starts=2_000,
-                buffer_size=200_000,
-                init_alpha_d=0.1,
-                init_alpha_c=0.1,
-                actor_lr=1e-3,
-                critic_lr=1e-3,
-                alpha_lr=1e-3,
-                tau=0.01,
-            ),
-        }
+    # "tuned" (the command line's default): sized for a laptop CPU, with 64 batched env copies, networks of
+    # 64-64, a tenth of an update per sample on batches of 128 (an update costs about the same at 64 or 128 here),
+    # lower initial temperatures (Platform's returns sum to at most 1, so an entropy bonus of 1 nat a step would
+    # dominate them) and a discrete target entropy of half the uniform's; how it learns:
+    # benchmarks/hsac_platform.md.
+    PRESETS = {
+        "paper": {},
+        "tuned": dict(
+            num_envs=64,
+            hidden_sizes=(64, 64),
+            batch_size=128,
+            updates_per_step=0.1,
+            target_entropy_d=0.5,
+            learning_starts=2_000,
+            buffer_size=200_000,
+            init_alpha_d=0.1,
+            init_alpha_c=0.1,
+            actor_lr=1e-3,
+            critic_lr=1e-3,
+            alpha_lr=1e-3,
+            tau=0.01,
+        ),
+    }
 
 
 class HybridSACActor(nn.Module):

@@ -42,7 +42,6 @@ from __future__ import annotations
 
 import copy
 import dataclasses
-from typing import TYPE_CHECKING
 
 import numpy as np
 import torch
@@ -65,9 +64,6 @@ from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, at_
 from pamdp.distributions import LOG_STD_MAX, LOG_STD_MIN, masked_logits
 from pamdp.policies import ACTIVATIONS, mlp
 from pamdp.spaces import HybridActionSpace
-
-if TYPE_CHECKING:
-    from typing_extensions import Self
 
 __all__ = ["HyAR", "HyARConfig", "ActionRepresentation", "latent_bounds"]
 
@@ -192,31 +188,29 @@ class HyARConfig(OffPolicyConfig, AlgoConfig):
         """The samples before the first update (:class:`~pamdp.algos.offpolicy.OffPolicyLoop`): the warm-up's."""
         return self.warmup_steps
 
-    @classmethod
-    def presets(cls) -> dict[str, Self]:
-        # "cpu" (the command line's default): smaller networks, 64 batched env copies and a quarter of a TD3 update
-        # per sample, for a laptop CPU, with a small KL weight and small latents (a 1-D parameter in 6 latent
-        # dimensions left 5 for the critic to learn to ignore). It is sized, not tuned: see docs/algorithms.md.
-        return {
-            "cpu": cls(
-                num_envs=64,
-                embed_dim=3,
-                latent_dim=2,
-                kl_weight=0.01,
-                hidden_sizes=(128, 128),
-                vae_hidden_sizes=(128, 128),
-                updates_per_step=0.25,
-                vae_interval=2_000,
-                vae_updates=20,
-                warmup_updates=2_000,
-                buffer_size=200_000,
-                bound="invert",
-                epsilon_start=0.5,
-                epsilon_end=0.05,
-                epsilon_steps=50_000,
-            ),
-            "paper": cls(),
-        }
+    # "cpu" (the command line's default): smaller networks, 64 batched env copies and a quarter of a TD3 update
+    # per sample, for a laptop CPU, with a small KL weight and small latents (a 1-D parameter in 6 latent
+    # dimensions left 5 for the critic to learn to ignore). It is sized, not tuned: see docs/algorithms.md.
+    PRESETS = {
+        "cpu": dict(
+            num_envs=64,
+            embed_dim=3,
+            latent_dim=2,
+            kl_weight=0.01,
+            hidden_sizes=(128, 128),
+            vae_hidden_sizes=(128, 128),
+            updates_per_step=0.25,
+            vae_interval=2_000,
+            vae_updates=20,
+            warmup_updates=2_000,
+            buffer_size=200_000,
+            bound="invert",
+            epsilon_start=0.5,
+            epsilon_end=0.05,
+            epsilon_steps=50_000,
+        ),
+        "paper": {},
+    }
 
 
 class ActionRepresentation(nn.Module):

@@ -30,7 +30,6 @@ from __future__ import annotations
 
 import copy
 import dataclasses
-from typing import TYPE_CHECKING
 
 import numpy as np
 import torch
@@ -54,9 +53,6 @@ from pamdp.algos.settings import POSITIVE, AlgoConfig, at_least, interval, setti
 from pamdp.distributions import masked_logits
 from pamdp.policies import mlp
 from pamdp.spaces import HybridActionSpace
-
-if TYPE_CHECKING:
-    from typing_extensions import Self
 
 __all__ = ["PADDPG", "PADDPGConfig"]
 
@@ -84,13 +80,11 @@ class PADDPGConfig(DeterministicActorConfig, OffPolicyConfig, AlgoConfig):
         10_000, "Samples in the replay buffer before the first update (the seed paper: 10^4).", at_least(0)
     )
 
-    @classmethod
-    def presets(cls) -> dict[str, Self]:
-        return {
-            "paper": cls(),
-            "paper_hfo": cls(hidden_sizes=(400, 300, 200)),
-            "hausknecht_stone": cls(hidden_sizes=(1024, 512, 256, 128)),
-        }
+    PRESETS = {
+        "paper": {},
+        "paper_hfo": dict(hidden_sizes=(400, 300, 200)),
+        "hausknecht_stone": dict(hidden_sizes=(1024, 512, 256, 128)),
+    }
 
 
 class Actor(nn.Module):

@@ -27,7 +27,6 @@ clip bounds the change of the whole hierarchical policy, as PATRPO's KL does.
 from __future__ import annotations
 
 import dataclasses
-from typing import TYPE_CHECKING
 
 import numpy as np
 import torch
@@ -38,9 +37,6 @@ from pamdp.algos.optim import descend
 from pamdp.algos.settings import NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, setting
 from pamdp.distributions import HybridDistribution, kl_divergence
 from pamdp.policies import ValueNetwork
-
-if TYPE_CHECKING:
-    from typing_extensions import Self
 
 __all__ = ["PAPPO", "PAPPOConfig", "clipped_surrogate", "ppo_loss"]
 
@@ -96,11 +92,9 @@ class PAPPOConfig(OnPolicyConfig, AlgoConfig):
             f"an integer in [1, batch_size={self.batch_size}]",
         )
 
-    @classmethod
-    def presets(cls) -> dict[str, Self]:
-        # "tuned": found by single probe runs on Platform (ent_coef_d's help says why; the record of its
-        # learning: benchmarks/later_platform.md)
-        return {"default": cls(), "tuned": cls(ent_coef_d=0.3, target_kl=0.02)}
+    # "tuned": found by single probe runs on Platform (ent_coef_d's help says why; the record of its
+    # learning: benchmarks/later_platform.md)
+    PRESETS = {"default": {}, "tuned": dict(ent_coef_d=0.3, target_kl=0.02)}
 
 
 def clipped_surrogate(logp: torch.Tensor, old_logp: torch.Tensor, adv: torch.Tensor, clip_range: float) -> torch.Tensor:

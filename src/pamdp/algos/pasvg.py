@@ -29,7 +29,6 @@ import copy
 import dataclasses
 import math
 from collections.abc import Callable
-from typing import TYPE_CHECKING
 
 import numpy as np
 import torch
@@ -52,9 +51,6 @@ from pamdp.algos.settings import NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_l
 from pamdp.distributions import LOG_STD_MAX, LOG_STD_MIN, masked_logits
 from pamdp.policies import every_action_linear, every_action_mlp, hierarchical_mlps, mlp
 from pamdp.spaces import HybridActionSpace
-
-if TYPE_CHECKING:
-    from typing_extensions import Self
 
 __all__ = ["PASVG0", "PASVG0Config", "GumbelHybridPolicy", "expected_q", "gumbel_noise", "gumbel_softmax_sample"]
 
@@ -143,32 +139,30 @@ class PASVG0Config(OffPolicyConfig, AlgoConfig):
                 self.straight_through, "straight_through", "True with discrete_gradient 'expected' (Q sees one-hots)"
             )
 
-    @classmethod
-    def presets(cls) -> dict[str, Self]:
-        return {
-            "paper": cls(),
-            # Small networks, 64 batched env copies and a quarter of an update per sample; pi_d's gradient from
-            # the exact expectation over the K actions instead of the Gumbel-Softmax estimate; pi_d's entropy
-            # held at 0.3 nats (of ln 3 = 1.10) by a tuned weight; 5 % of the collected discrete actions
-            # uniform; a fixed parameter noise (std 0.2 before the Tanh). How each choice was reached, and what
-            # it fixed: benchmarks/pasvg_tuning.md.
-            "tuned": cls(
-                num_envs=64,
-                hidden_sizes=(128, 128),
-                discrete_gradient="expected",
-                init_log_std=-1.6,
-                learn_std=False,
-                policy_lr=1e-4,
-                entropy_coef=0.1,
-                target_entropy=0.3,
-                explore_epsilon=0.05,
-                tau=0.005,
-                batch_size=128,
-                updates_per_step=0.25,
-                learning_starts=5_000,
-                buffer_size=1_000_000,
-            ),
-        }
+    PRESETS = {
+        "paper": {},
+        # Small networks, 64 batched env copies and a quarter of an update per sample; pi_d's gradient from
+        # the exact expectation over the K actions instead of the Gumbel-Softmax estimate; pi_d's entropy
+        # held at 0.3 nats (of ln 3 = 1.10) by a tuned weight; 5 % of the collected discrete actions
+        # uniform; a fixed parameter noise (std 0.2 before the Tanh). How each choice was reached, and what
+        # it fixed: benchmarks/pasvg_tuning.md.
+        "tuned": dict(
+            num_envs=64,
+            hidden_sizes=(128, 128),
+            discrete_gradient="expected",
+            init_log_std=-1.6,
+            learn_std=False,
+            policy_lr=1e-4,
+            entropy_coef=0.1,
+            target_entropy=0.3,
+            explore_epsilon=0.05,
+            tau=0.005,
+            batch_size=128,
+            updates_per_step=0.25,
+            learning_starts=5_000,
+            buffer_size=1_000_000,
+        ),
+    }
 
 
 def gumbel_noise(shape: tuple[int, ...], generator: torch.Generator) -> torch.Tensor:

@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Callable
-from typing import TYPE_CHECKING
 
 import numpy as np
 import torch
@@ -49,9 +48,6 @@ from pamdp.algos.trpo import (
 )
 from pamdp.distributions import KL_ESTIMATORS, kl_divergence
 from pamdp.policies import ValueNetwork
-
-if TYPE_CHECKING:
-    from typing_extensions import Self
 
 __all__ = ["PATRPO", "PATRPOConfig"]
 
@@ -129,19 +125,17 @@ class PATRPOConfig(OnPolicyConfig, AlgoConfig):
             "auto or double_backprop with kl_estimator='joint_sample' (its Hessian has no closed form)",
         )
 
-    @classmethod
-    def presets(cls) -> dict[str, Self]:
-        return {
-            "paper": cls(),
-            "tuned": cls(
-                delta=0.02,
-                gae_lambda=0.97,
-                batch_size=5_000,
-                init_log_std=-0.5,
-                entropy_coef=0.01,
-                fvp_subsample=0.2,
-            ),
-        }
+    PRESETS = {
+        "paper": {},
+        "tuned": dict(
+            delta=0.02,
+            gae_lambda=0.97,
+            batch_size=5_000,
+            init_log_std=-0.5,
+            entropy_coef=0.01,
+            fvp_subsample=0.2,
+        ),
+    }
 
 
 class PATRPO(Algorithm):

@@ -32,7 +32,6 @@ from __future__ import annotations
 import copy
 import dataclasses
 import math
-from typing import TYPE_CHECKING
 
 import numpy as np
 import torch
@@ -64,9 +63,6 @@ from pamdp.algos.settings import (
 from pamdp.distributions import masked_logits
 from pamdp.policies import in_chunks, mlp
 from pamdp.spaces import HybridActionSpace
-
-if TYPE_CHECKING:
-    from typing_extensions import Self
 
 __all__ = ["PDQN", "PDQNConfig", "ParamActor", "QNetwork", "param_blocks"]
 
@@ -134,24 +130,22 @@ class PDQNConfig(DeterministicActorConfig, OffPolicyConfig, AlgoConfig):
                 "or no passthrough"
             )
 
-    @classmethod
-    def presets(cls) -> dict[str, Self]:
-        # "paper": Bester et al.'s text as recalled here (not re-read; never their code); grad_clip, learning_starts,
-        # explore_params and the conversion of 1000 episodes to 5 000 samples are assumptions (see the help).
-        # "tuned": the same learning rates and targets with a smaller Q-network and batch, 64 batched env copies
-        # and a quarter of an update per sample (how it learns: benchmarks/later_platform.md).
-        return {
-            "paper": cls(),
-            "tuned": cls(
-                num_envs=64,
-                hidden_sizes=(64,),
-                batch_size=64,
-                updates_per_step=0.25,
-                epsilon_steps=10_000,
-                learning_starts=1_000,
-                buffer_size=20_000,
-            ),
-        }
+    # "paper": Bester et al.'s text as recalled here (not re-read; never their code); grad_clip, learning_starts,
+    # explore_params and the conversion of 1000 episodes to 5 000 samples are assumptions (see the help).
+    # "tuned": the same learning rates and targets with a smaller Q-network and batch, 64 batched env copies
+    # and a quarter of an update per sample (how it learns: benchmarks/later_platform.md).
+    PRESETS = {
+        "paper": {},
+        "tuned": dict(
+            num_envs=64,
+            hidden_sizes=(64,),
+            batch_size=64,
+            updates_per_step=0.25,
+            epsilon_steps=10_000,
+            learning_starts=1_000,
+            buffer_size=20_000,
+        ),
+    }
 
 
 def param_blocks(hybrid: HybridActionSpace) -> np.ndarray:

@@ -169,10 +169,13 @@ class AlgoConfig:
         if not ok:
             raise ValueError(f"{type(self).__name__}.{name} = {getattr(self, name)!r}; expected {expected}")
 
+    PRESETS: typing.ClassVar[dict[str, dict[str, Any]]] = {"default": {}}
+    """A subclass's presets as the settings each changes from the defaults; :meth:`presets` makes them."""
+
     @classmethod
     def presets(cls) -> dict[str, Self]:
         """Named settings, e.g. ``"paper"``; the first one is the default."""
-        return {"default": cls()}
+        return {name: cls(**changes) for name, changes in cls.PRESETS.items()}
 
     @classmethod
     def preset(cls, name: str, env_id: str | None = None, env_kwargs: dict | None = None) -> Self:
