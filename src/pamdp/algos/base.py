@@ -148,11 +148,17 @@ class Algorithm:
         among the actions ``mask`` allows (bool ``(B, K)`` on the device; ``None``: all)."""
         raise NotImplementedError
 
+    MODULES: ClassVar[tuple[str, ...]] = ()
+    """The attributes that hold the algorithm's networks, saved under their names (``None``: a network its
+    settings leave out)."""
+    OPTIMIZERS: ClassVar[dict[str, str]] = {}
+    """The optimisers, ``{name in a checkpoint: attribute}`` (``None``: one its settings leave out)."""
+
     def _modules(self) -> dict[str, torch.nn.Module]:
-        raise NotImplementedError
+        return {name: module for name in self.MODULES if (module := getattr(self, name, None)) is not None}
 
     def _optimizers(self) -> dict[str, torch.optim.Optimizer]:
-        return {}
+        return {name: opt for name, attr in self.OPTIMIZERS.items() if (opt := getattr(self, attr, None)) is not None}
 
     def _extra_state(self) -> dict:
         """What a checkpoint holds besides modules, optimisers and the loop's state."""

@@ -178,6 +178,8 @@ class HybridSAC(Algorithm):
 
     config_class = HybridSACConfig
     config: HybridSACConfig
+    MODULES = ("actor", "critic", "critic_target", "temperatures")
+    OPTIMIZERS = {"actor": "actor_optimizer", "critic": "critic_optimizer", "temperatures": "alpha_optimizer"}
 
     def _build(self) -> None:
         cfg, h = self.config, self.hybrid
@@ -195,17 +197,6 @@ class HybridSAC(Algorithm):
         self.loop = OffPolicyLoop(self, params=((h.total_param_size,), np.float32))
         self.replay = self.loop.buffer
         self._soft_update = soft_updater([(self.critic_target, self.critic)])
-
-    def _modules(self):
-        return {
-            "actor": self.actor,
-            "critic": self.critic,
-            "critic_target": self.critic_target,
-            "temperatures": self.temperatures,
-        }
-
-    def _optimizers(self):
-        return {"actor": self.actor_optimizer, "critic": self.critic_optimizer, "temperatures": self.alpha_optimizer}
 
     @property
     def alphas(self) -> tuple[float, float]:

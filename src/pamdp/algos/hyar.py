@@ -321,6 +321,8 @@ class HyAR(Algorithm):
 
     config_class = HyARConfig
     config: HyARConfig
+    MODULES = ("rep", "actor", "critic", "actor_target", "critic_target")
+    OPTIMIZERS = {"rep": "rep_optimizer", "actor": "actor_optimizer", "critic": "critic_optimizer"}
 
     def _build(self) -> None:
         cfg, h = self.config, self.hybrid
@@ -345,18 +347,6 @@ class HyAR(Algorithm):
         self.pretrained = False  # the warm-up round of representation training is done
         self.n_updates = 0  # TD3 updates so far (the policy delay and the representation rounds count them)
         self.rl_start = 0  # the replay's insertion counter at the representation's pre-training (td3_replay)
-
-    def _modules(self):
-        return {
-            "rep": self.rep,
-            "actor": self.actor,
-            "critic": self.critic,
-            "actor_target": self.actor_target,
-            "critic_target": self.critic_target,
-        }
-
-    def _optimizers(self):
-        return {"rep": self.rep_optimizer, "actor": self.actor_optimizer, "critic": self.critic_optimizer}
 
     def _extra_state(self):
         return {"pretrained": self.pretrained, "n_updates": self.n_updates, "rl_start": self.rl_start}

@@ -128,6 +128,8 @@ class PADDPG(Algorithm):
 
     config_class = PADDPGConfig
     config: PADDPGConfig
+    MODULES = ("actor", "critic", "actor_target", "critic_target")
+    OPTIMIZERS = {"actor": "actor_optimizer", "critic": "critic_optimizer"}
 
     def _build(self) -> None:
         cfg, h = self.config, self.hybrid
@@ -155,17 +157,6 @@ class PADDPG(Algorithm):
         again by whoever replaces a module."""
         self._dense = {name: Dense.of(module.net) for name, module in self._modules().items()}
         self._soft_update = soft_updater(((self.actor_target, self.actor), (self.critic_target, self.critic)))
-
-    def _modules(self):
-        return {
-            "actor": self.actor,
-            "critic": self.critic,
-            "actor_target": self.actor_target,
-            "critic_target": self.critic_target,
-        }
-
-    def _optimizers(self):
-        return {"actor": self.actor_optimizer, "critic": self.critic_optimizer}
 
     def _act(self, obs, deterministic, mask=None):
         out = self.actor(obs).clamp(-1.0, 1.0)

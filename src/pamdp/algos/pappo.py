@@ -141,6 +141,8 @@ class PAPPO(Algorithm):
 
     config_class = PAPPOConfig
     config: PAPPOConfig
+    MODULES = ("policy", "value")
+    OPTIMIZERS = {"adam": "optimizer"}
 
     def _build(self) -> None:
         cfg = self.config
@@ -148,12 +150,6 @@ class PAPPO(Algorithm):
         self.value = ValueNetwork(self.obs_dim, cfg.vf_hidden_sizes)
         self.optimizer = torch.optim.Adam([*self.policy.parameters(), *self.value.parameters()], lr=cfg.lr)
         self.loop = Rollout(self)  # a loaded model starts new episodes
-
-    def _modules(self):
-        return {"policy": self.policy, "value": self.value}
-
-    def _optimizers(self):
-        return {"adam": self.optimizer}
 
     def _act(self, obs, deterministic, mask=None):
         return self.policy.act(obs, mask, deterministic, self.torch_gen)

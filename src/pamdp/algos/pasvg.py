@@ -298,6 +298,9 @@ class PASVG0(Algorithm):
 
     config_class = PASVG0Config
     config: PASVG0Config
+    # entropy_weight with target_entropy only; critic2 and its target with twin_critics only
+    MODULES = ("policy", "critic", "policy_target", "critic_target", "entropy_weight", "critic2", "critic2_target")
+    OPTIMIZERS = {"policy": "policy_optimizer", "critic": "critic_optimizer", "entropy_weight": "entropy_optimizer"}
 
     def _build(self) -> None:
         cfg, h = self.config, self.hybrid
@@ -354,25 +357,6 @@ class PASVG0(Algorithm):
                 "pi_c": Dense.of(self.policy.pi_c),
                 "critic": Dense.of(self.critic.net),
             }
-
-    def _modules(self):
-        modules = {
-            "policy": self.policy,
-            "critic": self.critic,
-            "policy_target": self.policy_target,
-            "critic_target": self.critic_target,
-        }
-        if self.entropy_weight is not None:
-            modules["entropy_weight"] = self.entropy_weight
-        if self.critic2 is not None:
-            modules["critic2"], modules["critic2_target"] = self.critic2, self.critic2_target
-        return modules
-
-    def _optimizers(self):
-        optimizers = {"policy": self.policy_optimizer, "critic": self.critic_optimizer}
-        if self.entropy_optimizer is not None:
-            optimizers["entropy_weight"] = self.entropy_optimizer
-        return optimizers
 
     def _extra_state(self):
         return {"critic_updates": self.critic_updates}

@@ -143,6 +143,8 @@ class PATRPO(Algorithm):
 
     config_class = PATRPOConfig
     config: PATRPOConfig
+    MODULES = ("policy", "value")  # the value network and its optimiser with baseline="mlp" only
+    OPTIMIZERS = {"value": "vf_optimizer"}
 
     def _build(self) -> None:
         cfg = self.config
@@ -154,12 +156,6 @@ class PATRPO(Algorithm):
         else:
             self.linear_baseline = LinearFeatureBaseline(self.obs_dim)
         self.loop = Rollout(self)  # a loaded model starts new episodes
-
-    def _modules(self):
-        return {"policy": self.policy, **({"value": self.value} if self.config.baseline == "mlp" else {})}
-
-    def _optimizers(self):
-        return {"value": self.vf_optimizer} if self.config.baseline == "mlp" else {}
 
     def _extra_state(self):
         if self.config.baseline == "linear":

@@ -246,6 +246,8 @@ class PDQN(Algorithm):
 
     config_class = PDQNConfig
     config: PDQNConfig
+    MODULES = ("actor", "q_net", "actor_target", "q_target")
+    OPTIMIZERS = {"actor": "actor_optimizer", "q_net": "q_optimizer"}
 
     def _build(self) -> None:
         cfg, h = self.config, self.hybrid
@@ -269,12 +271,6 @@ class PDQN(Algorithm):
         )
         self.replay = self.loop.buffer
         self._ou = OUNoise(cfg.ou_theta, cfg.ou_sigma)
-
-    def _modules(self):
-        return {"actor": self.actor, "q_net": self.q_net, "actor_target": self.actor_target, "q_target": self.q_target}
-
-    def _optimizers(self):
-        return {"actor": self.actor_optimizer, "q_net": self.q_optimizer}
 
     # -- acting ----------------------------------------------------------------------------------
     def _act(self, obs, deterministic, mask=None):
