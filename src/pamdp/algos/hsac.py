@@ -201,8 +201,8 @@ class HybridSAC(Algorithm):
     @property
     def alphas(self) -> tuple[float, float]:
         """The current temperatures ``(alpha_d, alpha_c)``."""
-        t = self.temperatures
-        return float(t.log_alpha_d.detach().exp()), float(t.log_alpha_c.detach().exp())
+        alpha_d, alpha_c = self._alpha_tensors()
+        return float(alpha_d), float(alpha_c)
 
     # -- acting ----------------------------------------------------------------------------------
     def _act(self, obs, deterministic, mask=None):

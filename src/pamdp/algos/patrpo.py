@@ -206,16 +206,8 @@ class PATRPO(Algorithm):
             "train/param_std": float(self.policy.log_std.detach().exp()[self.policy.mask].mean()),
         }
         if not (np.isfinite(shs) and shs > 0):  # no direction (a vanishing gradient): no step, no line search
-            stats.update(
-                {
-                    "train/update_skipped": 1.0,
-                    "train/line_search_success": 0.0,
-                    "train/backtracks": 0.0,
-                    "losses/surrogate_improvement": 0.0,
-                    "train/kl": 0.0,
-                }
-            )
-            return stats
+            nothing = ("train/line_search_success", "train/backtracks", "losses/surrogate_improvement", "train/kl")
+            return {**stats, "train/update_skipped": 1.0, **dict.fromkeys(nothing, 0.0)}
         full_step = np.sqrt(2.0 * cfg.delta / shs) * direction
         result = backtracking_line_search(
             params, full_step, evaluate, float(objective.detach()), cfg.delta, cfg.backtrack_ratio, cfg.max_backtracks
