@@ -341,8 +341,8 @@ class OffPolicyLoop:
         algo: the algorithm.
         mc_returns: compute Monte-Carlo returns (discounted by ``config.gamma``) when episodes end.
         tail_value: with ``mc_returns``, the value of a truncated episode's final observations
-            ``(B, d)`` with their action masks (``(B, K)`` bool, or ``None``) ``-> (B,)``, which bootstraps its
-            Monte-Carlo return; ``None`` treats the cut as an end.
+            ``(B, d)`` with their action masks (``(B, K)`` bool, or ``None``) ``-> (B,)``, tensors on the
+            algorithm's device, which bootstraps its Monte-Carlo return; ``None`` treats the cut as an end.
         fields: the algorithm's own fields, ``name=(shape, dtype)``.
 
     With the ``action_mask`` setting the loop reads the env's ``info["action_mask"]`` at every step, passes the
@@ -354,7 +354,7 @@ class OffPolicyLoop:
         self,
         algo,
         mc_returns: bool = False,
-        tail_value: Callable[[np.ndarray, np.ndarray | None], np.ndarray] | None = None,
+        tail_value: Callable[[torch.Tensor, torch.Tensor | None], torch.Tensor] | None = None,
         **fields,
     ):
         cfg, hybrid = algo.config, algo.hybrid
@@ -436,8 +436,11 @@ class OffPolicyLoop:
         tails = np.zeros(len(step.done))
         cut = [i for i in ended if not step.terminated[i]]
         if cut and self.tail_value is not None:
-            masks = None if step.next_masks is None else step.next_masks[cut]
-            tails[cut] = self.tail_value(np.asarray(step.next_obs, dtype=np.float32)[cut], masks)
+            device = self.algo.device
+            obs = torch.from_numpy(np.asarray(step.next_obs, dtype=np.float32)[cut]).to(device)
+            masks = None if step.next_masks is None else torch.from_numpy(step.next_masks[cut]).to(device)
+            with torch.no_grad():
+                tails[cut] = self.tail_value(obs, masks).cpu().numpy()
         for c, i in zip(counters, np.flatnonzero(step.valid)):
             self._pending[i][0].append(int(c))
             self._pending[i][1].append(float(step.reward[i]) * self.config.reward_scale)  # on the critics' scale

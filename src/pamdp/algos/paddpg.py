@@ -193,11 +193,9 @@ class PADDPG(Algorithm):
         a, x = self.actor.action(out, mask)
         return a, x, {"out": out.cpu().numpy()}
 
-    def _target_value(self, obs: np.ndarray, mask: np.ndarray | None) -> np.ndarray:
+    def _target_value(self, obs: torch.Tensor, mask: torch.Tensor | None) -> torch.Tensor:
         """``Q'(s, mu'(s))``, the bootstrap of a truncated episode's Monte-Carlo return."""
-        with torch.no_grad():
-            o, mask = self._from_numpy(obs), None if mask is None else self._from_numpy(mask)
-            return self.critic_target(o, self._masked(self.actor_target(o).clamp(-1.0, 1.0), mask)).cpu().numpy()
+        return self.critic_target(obs, self._masked(self.actor_target(obs).clamp(-1.0, 1.0), mask))
 
     def _epoch_stats(self, step: int) -> dict[str, float]:
         return {"train/epsilon": self.epsilon(step)}

@@ -266,7 +266,7 @@ class PDQN(Algorithm):
         self.loop = OffPolicyLoop(
             self,
             mc_returns=cfg.beta > 0,
-            tail_value=self._target_value,
+            tail_value=self._next_value,
             params=((h.total_param_size,), np.float32),  # every action's, after exploration: what Q learns on
         )
         self.replay = self.loop.buffer
@@ -305,15 +305,9 @@ class PDQN(Algorithm):
         a, params = self._epsilon_greedy(a, params.clamp(-1.0, 1.0), self.epsilon(step), mask)
         return a, self.actor.select(params, a), {"params": params.cpu().numpy()}
 
-    def _target_value(self, obs: np.ndarray, mask: np.ndarray | None) -> np.ndarray:
-        """``max_k Q'_k(s, x'(s))`` over the allowed ``k``, the bootstrap of a truncated episode's Monte-Carlo
-        return."""
-        with torch.no_grad():
-            o = self._from_numpy(obs)
-            return self._next_value(o, None if mask is None else self._from_numpy(mask)).cpu().numpy()
-
     def _next_value(self, obs: torch.Tensor, mask: torch.Tensor | None) -> torch.Tensor:
-        """``max_k Q'_k(s, x'(s))`` of the target networks, over the actions ``mask`` allows."""
+        """``max_k Q'_k(s, x'(s))`` of the target networks, over the actions ``mask`` allows: the TD target's
+        bootstrap, and a truncated episode's Monte-Carlo return's."""
         return masked_logits(self.q_target(obs, self.actor_target(obs).clamp(-1.0, 1.0)), mask).max(-1).values
 
     # -- learning --------------------------------------------------------------------------------
