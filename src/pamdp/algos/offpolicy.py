@@ -120,14 +120,12 @@ class DeterministicActorConfig:
 
     bound: str = setting(
         "invert",
-        "Keeping the actor's outputs in [-1, 1]: invert (inverting gradients, Hausknecht & Stone), squash (Tanh) "
-        "or zero.",
+        "Keeping outputs in [-1, 1]: invert (Hausknecht & Stone's inverting gradients), squash (Tanh) or zero.",
         one_of(BOUNDS),
     )
     beta: float = setting(
         0.2,
-        "Weight of the Monte-Carlo return in the target (Hausknecht & Stone: 0.2 to 0.5); 0 gives DDPG's pure "
-        "one-step TD target.",
+        "Weight of the Monte-Carlo return in the target (H&S: 0.2 to 0.5); 0 gives DDPG's pure TD target.",
         interval(0, 1),
     )
     epsilon_start: float = setting(
