@@ -50,12 +50,13 @@ from pamdp.algos.offpolicy import (
     OffPolicyLoop,
     Temperatures,
     TwinQ,
+    learning_starts_setting,
     shared_setting,
     soft_updater,
     temperature_gradient,
 )
 from pamdp.algos.optim import apply_gradients, descend
-from pamdp.algos.settings import NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
+from pamdp.algos.settings import NON_NEGATIVE, POSITIVE, AlgoConfig, Check, interval, one_of, setting
 from pamdp.distributions import LOG_STD_MAX, LOG_STD_MIN, MASKED, SquashedHybrid, masked_logits
 from pamdp.policies import every_action_mlp, hierarchical_mlps, mlp, small_init_
 from pamdp.spaces import HybridActionSpace
@@ -100,9 +101,7 @@ class HybridSACConfig(OffPolicyConfig, AlgoConfig):
     )
     tau: float = setting(0.005, "Soft target-update rate of the critics (SAC: 0.005).", interval(0, 1, low_open=True))
     batch_size: int = shared_setting("batch_size", 256, "SAC: 256; assumed")
-    learning_starts: int = setting(
-        10_000, "Samples in the replay buffer before the first update (SAC: 10 000; assumed).", at_least(0)
-    )
+    learning_starts: int = learning_starts_setting(10_000, "SAC: 10 000; assumed")
 
     # "tuned" (the command line's default): sized for a laptop CPU, with 64 batched env copies, networks of
     # 64-64, a tenth of an update per sample on batches of 128 (an update costs about the same at 64 or 128 here),

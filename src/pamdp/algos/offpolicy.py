@@ -44,6 +44,7 @@ __all__ = [
     "OffPolicyConfig",
     "DeterministicActorConfig",
     "shared_setting",
+    "learning_starts_setting",
     "OffPolicyLoop",
     "TwinQ",
     "Temperatures",
@@ -152,6 +153,12 @@ def shared_setting(name: str, default, source: str | None = None):
     again with an algorithm's own ``default``, its help and check kept (:func:`~pamdp.algos.settings.redeclared`)."""
     base = OffPolicyConfig if name in OffPolicyConfig.__dataclass_fields__ else DeterministicActorConfig
     return redeclared(base, name, default, source)
+
+
+def learning_starts_setting(default: int, source: str) -> int:
+    """The ``learning_starts`` setting of an off-policy config, with its ``default`` and where the value comes
+    from (HyAR's is no setting: its warm-up, ``warmup_steps``)."""
+    return setting(default, f"Samples in the replay buffer before the first update ({source}).", at_least(0))
 
 
 # act(obs (N, d) tensor, global step, episode_start (N,) bool, mask (N, K) bool tensor or None)

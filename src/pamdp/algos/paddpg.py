@@ -43,13 +43,14 @@ from pamdp.algos.offpolicy import (
     OffPolicyLoop,
     OUNoise,
     bounded,
+    learning_starts_setting,
     linear_epsilon,
     mixed_target,
     shared_setting,
     soft_updater,
 )
 from pamdp.algos.optim import apply_gradients
-from pamdp.algos.settings import POSITIVE, AlgoConfig, at_least, interval, setting
+from pamdp.algos.settings import POSITIVE, AlgoConfig, interval, setting
 from pamdp.distributions import masked_logits
 from pamdp.policies import mlp
 from pamdp.spaces import HybridActionSpace
@@ -76,9 +77,7 @@ class PADDPGConfig(DeterministicActorConfig, OffPolicyConfig, AlgoConfig):
         0.001, "Soft target-update rate: target <- tau * online + (1 - tau) * target.", interval(0, 1, low_open=True)
     )
     buffer_size: int = shared_setting("buffer_size", 500_000, "Hausknecht & Stone: 500 000")
-    learning_starts: int = setting(
-        10_000, "Samples in the replay buffer before the first update (the seed paper: 10^4).", at_least(0)
-    )
+    learning_starts: int = learning_starts_setting(10_000, "the seed paper: 10^4")
 
     PRESETS = {
         "paper": {},

@@ -41,6 +41,7 @@ from pamdp.algos.offpolicy import (
     OffPolicyConfig,
     OffPolicyLoop,
     Temperatures,
+    learning_starts_setting,
     shared_setting,
     soft_updater,
     temperature_gradient,
@@ -125,9 +126,7 @@ class PASVG0Config(OffPolicyConfig, AlgoConfig):
         interval(0, 1, low_open=True),
     )
     buffer_size: int = shared_setting("buffer_size", 10_000_000, "paper: 10^7")
-    learning_starts: int = setting(
-        10_000, "Samples in the replay buffer before the first update (paper: 10^4).", at_least(0)
-    )
+    learning_starts: int = learning_starts_setting(10_000, "paper: 10^4")
 
     def __post_init__(self):
         """The checks across settings (each setting's own runs in AlgoConfig)."""

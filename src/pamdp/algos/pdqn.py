@@ -45,6 +45,7 @@ from pamdp.algos.offpolicy import (
     OffPolicyLoop,
     OUNoise,
     backprop_actor,
+    learning_starts_setting,
     linear_epsilon,
     mixed_target,
     shared_setting,
@@ -56,7 +57,6 @@ from pamdp.algos.settings import (
     POSITIVE,
     AlgoConfig,
     Check,
-    at_least,
     interval,
     setting,
 )
@@ -116,9 +116,7 @@ class PDQNConfig(DeterministicActorConfig, OffPolicyConfig, AlgoConfig):
     )
     ou_sigma: float = shared_setting("ou_sigma", 0.0001, "Bester et al.: 1e-4")
     buffer_size: int = shared_setting("buffer_size", 10_000, "Bester et al. on Platform: 10 000")
-    learning_starts: int = setting(
-        500, "Samples in the replay buffer before the first update (assumed: 500).", at_least(0)
-    )
+    learning_starts: int = learning_starts_setting(500, "assumed: 500")
 
     def __post_init__(self):
         super().__post_init__()
