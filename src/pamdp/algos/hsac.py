@@ -53,6 +53,7 @@ from pamdp.algos.offpolicy import (
     learning_starts_setting,
     shared_setting,
     soft_updater,
+    tau_setting,
     temperature_gradient,
 )
 from pamdp.algos.optim import apply_gradients, descend
@@ -99,7 +100,7 @@ class HybridSACConfig(OffPolicyConfig, AlgoConfig):
         "pi_c's target entropy in nats per parameter of the chosen action (SAC: -1 per action dimension; assumed).",
         Check(lambda v: v < math.log(2.0), "a number below log 2 (the uniform's entropy on [-1, 1])"),
     )
-    tau: float = setting(0.005, "Soft target-update rate of the critics (SAC: 0.005).", interval(0, 1, low_open=True))
+    tau: float = tau_setting(0.005, "of the critics; SAC: 0.005")
     batch_size: int = shared_setting("batch_size", 256, "SAC: 256; assumed")
     learning_starts: int = learning_starts_setting(10_000, "SAC: 10 000; assumed")
 

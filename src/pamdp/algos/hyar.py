@@ -57,6 +57,7 @@ from pamdp.algos.offpolicy import (
     linear_epsilon,
     shared_setting,
     soft_updater,
+    tau_setting,
     uniform_actions,
 )
 from pamdp.algos.optim import apply_gradients, descend
@@ -129,7 +130,7 @@ class HyARConfig(OffPolicyConfig, AlgoConfig):
     actor_lr: float = setting(3e-4, "Adam learning rate of the actor (TD3: 3e-4).", POSITIVE)
     critic_lr: float = setting(3e-4, "Adam learning rate of the critics (TD3: 3e-4).", POSITIVE)
     batch_size: int = shared_setting("batch_size", 128, "assumed: 128")
-    tau: float = setting(0.005, "Soft target-update rate (TD3: 0.005).", interval(0, 1, low_open=True))
+    tau: float = tau_setting(0.005, "TD3: 0.005")
     exploration_noise: float = setting(
         0.1,
         "Std of the Gaussian noise on the actor's [-1, 1] output (TD3: 0.1); with exploration_noise_steps, the std "

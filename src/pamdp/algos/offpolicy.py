@@ -45,6 +45,7 @@ __all__ = [
     "DeterministicActorConfig",
     "shared_setting",
     "learning_starts_setting",
+    "tau_setting",
     "OffPolicyLoop",
     "TwinQ",
     "Temperatures",
@@ -159,6 +160,12 @@ def learning_starts_setting(default: int, source: str) -> int:
     """The ``learning_starts`` setting of an off-policy config, with its ``default`` and where the value comes
     from (HyAR's is no setting: its warm-up, ``warmup_steps``)."""
     return setting(default, f"Samples in the replay buffer before the first update ({source}).", at_least(0))
+
+
+def tau_setting(default: float, source: str) -> float:
+    """A soft target-update rate (:func:`soft_updater`'s ``tau``), with its ``default`` and where it comes from."""
+    help = f"Soft target-update rate, target <- tau * online + (1 - tau) * target ({source})."
+    return setting(default, help, interval(0, 1, low_open=True))
 
 
 # act(obs (N, d) tensor, global step, episode_start (N,) bool, mask (N, K) bool tensor or None)

@@ -48,6 +48,7 @@ from pamdp.algos.offpolicy import (
     mixed_target,
     shared_setting,
     soft_updater,
+    tau_setting,
 )
 from pamdp.algos.optim import apply_gradients
 from pamdp.algos.settings import POSITIVE, AlgoConfig, interval, setting
@@ -73,9 +74,7 @@ class PADDPGConfig(DeterministicActorConfig, OffPolicyConfig, AlgoConfig):
     )
     grad_clip: float = shared_setting("grad_clip", 10.0, "Hausknecht & Stone: 10")
     batch_size: int = shared_setting("batch_size", 32, "Hausknecht & Stone: 32")
-    tau: float = setting(
-        0.001, "Soft target-update rate: target <- tau * online + (1 - tau) * target.", interval(0, 1, low_open=True)
-    )
+    tau: float = tau_setting(0.001, "DDPG's 0.001")
     buffer_size: int = shared_setting("buffer_size", 500_000, "Hausknecht & Stone: 500 000")
     learning_starts: int = learning_starts_setting(10_000, "the seed paper: 10^4")
 

@@ -44,6 +44,7 @@ from pamdp.algos.offpolicy import (
     learning_starts_setting,
     shared_setting,
     soft_updater,
+    tau_setting,
     temperature_gradient,
     uniform_actions,
 )
@@ -120,11 +121,7 @@ class PASVG0Config(OffPolicyConfig, AlgoConfig):
         1e-5, "Adam learning rate of pi_d and pi_c (paper: 1e-5, which learns slowly).", POSITIVE
     )
     batch_size: int = shared_setting("batch_size", 64, "DDPG's 64; the paper does not say")
-    tau: float = setting(
-        0.001,
-        "Soft target-update rate (DDPG's 0.001): target <- tau * online + (1 - tau) * target.",
-        interval(0, 1, low_open=True),
-    )
+    tau: float = tau_setting(0.001, "DDPG's 0.001")
     buffer_size: int = shared_setting("buffer_size", 10_000_000, "paper: 10^7")
     learning_starts: int = learning_starts_setting(10_000, "paper: 10^4")
 

@@ -50,6 +50,7 @@ from pamdp.algos.offpolicy import (
     mixed_target,
     shared_setting,
     soft_updater,
+    tau_setting,
     uniform_actions,
 )
 from pamdp.algos.optim import apply_gradients, descend
@@ -57,7 +58,6 @@ from pamdp.algos.settings import (
     POSITIVE,
     AlgoConfig,
     Check,
-    interval,
     setting,
 )
 from pamdp.distributions import masked_logits
@@ -98,12 +98,8 @@ class PDQNConfig(DeterministicActorConfig, OffPolicyConfig, AlgoConfig):
     grad_clip: float = shared_setting("grad_clip", 10.0, "assumed: 10")
     batch_size: int = shared_setting("batch_size", 128, "Bester et al.: 128")
     gamma: float = shared_setting("gamma", 0.9, "Bester et al. on Platform: 0.9")
-    tau_q: float = setting(
-        0.1, "Soft target-update rate of the Q-network (Bester et al.: 0.1).", interval(0, 1, low_open=True)
-    )
-    tau_actor: float = setting(
-        0.001, "Soft target-update rate of the actor (Bester et al.: 0.001).", interval(0, 1, low_open=True)
-    )
+    tau_q: float = tau_setting(0.1, "of the Q-network; Bester et al.: 0.1")
+    tau_actor: float = tau_setting(0.001, "of the actor; Bester et al.: 0.001")
     beta: float = shared_setting("beta", 0.0, "0 on Platform")
     epsilon_end: float = shared_setting("epsilon_end", 0.01, "Bester et al.: 0.01")
     epsilon_steps: int = shared_setting(
