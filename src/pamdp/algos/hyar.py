@@ -50,6 +50,7 @@ from torch import nn
 
 from pamdp.algos.base import Algorithm
 from pamdp.algos.offpolicy import (
+    EpsilonSchedule,
     OffPolicyConfig,
     OffPolicyLoop,
     TwinQ,
@@ -317,7 +318,7 @@ class LatentActor(nn.Module):
         return self.low + (u + 1.0) * 0.5 * (self.high - self.low)
 
 
-class HyAR(Algorithm):
+class HyAR(EpsilonSchedule, Algorithm):
     """HyAR-TD3 (Li et al. 2022): TD3 in a learned hybrid action representation. See :class:`HyARConfig`."""
 
     config_class = HyARConfig
@@ -395,11 +396,6 @@ class HyAR(Algorithm):
         latent = self.rep.snap(latent, mask)
         a, x = self.rep.decode(obs, latent, mask)
         return a, x, {"latent": latent.cpu().numpy()}
-
-    def epsilon(self, step: int) -> float:
-        """The chance of a drawn embedding after ``step`` samples: linear from epsilon_start to epsilon_end."""
-        cfg = self.config
-        return linear_epsilon(step, cfg.epsilon_start, cfg.epsilon_end, cfg.epsilon_steps)
 
     # -- learning --------------------------------------------------------------------------------
     def _epoch_stats(self, step: int) -> dict[str, float]:

@@ -54,6 +54,7 @@ __all__ = [
     "soft_update",
     "soft_updater",
     "linear_epsilon",
+    "EpsilonSchedule",
     "uniform_actions",
     "mixed_target",
     "discounted_returns",
@@ -256,6 +257,20 @@ class OUNoise:
 def linear_epsilon(step: int, start: float, end: float, steps: int) -> float:
     """An exploration rate falling linearly from ``start`` to ``end`` over ``steps`` samples, then held."""
     return start + min(step / steps, 1.0) * (end - start)
+
+
+class EpsilonSchedule:
+    """An algorithm's ``epsilon(step)``: its config's ``epsilon_start`` falling linearly to ``epsilon_end`` over
+    ``epsilon_steps`` samples (PADDPG's and P-DQN's exploration rate, HyAR's chance of a drawn embedding), and
+    ``train/epsilon`` at the end of each epoch; a base beside :class:`~pamdp.algos.base.Algorithm`."""
+
+    def epsilon(self, step: int) -> float:
+        """The exploration rate after ``step`` samples: linear from epsilon_start to epsilon_end."""
+        cfg = self.config
+        return linear_epsilon(step, cfg.epsilon_start, cfg.epsilon_end, cfg.epsilon_steps)
+
+    def _epoch_stats(self, step: int) -> dict[str, float]:
+        return {"train/epsilon": self.epsilon(step)}
 
 
 def uniform_actions(

@@ -39,12 +39,12 @@ from pamdp.algos.base import Algorithm
 from pamdp.algos.dense import Dense
 from pamdp.algos.offpolicy import (
     DeterministicActorConfig,
+    EpsilonSchedule,
     OffPolicyConfig,
     OffPolicyLoop,
     OUNoise,
     bounded,
     learning_starts_setting,
-    linear_epsilon,
     mixed_target,
     shared_setting,
     soft_updater,
@@ -121,7 +121,7 @@ class Critic(nn.Module):
         return self.net(torch.cat([obs, out], dim=-1)).squeeze(-1)
 
 
-class PADDPG(Algorithm):
+class PADDPG(EpsilonSchedule, Algorithm):
     """Parameterized-action DDPG with inverting gradients (Hausknecht & Stone). See :class:`PADDPGConfig`."""
 
     config_class = PADDPGConfig
@@ -170,11 +170,6 @@ class PADDPG(Algorithm):
         k = self.hybrid.n_actions
         return torch.cat([torch.where(mask, out[:, :k], -1.0), out[:, k:]], dim=-1)
 
-    def epsilon(self, step: int) -> float:
-        """The exploration rate after ``step`` samples: linear from epsilon_start to epsilon_end."""
-        cfg = self.config
-        return linear_epsilon(step, cfg.epsilon_start, cfg.epsilon_end, cfg.epsilon_steps)
-
     def _epsilon_greedy(self, out: torch.Tensor, eps: float) -> torch.Tensor:
         random = self.np_rng.random(len(out)) < eps
         uniform = self.np_rng.uniform(-1.0, 1.0, size=out.shape).astype(np.float32)
@@ -194,9 +189,6 @@ class PADDPG(Algorithm):
     def _target_value(self, obs: torch.Tensor, mask: torch.Tensor | None) -> torch.Tensor:
         """``Q'(s, mu'(s))``, the bootstrap of a truncated episode's Monte-Carlo return."""
         return self.critic_target(obs, self._masked(self.actor_target(obs).clamp(-1.0, 1.0), mask))
-
-    def _epoch_stats(self, step: int) -> dict[str, float]:
-        return {"train/epsilon": self.epsilon(step)}
 
     def _update(self) -> dict[str, float]:
         """One critic step on the mixed target and one actor step along the bounded ``dQ/dmu``, back-propagated

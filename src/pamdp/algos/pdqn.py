@@ -41,12 +41,12 @@ from torch import nn
 from pamdp.algos.base import Algorithm
 from pamdp.algos.offpolicy import (
     DeterministicActorConfig,
+    EpsilonSchedule,
     OffPolicyConfig,
     OffPolicyLoop,
     OUNoise,
     backprop_actor,
     learning_starts_setting,
-    linear_epsilon,
     mixed_target,
     shared_setting,
     soft_updater,
@@ -235,7 +235,7 @@ class QNetwork(nn.Module):
         super()._load_from_state_dict(state_dict, prefix, *args, **kwargs)
 
 
-class PDQN(Algorithm):
+class PDQN(EpsilonSchedule, Algorithm):
     """P-DQN (Xiong et al. 2018) and, with ``multi_pass``, MP-DQN (Bester et al. 2019). See :class:`PDQNConfig`."""
 
     config_class = PDQNConfig
@@ -274,11 +274,6 @@ class PDQN(Algorithm):
             a, params = self._epsilon_greedy(a, params, self.config.epsilon_end, mask)
         return a, self.actor.select(params, a)
 
-    def epsilon(self, step: int) -> float:
-        """The exploration rate after ``step`` samples: linear from epsilon_start to epsilon_end."""
-        cfg = self.config
-        return linear_epsilon(step, cfg.epsilon_start, cfg.epsilon_end, cfg.epsilon_steps)
-
     def _epsilon_greedy(self, a: torch.Tensor, params: torch.Tensor, eps: float, mask: torch.Tensor | None):
         """With probability ``eps`` a uniform discrete action among the allowed (with ``explore_params``, uniform
         parameters for it)."""
@@ -305,9 +300,6 @@ class PDQN(Algorithm):
         return masked_logits(self.q_target(obs, self.actor_target(obs).clamp(-1.0, 1.0)), mask).max(-1).values
 
     # -- learning --------------------------------------------------------------------------------
-    def _epoch_stats(self, step: int) -> dict[str, float]:
-        return {"train/epsilon": self.epsilon(step)}
-
     def _update(self) -> dict[str, float]:
         """One TD step of the Q-network, one actor step along the bounded ``d sum_k Q_k / dx``, soft target updates."""
         cfg = self.config
