@@ -3,7 +3,7 @@
 The public API is Stable-Baselines3's, which users know: ``Algo(env, config)``, ``.learn(total_timesteps)``,
 ``.predict(obs, deterministic=True)``, ``.save(path)``, ``Algo.load(path)``. An algorithm subclasses
 :class:`Algorithm` (one level of inheritance) and provides ``_build`` (networks and optimisers),
-``_act`` (actions for a batch of observations), ``_modules``/``_optimizers`` (what a checkpoint holds) and its
+``_act`` (actions for a batch of observations), ``MODULES``/``OPTIMIZERS`` (what a checkpoint holds) and its
 family's loop, :attr:`Algorithm.loop`, which runs its epochs: an off-policy algorithm's
 :class:`~pamdp.algos.offpolicy.OffPolicyLoop` (the algorithm gives it ``_explore`` and ``_update``), an on-policy
 one's :class:`~pamdp.algos.onpolicy.Rollout` (``_values`` and ``_learn``). Its settings are an

@@ -107,7 +107,7 @@ def redeclared(base: type, name: str, default: Any, source: str | None = None) -
 
 @dataclasses.dataclass(frozen=True)
 class AlgoConfig:
-    """Settings every algorithm has. Subclasses add their own and a ``presets()`` table."""
+    """Settings every algorithm has. Subclasses add their own and a :attr:`PRESETS` table."""
 
     seed: int = setting(0, "Seeds the networks' initialisation, action sampling and the environments.", at_least(0))
     num_envs: int = setting(
