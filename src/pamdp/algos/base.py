@@ -3,7 +3,7 @@
 The public API is Stable-Baselines3's, which users know: ``Algo(env, config)``, ``.learn(total_timesteps)``,
 ``.predict(obs, deterministic=True)``, ``.save(path)``, ``Algo.load(path)``. An algorithm subclasses
 :class:`Algorithm` (one level of inheritance) and provides ``_build`` (networks and optimisers),
-``_act`` (actions for a batch of observations), ``_modules``/``_optimizers`` (what a checkpoint holds) and its
+``_act`` (actions for a batch of observations), ``MODULES``/``OPTIMIZERS`` (what a checkpoint holds) and its
 family's loop, :attr:`Algorithm.loop`, which runs its epochs: an off-policy algorithm's
 :class:`~pamdp.algos.offpolicy.OffPolicyLoop` (the algorithm gives it ``_explore`` and ``_update``), an on-policy
 one's :class:`~pamdp.algos.onpolicy.Rollout` (``_values`` and ``_learn``). Its settings are an
@@ -148,11 +148,17 @@ class Algorithm:
         among the actions ``mask`` allows (bool ``(B, K)`` on the device; ``None``: all)."""
         raise NotImplementedError
 
+    MODULES: ClassVar[tuple[str, ...]] = ()
+    """The attributes that hold the algorithm's networks, saved under their names (``None``: a network its
+    settings leave out)."""
+    OPTIMIZERS: ClassVar[dict[str, str]] = {}
+    """The optimisers, ``{name in a checkpoint: attribute}`` (``None``: one its settings leave out)."""
+
     def _modules(self) -> dict[str, torch.nn.Module]:
-        raise NotImplementedError
+        return {name: module for name in self.MODULES if (module := getattr(self, name, None)) is not None}
 
     def _optimizers(self) -> dict[str, torch.optim.Optimizer]:
-        return {}
+        return {name: opt for name, attr in self.OPTIMIZERS.items() if (opt := getattr(self, attr, None)) is not None}
 
     def _extra_state(self) -> dict:
         """What a checkpoint holds besides modules, optimisers and the loop's state."""

@@ -38,7 +38,6 @@ from __future__ import annotations
 import copy
 import dataclasses
 import math
-from typing import TYPE_CHECKING
 
 import numpy as np
 import torch
@@ -51,18 +50,17 @@ from pamdp.algos.offpolicy import (
     OffPolicyLoop,
     Temperatures,
     TwinQ,
+    learning_starts_setting,
     shared_setting,
     soft_updater,
+    tau_setting,
     temperature_gradient,
 )
 from pamdp.algos.optim import apply_gradients, descend
-from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
+from pamdp.algos.settings import NON_NEGATIVE, POSITIVE, AlgoConfig, Check, interval, one_of, setting
 from pamdp.distributions import LOG_STD_MAX, LOG_STD_MIN, MASKED, SquashedHybrid, masked_logits
-from pamdp.policies import ACTIVATIONS, every_action_mlp, hierarchical_mlps, mlp, small_init_
+from pamdp.policies import every_action_mlp, hierarchical_mlps, mlp, small_init_
 from pamdp.spaces import HybridActionSpace
-
-if TYPE_CHECKING:
-    from typing_extensions import Self
 
 __all__ = ["HybridSAC", "HybridSACConfig", "HybridSACActor"]
 
@@ -81,10 +79,7 @@ class HybridSACConfig(OffPolicyConfig, AlgoConfig):
         "(pi_c(x|s,a) on [s, onehot(a)], the seed paper's).",
         one_of(FORMS),
     )
-    hidden_sizes: tuple[int, ...] = setting(
-        (256, 256), "Hidden layers of each policy network and each critic (SAC's: 256-256; assumed).", LAYERS
-    )
-    activation: str = setting("relu", "Hidden activation: relu, leaky_relu, tanh or elu.", one_of(ACTIVATIONS))
+    hidden_sizes: tuple[int, ...] = shared_setting("hidden_sizes", (256, 256), "SAC's: 256-256; assumed")
     actor_lr: float = setting(3e-4, "Adam learning rate of the policy (SAC: 3e-4; assumed).", POSITIVE)
     critic_lr: float = setting(3e-4, "Adam learning rate of the twin critics (SAC: 3e-4; assumed).", POSITIVE)
     alpha_lr: float = setting(
@@ -105,37 +100,33 @@ class HybridSACConfig(OffPolicyConfig, AlgoConfig):
         "pi_c's target entropy in nats per parameter of the chosen action (SAC: -1 per action dimension; assumed).",
         Check(lambda v: v < math.log(2.0), "a number below log 2 (the uniform's entropy on [-1, 1])"),
     )
-    tau: float = setting(0.005, "Soft target-update rate of the critics (SAC: 0.005).", interval(0, 1, low_open=True))
+    tau: float = tau_setting(0.005, "of the critics; SAC: 0.005")
     batch_size: int = shared_setting("batch_size", 256, "SAC: 256; assumed")
-    learning_starts: int = setting(
-        10_000, "Samples in the replay buffer before the first update (SAC: 10 000; assumed).", at_least(0)
-    )
+    learning_starts: int = learning_starts_setting(10_000, "SAC: 10 000; assumed")
 
-    @classmethod
-    def presets(cls) -> dict[str, Self]:
-        # "tuned" (the command line's default): sized for a laptop CPU, with 64 batched env copies, networks of
-        # 64-64, a tenth of an update per sample on batches of 128 (an update costs about the same at 64 or 128 here),
-        # lower initial temperatures (Platform's returns sum to at most 1, so an entropy bonus of 1 nat a step would
-        # dominate them) and a discrete target entropy of half the uniform's; how it learns:
-        # benchmarks/hsac_platform.md.
-        return {
-            "paper": cls(),
-            "tuned": cls(
-                num_envs=64,
-                hidden_sizes=(64, 64),
-                batch_size=128,
-                updates_per_step=0.1,
-                target_entropy_d=0.5,
-                learning_starts=2_000,
-                buffer_size=200_000,
-                init_alpha_d=0.1,
-                init_alpha_c=0.1,
-                actor_lr=1e-3,
-                critic_lr=1e-3,
-                alpha_lr=1e-3,
-                tau=0.01,
-            ),
-        }
+    # "tuned" (the command line's default): sized for a laptop CPU, with 64 batched env copies, networks of
+    # 64-64, a tenth of an update per sample on batches of 128 (an update costs about the same at 64 or 128 here),
+    # lower initial temperatures (Platform's returns sum to at most 1, so an entropy bonus of 1 nat a step would
+    # dominate them) and a discrete target entropy of half the uniform's; how it learns:
+    # benchmarks/hsac_platform.md.
+    PRESETS = {
+        "paper": {},
+        "tuned": dict(
+            num_envs=64,
+            hidden_sizes=(64, 64),
+            batch_size=128,
+            updates_per_step=0.1,
+            target_entropy_d=0.5,
+            learning_starts=2_000,
+            buffer_size=200_000,
+            init_alpha_d=0.1,
+            init_alpha_c=0.1,
+            actor_lr=1e-3,
+            critic_lr=1e-3,
+            alpha_lr=1e-3,
+            tau=0.01,
+        ),
+    }
 
 
 class HybridSACActor(nn.Module):
@@ -187,6 +178,8 @@ class HybridSAC(Algorithm):
 
     config_class = HybridSACConfig
     config: HybridSACConfig
+    MODULES = ("actor", "critic", "critic_target", "temperatures")
+    OPTIMIZERS = {"actor": "actor_optimizer", "critic": "critic_optimizer", "temperatures": "alpha_optimizer"}
 
     def _build(self) -> None:
         cfg, h = self.config, self.hybrid
@@ -205,22 +198,11 @@ class HybridSAC(Algorithm):
         self.replay = self.loop.buffer
         self._soft_update = soft_updater([(self.critic_target, self.critic)])
 
-    def _modules(self):
-        return {
-            "actor": self.actor,
-            "critic": self.critic,
-            "critic_target": self.critic_target,
-            "temperatures": self.temperatures,
-        }
-
-    def _optimizers(self):
-        return {"actor": self.actor_optimizer, "critic": self.critic_optimizer, "temperatures": self.alpha_optimizer}
-
     @property
     def alphas(self) -> tuple[float, float]:
         """The current temperatures ``(alpha_d, alpha_c)``."""
-        t = self.temperatures
-        return float(t.log_alpha_d.detach().exp()), float(t.log_alpha_c.detach().exp())
+        alpha_d, alpha_c = self._alpha_tensors()
+        return float(alpha_d), float(alpha_c)
 
     # -- acting ----------------------------------------------------------------------------------
     def _act(self, obs, deterministic, mask=None):

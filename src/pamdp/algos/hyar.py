@@ -42,7 +42,6 @@ from __future__ import annotations
 
 import copy
 import dataclasses
-from typing import TYPE_CHECKING
 
 import numpy as np
 import torch
@@ -51,6 +50,7 @@ from torch import nn
 
 from pamdp.algos.base import Algorithm
 from pamdp.algos.offpolicy import (
+    EpsilonSchedule,
     OffPolicyConfig,
     OffPolicyLoop,
     TwinQ,
@@ -58,6 +58,7 @@ from pamdp.algos.offpolicy import (
     linear_epsilon,
     shared_setting,
     soft_updater,
+    tau_setting,
     uniform_actions,
 )
 from pamdp.algos.optim import apply_gradients, descend
@@ -65,9 +66,6 @@ from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, at_
 from pamdp.distributions import LOG_STD_MAX, LOG_STD_MIN, masked_logits
 from pamdp.policies import ACTIVATIONS, mlp
 from pamdp.spaces import HybridActionSpace
-
-if TYPE_CHECKING:
-    from typing_extensions import Self
 
 __all__ = ["HyAR", "HyARConfig", "ActionRepresentation", "latent_bounds"]
 
@@ -84,10 +82,7 @@ class HyARConfig(OffPolicyConfig, AlgoConfig):
     vae_hidden_sizes: tuple[int, ...] = setting(
         (256, 256), "Hidden layers of the VAE's encoder and decoder (assumed).", LAYERS
     )
-    hidden_sizes: tuple[int, ...] = setting(
-        (256, 256), "Hidden layers of the actor and each critic (TD3's: 256-256).", LAYERS
-    )
-    activation: str = setting("relu", "Hidden activation: relu, leaky_relu, tanh or elu.", one_of(ACTIVATIONS))
+    hidden_sizes: tuple[int, ...] = shared_setting("hidden_sizes", (256, 256), "TD3's: 256-256")
     bound: str = setting(
         "squash",
         "Keeping the actor's output in [-1, 1]: squash (Tanh, the paper) or invert (a linear output and Hausknecht "
@@ -136,7 +131,7 @@ class HyARConfig(OffPolicyConfig, AlgoConfig):
     actor_lr: float = setting(3e-4, "Adam learning rate of the actor (TD3: 3e-4).", POSITIVE)
     critic_lr: float = setting(3e-4, "Adam learning rate of the critics (TD3: 3e-4).", POSITIVE)
     batch_size: int = shared_setting("batch_size", 128, "assumed: 128")
-    tau: float = setting(0.005, "Soft target-update rate (TD3: 0.005).", interval(0, 1, low_open=True))
+    tau: float = tau_setting(0.005, "TD3: 0.005")
     exploration_noise: float = setting(
         0.1,
         "Std of the Gaussian noise on the actor's [-1, 1] output (TD3: 0.1); with exploration_noise_steps, the std "
@@ -195,31 +190,29 @@ class HyARConfig(OffPolicyConfig, AlgoConfig):
         """The samples before the first update (:class:`~pamdp.algos.offpolicy.OffPolicyLoop`): the warm-up's."""
         return self.warmup_steps
 
-    @classmethod
-    def presets(cls) -> dict[str, Self]:
-        # "cpu" (the command line's default): smaller networks, 64 batched env copies and a quarter of a TD3 update
-        # per sample, for a laptop CPU, with a small KL weight and small latents (a 1-D parameter in 6 latent
-        # dimensions left 5 for the critic to learn to ignore). It is sized, not tuned: see docs/algorithms.md.
-        return {
-            "cpu": cls(
-                num_envs=64,
-                embed_dim=3,
-                latent_dim=2,
-                kl_weight=0.01,
-                hidden_sizes=(128, 128),
-                vae_hidden_sizes=(128, 128),
-                updates_per_step=0.25,
-                vae_interval=2_000,
-                vae_updates=20,
-                warmup_updates=2_000,
-                buffer_size=200_000,
-                bound="invert",
-                epsilon_start=0.5,
-                epsilon_end=0.05,
-                epsilon_steps=50_000,
-            ),
-            "paper": cls(),
-        }
+    # "cpu" (the command line's default): smaller networks, 64 batched env copies and a quarter of a TD3 update
+    # per sample, for a laptop CPU, with a small KL weight and small latents (a 1-D parameter in 6 latent
+    # dimensions left 5 for the critic to learn to ignore). It is sized, not tuned: see docs/algorithms.md.
+    PRESETS = {
+        "cpu": dict(
+            num_envs=64,
+            embed_dim=3,
+            latent_dim=2,
+            kl_weight=0.01,
+            hidden_sizes=(128, 128),
+            vae_hidden_sizes=(128, 128),
+            updates_per_step=0.25,
+            vae_interval=2_000,
+            vae_updates=20,
+            warmup_updates=2_000,
+            buffer_size=200_000,
+            bound="invert",
+            epsilon_start=0.5,
+            epsilon_end=0.05,
+            epsilon_steps=50_000,
+        ),
+        "paper": {},
+    }
 
 
 class ActionRepresentation(nn.Module):
@@ -325,11 +318,13 @@ class LatentActor(nn.Module):
         return self.low + (u + 1.0) * 0.5 * (self.high - self.low)
 
 
-class HyAR(Algorithm):
+class HyAR(EpsilonSchedule, Algorithm):
     """HyAR-TD3 (Li et al. 2022): TD3 in a learned hybrid action representation. See :class:`HyARConfig`."""
 
     config_class = HyARConfig
     config: HyARConfig
+    MODULES = ("rep", "actor", "critic", "actor_target", "critic_target")
+    OPTIMIZERS = {"rep": "rep_optimizer", "actor": "actor_optimizer", "critic": "critic_optimizer"}
 
     def _build(self) -> None:
         cfg, h = self.config, self.hybrid
@@ -354,18 +349,6 @@ class HyAR(Algorithm):
         self.pretrained = False  # the warm-up round of representation training is done
         self.n_updates = 0  # TD3 updates so far (the policy delay and the representation rounds count them)
         self.rl_start = 0  # the replay's insertion counter at the representation's pre-training (td3_replay)
-
-    def _modules(self):
-        return {
-            "rep": self.rep,
-            "actor": self.actor,
-            "critic": self.critic,
-            "actor_target": self.actor_target,
-            "critic_target": self.critic_target,
-        }
-
-    def _optimizers(self):
-        return {"rep": self.rep_optimizer, "actor": self.actor_optimizer, "critic": self.critic_optimizer}
 
     def _extra_state(self):
         return {"pretrained": self.pretrained, "n_updates": self.n_updates, "rl_start": self.rl_start}
@@ -413,11 +396,6 @@ class HyAR(Algorithm):
         latent = self.rep.snap(latent, mask)
         a, x = self.rep.decode(obs, latent, mask)
         return a, x, {"latent": latent.cpu().numpy()}
-
-    def epsilon(self, step: int) -> float:
-        """The chance of a drawn embedding after ``step`` samples: linear from epsilon_start to epsilon_end."""
-        cfg = self.config
-        return linear_epsilon(step, cfg.epsilon_start, cfg.epsilon_end, cfg.epsilon_steps)
 
     # -- learning --------------------------------------------------------------------------------
     def _epoch_stats(self, step: int) -> dict[str, float]:

@@ -34,15 +34,18 @@ import torch
 from torch import nn
 
 from pamdp.algos.replay import ReplayBuffer, transition_fields
-from pamdp.algos.settings import NON_NEGATIVE, POSITIVE, at_least, interval, setting
+from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, at_least, interval, one_of, redeclared, setting
 from pamdp.algos.subnormals import subnormals_flushed
 from pamdp.algos.vector_env import Step, VectorStepper
 from pamdp.distributions import masked_logits
-from pamdp.policies import mlp
+from pamdp.policies import ACTIVATIONS, mlp
 
 __all__ = [
     "OffPolicyConfig",
+    "DeterministicActorConfig",
     "shared_setting",
+    "learning_starts_setting",
+    "tau_setting",
     "OffPolicyLoop",
     "TwinQ",
     "Temperatures",
@@ -51,6 +54,7 @@ __all__ = [
     "soft_update",
     "soft_updater",
     "linear_epsilon",
+    "EpsilonSchedule",
     "uniform_actions",
     "mixed_target",
     "discounted_returns",
@@ -104,13 +108,65 @@ class OffPolicyConfig:
         "script: 1/50); logged returns and evaluations stay the env's.",
         POSITIVE,
     )
+    hidden_sizes: tuple[int, ...] = setting(
+        (256, 256), "Hidden layers of the actor (or policy) and the critics.", LAYERS
+    )
+    activation: str = setting("relu", "Hidden activation: relu, leaky_relu, tanh or elu.", one_of(ACTIVATIONS))
 
 
-def shared_setting(name: str, default, source: str):
-    """:class:`OffPolicyConfig`'s setting ``name`` with an algorithm's own ``default``; ``source`` says where the
-    value comes from and joins the help ("Transitions per gradient update (Hausknecht & Stone: 32).")."""
-    help = OffPolicyConfig.__dataclass_fields__[name].metadata["help"]
-    return setting(default, f"{help.rstrip('.')} ({source}).")
+@dataclasses.dataclass(frozen=True)
+class DeterministicActorConfig:
+    """The settings of a deterministic actor with outputs in ``[-1, 1]`` (PADDPG's and P-DQN's), declared once as
+    :class:`OffPolicyConfig`'s are: how the outputs are kept in bounds, the Monte-Carlo part of the target, and
+    the exploration, epsilon-greedy with Ornstein-Uhlenbeck noise. The defaults are PADDPG's, Hausknecht & Stone's.
+    """
+
+    bound: str = setting(
+        "invert",
+        "Keeping outputs in [-1, 1]: invert (Hausknecht & Stone's inverting gradients), squash (Tanh) or zero.",
+        one_of(BOUNDS),
+    )
+    beta: float = setting(
+        0.2,
+        "Weight of the Monte-Carlo return in the target (H&S: 0.2 to 0.5); 0 gives DDPG's pure TD target.",
+        interval(0, 1),
+    )
+    epsilon_start: float = setting(
+        1.0, "Exploration rate at the start: the chance of a uniformly random action.", interval(0, 1)
+    )
+    epsilon_end: float = setting(0.1, "Exploration rate after the annealing.", interval(0, 1))
+    epsilon_steps: int = setting(
+        100_000, "Environment samples over which epsilon falls linearly to epsilon_end.", at_least(1)
+    )
+    ou_sigma: float = setting(
+        0.0,
+        "Scale of Ornstein-Uhlenbeck noise on the actor's parameters, in [-1, 1] units; 0 turns it off.",
+        NON_NEGATIVE,
+    )
+    ou_theta: float = setting(
+        0.15,
+        "Mean reversion of the Ornstein-Uhlenbeck noise (DDPG's 0.15); 1 gives i.i.d. Gaussian noise.",
+        interval(0, 1, low_open=True),
+    )
+
+
+def shared_setting(name: str, default, source: str | None = None):
+    """The family's setting ``name`` (of :class:`OffPolicyConfig` or :class:`DeterministicActorConfig`) declared
+    again with an algorithm's own ``default``, its help and check kept (:func:`~pamdp.algos.settings.redeclared`)."""
+    base = OffPolicyConfig if name in OffPolicyConfig.__dataclass_fields__ else DeterministicActorConfig
+    return redeclared(base, name, default, source)
+
+
+def learning_starts_setting(default: int, source: str) -> int:
+    """The ``learning_starts`` setting of an off-policy config, with its ``default`` and where the value comes
+    from (HyAR's is no setting: its warm-up, ``warmup_steps``)."""
+    return setting(default, f"Samples in the replay buffer before the first update ({source}).", at_least(0))
+
+
+def tau_setting(default: float, source: str) -> float:
+    """A soft target-update rate (:func:`soft_updater`'s ``tau``), with its ``default`` and where it comes from."""
+    help = f"Soft target-update rate, target <- tau * online + (1 - tau) * target ({source})."
+    return setting(default, help, interval(0, 1, low_open=True))
 
 
 # act(obs (N, d) tensor, global step, episode_start (N,) bool, mask (N, K) bool tensor or None)
@@ -201,6 +257,20 @@ class OUNoise:
 def linear_epsilon(step: int, start: float, end: float, steps: int) -> float:
     """An exploration rate falling linearly from ``start`` to ``end`` over ``steps`` samples, then held."""
     return start + min(step / steps, 1.0) * (end - start)
+
+
+class EpsilonSchedule:
+    """An algorithm's ``epsilon(step)``: its config's ``epsilon_start`` falling linearly to ``epsilon_end`` over
+    ``epsilon_steps`` samples (PADDPG's and P-DQN's exploration rate, HyAR's chance of a drawn embedding), and
+    ``train/epsilon`` at the end of each epoch; a base beside :class:`~pamdp.algos.base.Algorithm`."""
+
+    def epsilon(self, step: int) -> float:
+        """The exploration rate after ``step`` samples: linear from epsilon_start to epsilon_end."""
+        cfg = self.config
+        return linear_epsilon(step, cfg.epsilon_start, cfg.epsilon_end, cfg.epsilon_steps)
+
+    def _epoch_stats(self, step: int) -> dict[str, float]:
+        return {"train/epsilon": self.epsilon(step)}
 
 
 def uniform_actions(
@@ -298,8 +368,8 @@ class OffPolicyLoop:
         algo: the algorithm.
         mc_returns: compute Monte-Carlo returns (discounted by ``config.gamma``) when episodes end.
         tail_value: with ``mc_returns``, the value of a truncated episode's final observations
-            ``(B, d)`` with their action masks (``(B, K)`` bool, or ``None``) ``-> (B,)``, which bootstraps its
-            Monte-Carlo return; ``None`` treats the cut as an end.
+            ``(B, d)`` with their action masks (``(B, K)`` bool, or ``None``) ``-> (B,)``, tensors on the
+            algorithm's device, which bootstraps its Monte-Carlo return; ``None`` treats the cut as an end.
         fields: the algorithm's own fields, ``name=(shape, dtype)``.
 
     With the ``action_mask`` setting the loop reads the env's ``info["action_mask"]`` at every step, passes the
@@ -311,7 +381,7 @@ class OffPolicyLoop:
         self,
         algo,
         mc_returns: bool = False,
-        tail_value: Callable[[np.ndarray, np.ndarray | None], np.ndarray] | None = None,
+        tail_value: Callable[[torch.Tensor, torch.Tensor | None], torch.Tensor] | None = None,
         **fields,
     ):
         cfg, hybrid = algo.config, algo.hybrid
@@ -393,8 +463,11 @@ class OffPolicyLoop:
         tails = np.zeros(len(step.done))
         cut = [i for i in ended if not step.terminated[i]]
         if cut and self.tail_value is not None:
-            masks = None if step.next_masks is None else step.next_masks[cut]
-            tails[cut] = self.tail_value(np.asarray(step.next_obs, dtype=np.float32)[cut], masks)
+            device = self.algo.device
+            obs = torch.from_numpy(np.asarray(step.next_obs, dtype=np.float32)[cut]).to(device)
+            masks = None if step.next_masks is None else torch.from_numpy(step.next_masks[cut]).to(device)
+            with torch.no_grad():
+                tails[cut] = self.tail_value(obs, masks).cpu().numpy()
         for c, i in zip(counters, np.flatnonzero(step.valid)):
             self._pending[i][0].append(int(c))
             self._pending[i][1].append(float(step.reward[i]) * self.config.reward_scale)  # on the critics' scale

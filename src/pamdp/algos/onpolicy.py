@@ -8,18 +8,20 @@ and flattens the batch to its valid samples. What differs, the policy update, li
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable
 
 import numpy as np
 import torch
 
-from pamdp.algos.settings import one_of, setting
+from pamdp.algos.settings import LAYERS, at_least, interval, one_of, setting
 from pamdp.algos.subnormals import subnormals_flushed
 from pamdp.algos.vector_env import VectorStepper
-from pamdp.policies import PI_C_INPUTS
+from pamdp.policies import ACTIVATIONS, PI_C_INPUTS, HybridPolicy
 
 __all__ = [
-    "pi_c_input_setting",
+    "OnPolicyConfig",
+    "hybrid_policy",
     "Rollout",
     "gae",
     "advantage_batch",
@@ -30,14 +32,42 @@ __all__ = [
 ]
 
 
-def pi_c_input_setting() -> str:
-    """The ``pi_c_input`` setting of the hierarchical policy's algorithms (:class:`~pamdp.policies.HybridPolicy`)."""
-    return setting(
+@dataclasses.dataclass(frozen=True)
+class OnPolicyConfig:
+    """The settings of the hierarchical policy, its sampling and its advantages, declared once for PATRPO and
+    PAPPO; an algorithm's config inherits it beside :class:`~pamdp.algos.settings.AlgoConfig` (as the off-policy
+    ones inherit :class:`~pamdp.algos.offpolicy.OffPolicyConfig`) and declares a setting whose default it changes
+    again with :func:`~pamdp.algos.settings.redeclared`. The defaults are the common PPO ones."""
+
+    num_envs: int = setting(
+        64, "Copies of the env stepped together; the samples are on-policy, so more is just faster.", at_least(1)
+    )
+    hidden_sizes: tuple[int, ...] = setting((64, 64), "Hidden layers of pi_d and pi_c, each its own network.", LAYERS)
+    activation: str = setting(
+        "tanh", "Hidden activation of the policies: tanh (PPO's usual), relu, leaky_relu or elu.", one_of(ACTIVATIONS)
+    )
+    init_log_std: float = setting(0.0, "Initial log-std of the parameter noise, in [-1, 1] units.")
+    pi_c_input: str = setting(
         "onehot",
         "What pi_c reads: onehot ([s, onehot(a)], the paper's) or state (s alone, a block of K * m outputs, one "
         "per action: every action's mean in one pass, for large K such as Hard Move's).",
         one_of(PI_C_INPUTS),
     )
+    batch_size: int = setting(
+        4096, "Samples per epoch, collected with the current policy before its update.", at_least(1)
+    )
+    gamma: float = setting(0.99, "Discount factor.", interval(0, 1))
+    gae_lambda: float = setting(
+        0.95, "GAE lambda: lower trades bias for less variance in the advantages.", interval(0, 1)
+    )
+    normalize_advantages: bool = setting(True, "Standardise advantages within the batch.")
+    vf_hidden_sizes: tuple[int, ...] = setting((64, 64), "Hidden layers of the value network.", LAYERS)
+
+
+def hybrid_policy(algo) -> HybridPolicy:
+    """The hierarchical policy that ``algo``'s :class:`OnPolicyConfig` describes, for its env."""
+    cfg = algo.config
+    return HybridPolicy(algo.obs_dim, algo.hybrid, cfg.hidden_sizes, cfg.activation, cfg.init_log_std, cfg.pi_c_input)
 
 
 def gae(

@@ -30,7 +30,6 @@ from __future__ import annotations
 
 import copy
 import dataclasses
-from typing import TYPE_CHECKING
 
 import numpy as np
 import torch
@@ -39,43 +38,35 @@ from torch import nn
 from pamdp.algos.base import Algorithm
 from pamdp.algos.dense import Dense
 from pamdp.algos.offpolicy import (
-    BOUNDS,
+    DeterministicActorConfig,
+    EpsilonSchedule,
     OffPolicyConfig,
     OffPolicyLoop,
     OUNoise,
     bounded,
-    linear_epsilon,
+    learning_starts_setting,
     mixed_target,
     shared_setting,
     soft_updater,
+    tau_setting,
 )
 from pamdp.algos.optim import apply_gradients
-from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, at_least, interval, one_of, setting
+from pamdp.algos.settings import POSITIVE, AlgoConfig, interval, setting
 from pamdp.distributions import masked_logits
-from pamdp.policies import ACTIVATIONS, mlp
+from pamdp.policies import mlp
 from pamdp.spaces import HybridActionSpace
-
-if TYPE_CHECKING:
-    from typing_extensions import Self
 
 __all__ = ["PADDPG", "PADDPGConfig"]
 
 
 @dataclasses.dataclass(frozen=True)
-class PADDPGConfig(OffPolicyConfig, AlgoConfig):
+class PADDPGConfig(DeterministicActorConfig, OffPolicyConfig, AlgoConfig):
     """PADDPG's settings. The defaults are the seed paper's preset: Hausknecht & Stone's settings with the
     hidden layers {400, 300} of DDPG (the paper used {400, 300, 200} on Half Field Offense: preset
     ``paper_hfo``; Hausknecht & Stone's own 1024-512-256-128 towers: preset ``hausknecht_stone``)."""
 
-    hidden_sizes: tuple[int, ...] = setting(
-        (400, 300), "Hidden layers of the actor and the critic (paper: {400, 300}).", LAYERS
-    )
-    activation: str = setting(
-        "leaky_relu", "Hidden activation: leaky_relu (slope 0.01, Hausknecht & Stone), relu, ...", one_of(ACTIVATIONS)
-    )
-    bound: str = setting(
-        "invert", "Keeping outputs in [-1, 1]: invert (inverting gradients), squash (Tanh) or zero.", one_of(BOUNDS)
-    )
+    hidden_sizes: tuple[int, ...] = shared_setting("hidden_sizes", (400, 300), "paper: {400, 300}")
+    activation: str = shared_setting("activation", "leaky_relu", "Hausknecht & Stone: leaky_relu, slope 0.01")
     actor_lr: float = setting(1e-5, "Adam learning rate of the actor (Hausknecht & Stone: 1e-5).", POSITIVE)
     critic_lr: float = setting(1e-3, "Adam learning rate of the critic (Hausknecht & Stone: 1e-3).", POSITIVE)
     adam_beta1: float = setting(
@@ -83,39 +74,15 @@ class PADDPGConfig(OffPolicyConfig, AlgoConfig):
     )
     grad_clip: float = shared_setting("grad_clip", 10.0, "Hausknecht & Stone: 10")
     batch_size: int = shared_setting("batch_size", 32, "Hausknecht & Stone: 32")
-    tau: float = setting(
-        0.001, "Soft target-update rate: target <- tau * online + (1 - tau) * target.", interval(0, 1, low_open=True)
-    )
-    beta: float = setting(
-        0.2,
-        "Weight of the Monte-Carlo return in the target (H&S: 0.2 to 0.5); 0 gives DDPG's pure TD target.",
-        interval(0, 1),
-    )
-    epsilon_start: float = setting(
-        1.0, "Exploration rate at the start: the chance of a uniformly random output.", interval(0, 1)
-    )
-    epsilon_end: float = setting(0.1, "Exploration rate after the annealing.", interval(0, 1))
-    epsilon_steps: int = setting(
-        100_000, "Environment samples over which epsilon falls linearly to epsilon_end.", at_least(1)
-    )
-    ou_sigma: float = setting(
-        0.0, "Scale of Ornstein-Uhlenbeck noise on the actor's parameters; 0 turns it off.", NON_NEGATIVE
-    )
-    ou_theta: float = setting(
-        0.15, "Mean reversion of the Ornstein-Uhlenbeck noise (DDPG's 0.15).", interval(0, 1, low_open=True)
-    )
+    tau: float = tau_setting(0.001, "DDPG's 0.001")
     buffer_size: int = shared_setting("buffer_size", 500_000, "Hausknecht & Stone: 500 000")
-    learning_starts: int = setting(
-        10_000, "Samples in the replay buffer before the first update (the seed paper: 10^4).", at_least(0)
-    )
+    learning_starts: int = learning_starts_setting(10_000, "the seed paper: 10^4")
 
-    @classmethod
-    def presets(cls) -> dict[str, Self]:
-        return {
-            "paper": cls(),
-            "paper_hfo": cls(hidden_sizes=(400, 300, 200)),
-            "hausknecht_stone": cls(hidden_sizes=(1024, 512, 256, 128)),
-        }
+    PRESETS = {
+        "paper": {},
+        "paper_hfo": dict(hidden_sizes=(400, 300, 200)),
+        "hausknecht_stone": dict(hidden_sizes=(1024, 512, 256, 128)),
+    }
 
 
 class Actor(nn.Module):
@@ -154,11 +121,13 @@ class Critic(nn.Module):
         return self.net(torch.cat([obs, out], dim=-1)).squeeze(-1)
 
 
-class PADDPG(Algorithm):
+class PADDPG(EpsilonSchedule, Algorithm):
     """Parameterized-action DDPG with inverting gradients (Hausknecht & Stone). See :class:`PADDPGConfig`."""
 
     config_class = PADDPGConfig
     config: PADDPGConfig
+    MODULES = ("actor", "critic", "actor_target", "critic_target")
+    OPTIMIZERS = {"actor": "actor_optimizer", "critic": "critic_optimizer"}
 
     def _build(self) -> None:
         cfg, h = self.config, self.hybrid
@@ -187,17 +156,6 @@ class PADDPG(Algorithm):
         self._dense = {name: Dense.of(module.net) for name, module in self._modules().items()}
         self._soft_update = soft_updater(((self.actor_target, self.actor), (self.critic_target, self.critic)))
 
-    def _modules(self):
-        return {
-            "actor": self.actor,
-            "critic": self.critic,
-            "actor_target": self.actor_target,
-            "critic_target": self.critic_target,
-        }
-
-    def _optimizers(self):
-        return {"actor": self.actor_optimizer, "critic": self.critic_optimizer}
-
     def _act(self, obs, deterministic, mask=None):
         out = self.actor(obs).clamp(-1.0, 1.0)
         if not deterministic:  # one epsilon-greedy draw at the final exploration rate
@@ -211,11 +169,6 @@ class PADDPG(Algorithm):
             return out
         k = self.hybrid.n_actions
         return torch.cat([torch.where(mask, out[:, :k], -1.0), out[:, k:]], dim=-1)
-
-    def epsilon(self, step: int) -> float:
-        """The exploration rate after ``step`` samples: linear from epsilon_start to epsilon_end."""
-        cfg = self.config
-        return linear_epsilon(step, cfg.epsilon_start, cfg.epsilon_end, cfg.epsilon_steps)
 
     def _epsilon_greedy(self, out: torch.Tensor, eps: float) -> torch.Tensor:
         random = self.np_rng.random(len(out)) < eps
@@ -233,14 +186,9 @@ class PADDPG(Algorithm):
         a, x = self.actor.action(out, mask)
         return a, x, {"out": out.cpu().numpy()}
 
-    def _target_value(self, obs: np.ndarray, mask: np.ndarray | None) -> np.ndarray:
+    def _target_value(self, obs: torch.Tensor, mask: torch.Tensor | None) -> torch.Tensor:
         """``Q'(s, mu'(s))``, the bootstrap of a truncated episode's Monte-Carlo return."""
-        with torch.no_grad():
-            o, mask = self._from_numpy(obs), None if mask is None else self._from_numpy(mask)
-            return self.critic_target(o, self._masked(self.actor_target(o).clamp(-1.0, 1.0), mask)).cpu().numpy()
-
-    def _epoch_stats(self, step: int) -> dict[str, float]:
-        return {"train/epsilon": self.epsilon(step)}
+        return self.critic_target(obs, self._masked(self.actor_target(obs).clamp(-1.0, 1.0), mask))
 
     def _update(self) -> dict[str, float]:
         """One critic step on the mixed target and one actor step along the bounded ``dQ/dmu``, back-propagated

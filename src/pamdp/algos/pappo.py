@@ -27,50 +27,27 @@ clip bounds the change of the whole hierarchical policy, as PATRPO's KL does.
 from __future__ import annotations
 
 import dataclasses
-from typing import TYPE_CHECKING
 
 import numpy as np
 import torch
 
 from pamdp.algos.base import Algorithm
-from pamdp.algos.onpolicy import (
-    Rollout,
-    mask_tensor,
-    network_values,
-    pi_c_input_setting,
-    update_tensors,
-)
+from pamdp.algos.onpolicy import OnPolicyConfig, Rollout, hybrid_policy, mask_tensor, network_values, update_tensors
 from pamdp.algos.optim import descend
-from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
+from pamdp.algos.settings import NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, setting
 from pamdp.distributions import HybridDistribution, kl_divergence
-from pamdp.policies import ACTIVATIONS, HybridPolicy, ValueNetwork
-
-if TYPE_CHECKING:
-    from typing_extensions import Self
+from pamdp.policies import ValueNetwork
 
 __all__ = ["PAPPO", "PAPPOConfig", "clipped_surrogate", "ppo_loss"]
 
 
 @dataclasses.dataclass(frozen=True)
-class PAPPOConfig(AlgoConfig):
+class PAPPOConfig(OnPolicyConfig, AlgoConfig):
     """PAPPO's settings; the defaults are the common PPO ones (Schulman et al. 2017; CleanRL, Stable-Baselines3)
-    on PATRPO's hierarchical policy, with a separate value network trained in the same loss.
+    on PATRPO's hierarchical policy (:class:`~pamdp.algos.onpolicy.OnPolicyConfig`'s), with a separate value
+    network trained in the same loss.
     """
 
-    num_envs: int = setting(
-        64,
-        "Copies of the env stepped together; PAPPO's samples are on-policy, so more is just faster.",
-        at_least(1),
-    )
-    hidden_sizes: tuple[int, ...] = setting((64, 64), "Hidden layers of pi_d and pi_c (each its own network).", LAYERS)
-    activation: str = setting(
-        "tanh", "Hidden activation of the policies: tanh (PPO's usual), relu, leaky_relu or elu.", one_of(ACTIVATIONS)
-    )
-    init_log_std: float = setting(0.0, "Initial log-std of the parameter noise, in [-1, 1] units.")
-    pi_c_input: str = pi_c_input_setting()
-    batch_size: int = setting(
-        4096, "Samples per epoch, collected with the current policy before its update.", at_least(1)
-    )
     n_epochs: int = setting(
         10, "Passes over each batch; more reuse per sample, and more drift from pi_old.", at_least(1)
     )
@@ -86,10 +63,6 @@ class PAPPOConfig(AlgoConfig):
         0.2,
         "eps: the ratio pi / pi_old is clipped to [1 - eps, 1 + eps] in the surrogate; 0.1-0.3 is usual.",
         interval(0, 1, low_open=True, high_open=True),
-    )
-    gamma: float = setting(0.99, "Discount factor.", interval(0, 1))
-    gae_lambda: float = setting(
-        0.95, "GAE lambda: lower trades bias for less variance in the advantages.", interval(0, 1)
     )
     ent_coef_d: float = setting(
         0.01,
@@ -109,8 +82,6 @@ class PAPPOConfig(AlgoConfig):
         "Stop an epoch's passes once a minibatch's chain-rule KL(pi_old || pi) exceeds this (0: never; 0.01-0.05).",
         NON_NEGATIVE,
     )
-    normalize_advantages: bool = setting(True, "Standardise advantages within the batch.")
-    vf_hidden_sizes: tuple[int, ...] = setting((64, 64), "Hidden layers of the value network.", LAYERS)
 
     def __post_init__(self):
         """The checks across settings (each setting's own runs in AlgoConfig)."""
@@ -121,11 +92,9 @@ class PAPPOConfig(AlgoConfig):
             f"an integer in [1, batch_size={self.batch_size}]",
         )
 
-    @classmethod
-    def presets(cls) -> dict[str, Self]:
-        # "tuned": found by single probe runs on Platform (ent_coef_d's help says why; the record of its
-        # learning: benchmarks/later_platform.md)
-        return {"default": cls(), "tuned": cls(ent_coef_d=0.3, target_kl=0.02)}
+    # "tuned": found by single probe runs on Platform (ent_coef_d's help says why; the record of its
+    # learning: benchmarks/later_platform.md)
+    PRESETS = {"default": {}, "tuned": dict(ent_coef_d=0.3, target_kl=0.02)}
 
 
 def clipped_surrogate(logp: torch.Tensor, old_logp: torch.Tensor, adv: torch.Tensor, clip_range: float) -> torch.Tensor:
@@ -172,21 +141,15 @@ class PAPPO(Algorithm):
 
     config_class = PAPPOConfig
     config: PAPPOConfig
+    MODULES = ("policy", "value")
+    OPTIMIZERS = {"adam": "optimizer"}
 
     def _build(self) -> None:
         cfg = self.config
-        self.policy = HybridPolicy(
-            self.obs_dim, self.hybrid, cfg.hidden_sizes, cfg.activation, cfg.init_log_std, cfg.pi_c_input
-        )
+        self.policy = hybrid_policy(self)
         self.value = ValueNetwork(self.obs_dim, cfg.vf_hidden_sizes)
         self.optimizer = torch.optim.Adam([*self.policy.parameters(), *self.value.parameters()], lr=cfg.lr)
         self.loop = Rollout(self)  # a loaded model starts new episodes
-
-    def _modules(self):
-        return {"policy": self.policy, "value": self.value}
-
-    def _optimizers(self):
-        return {"adam": self.optimizer}
 
     def _act(self, obs, deterministic, mask=None):
         return self.policy.act(obs, mask, deterministic, self.torch_gen)

@@ -29,7 +29,6 @@ import copy
 import dataclasses
 import math
 from collections.abc import Callable
-from typing import TYPE_CHECKING
 
 import numpy as np
 import torch
@@ -42,19 +41,18 @@ from pamdp.algos.offpolicy import (
     OffPolicyConfig,
     OffPolicyLoop,
     Temperatures,
+    learning_starts_setting,
     shared_setting,
     soft_updater,
+    tau_setting,
     temperature_gradient,
     uniform_actions,
 )
 from pamdp.algos.optim import apply_gradients, descend
-from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
+from pamdp.algos.settings import NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
 from pamdp.distributions import LOG_STD_MAX, LOG_STD_MIN, masked_logits
-from pamdp.policies import ACTIVATIONS, every_action_linear, every_action_mlp, hierarchical_mlps, mlp
+from pamdp.policies import every_action_linear, every_action_mlp, hierarchical_mlps, mlp
 from pamdp.spaces import HybridActionSpace
-
-if TYPE_CHECKING:
-    from typing_extensions import Self
 
 __all__ = ["PASVG0", "PASVG0Config", "GumbelHybridPolicy", "expected_q", "gumbel_noise", "gumbel_softmax_sample"]
 
@@ -63,10 +61,10 @@ __all__ = ["PASVG0", "PASVG0Config", "GumbelHybridPolicy", "expected_q", "gumbel
 class PASVG0Config(OffPolicyConfig, AlgoConfig):
     """PASVG(0)'s settings; the defaults are the paper's preset (DDPG's where the paper says nothing)."""
 
-    hidden_sizes: tuple[int, ...] = setting(
-        (400, 300), "Hidden layers of pi_d, pi_c and the critic (paper: {400, 300}).", LAYERS
+    hidden_sizes: tuple[int, ...] = shared_setting(
+        "hidden_sizes", (400, 300), "pi_d, pi_c and the critic; paper: {400, 300}"
     )
-    activation: str = setting("relu", "Hidden activation: relu (paper), tanh, leaky_relu or elu.", one_of(ACTIVATIONS))
+    activation: str = shared_setting("activation", "relu", "paper: relu")
     temperature: float = setting(
         1.0, "Gumbel-Softmax temperature t (paper: 1.0, fixed); lower is less biased, higher less noisy.", POSITIVE
     )
@@ -123,15 +121,9 @@ class PASVG0Config(OffPolicyConfig, AlgoConfig):
         1e-5, "Adam learning rate of pi_d and pi_c (paper: 1e-5, which learns slowly).", POSITIVE
     )
     batch_size: int = shared_setting("batch_size", 64, "DDPG's 64; the paper does not say")
-    tau: float = setting(
-        0.001,
-        "Soft target-update rate (DDPG's 0.001): target <- tau * online + (1 - tau) * target.",
-        interval(0, 1, low_open=True),
-    )
+    tau: float = tau_setting(0.001, "DDPG's 0.001")
     buffer_size: int = shared_setting("buffer_size", 10_000_000, "paper: 10^7")
-    learning_starts: int = setting(
-        10_000, "Samples in the replay buffer before the first update (paper: 10^4).", at_least(0)
-    )
+    learning_starts: int = learning_starts_setting(10_000, "paper: 10^4")
 
     def __post_init__(self):
         """The checks across settings (each setting's own runs in AlgoConfig)."""
@@ -143,32 +135,30 @@ class PASVG0Config(OffPolicyConfig, AlgoConfig):
                 self.straight_through, "straight_through", "True with discrete_gradient 'expected' (Q sees one-hots)"
             )
 
-    @classmethod
-    def presets(cls) -> dict[str, Self]:
-        return {
-            "paper": cls(),
-            # Small networks, 64 batched env copies and a quarter of an update per sample; pi_d's gradient from
-            # the exact expectation over the K actions instead of the Gumbel-Softmax estimate; pi_d's entropy
-            # held at 0.3 nats (of ln 3 = 1.10) by a tuned weight; 5 % of the collected discrete actions
-            # uniform; a fixed parameter noise (std 0.2 before the Tanh). How each choice was reached, and what
-            # it fixed: benchmarks/pasvg_tuning.md.
-            "tuned": cls(
-                num_envs=64,
-                hidden_sizes=(128, 128),
-                discrete_gradient="expected",
-                init_log_std=-1.6,
-                learn_std=False,
-                policy_lr=1e-4,
-                entropy_coef=0.1,
-                target_entropy=0.3,
-                explore_epsilon=0.05,
-                tau=0.005,
-                batch_size=128,
-                updates_per_step=0.25,
-                learning_starts=5_000,
-                buffer_size=1_000_000,
-            ),
-        }
+    PRESETS = {
+        "paper": {},
+        # Small networks, 64 batched env copies and a quarter of an update per sample; pi_d's gradient from
+        # the exact expectation over the K actions instead of the Gumbel-Softmax estimate; pi_d's entropy
+        # held at 0.3 nats (of ln 3 = 1.10) by a tuned weight; 5 % of the collected discrete actions
+        # uniform; a fixed parameter noise (std 0.2 before the Tanh). How each choice was reached, and what
+        # it fixed: benchmarks/pasvg_tuning.md.
+        "tuned": dict(
+            num_envs=64,
+            hidden_sizes=(128, 128),
+            discrete_gradient="expected",
+            init_log_std=-1.6,
+            learn_std=False,
+            policy_lr=1e-4,
+            entropy_coef=0.1,
+            target_entropy=0.3,
+            explore_epsilon=0.05,
+            tau=0.005,
+            batch_size=128,
+            updates_per_step=0.25,
+            learning_starts=5_000,
+            buffer_size=1_000_000,
+        ),
+    }
 
 
 def gumbel_noise(shape: tuple[int, ...], generator: torch.Generator) -> torch.Tensor:
@@ -304,6 +294,9 @@ class PASVG0(Algorithm):
 
     config_class = PASVG0Config
     config: PASVG0Config
+    # entropy_weight with target_entropy only; critic2 and its target with twin_critics only
+    MODULES = ("policy", "critic", "policy_target", "critic_target", "entropy_weight", "critic2", "critic2_target")
+    OPTIMIZERS = {"policy": "policy_optimizer", "critic": "critic_optimizer", "entropy_weight": "entropy_optimizer"}
 
     def _build(self) -> None:
         cfg, h = self.config, self.hybrid
@@ -360,25 +353,6 @@ class PASVG0(Algorithm):
                 "pi_c": Dense.of(self.policy.pi_c),
                 "critic": Dense.of(self.critic.net),
             }
-
-    def _modules(self):
-        modules = {
-            "policy": self.policy,
-            "critic": self.critic,
-            "policy_target": self.policy_target,
-            "critic_target": self.critic_target,
-        }
-        if self.entropy_weight is not None:
-            modules["entropy_weight"] = self.entropy_weight
-        if self.critic2 is not None:
-            modules["critic2"], modules["critic2_target"] = self.critic2, self.critic2_target
-        return modules
-
-    def _optimizers(self):
-        optimizers = {"policy": self.policy_optimizer, "critic": self.critic_optimizer}
-        if self.entropy_optimizer is not None:
-            optimizers["entropy_weight"] = self.entropy_optimizer
-        return optimizers
 
     def _extra_state(self):
         return {"critic_updates": self.critic_updates}

@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Callable
-from typing import TYPE_CHECKING
 
 import numpy as np
 import torch
@@ -31,14 +30,15 @@ import torch
 from pamdp.algos.base import Algorithm
 from pamdp.algos.onpolicy import (
     LinearFeatureBaseline,
+    OnPolicyConfig,
     Rollout,
+    hybrid_policy,
     mask_tensor,
     network_values,
-    pi_c_input_setting,
     update_tensors,
 )
 from pamdp.algos.optim import descend
-from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, at_least, interval, one_of, setting
+from pamdp.algos.settings import NON_NEGATIVE, POSITIVE, AlgoConfig, at_least, interval, one_of, redeclared, setting
 from pamdp.algos.trpo import (
     FisherVectorProduct,
     backtracking_line_search,
@@ -47,10 +47,7 @@ from pamdp.algos.trpo import (
     hybrid_gauss_newton_fvp,
 )
 from pamdp.distributions import KL_ESTIMATORS, kl_divergence
-from pamdp.policies import ACTIVATIONS, HybridPolicy, ValueNetwork
-
-if TYPE_CHECKING:
-    from typing_extensions import Self
+from pamdp.policies import ValueNetwork
 
 __all__ = ["PATRPO", "PATRPOConfig"]
 
@@ -59,26 +56,17 @@ FVP_METHODS = ("auto", "gauss_newton", "double_backprop")
 
 
 @dataclasses.dataclass(frozen=True)
-class PATRPOConfig(AlgoConfig):
+class PATRPOConfig(OnPolicyConfig, AlgoConfig):
     """PATRPO's settings; the defaults are the paper's preset, rllab's TRPO settings where the paper is silent,
     and two modern choices that do not change the algorithm: an MLP value baseline (rllab's linear one is
     ``baseline="linear"``) and 128 env copies stepped together (samples per epoch are ``batch_size`` either way).
     """
 
-    num_envs: int = setting(
-        128, "Copies of the env stepped together; PATRPO's samples are on-policy, so more is just faster.", at_least(1)
-    )
-    hidden_sizes: tuple[int, ...] = setting(
-        (200, 100, 50), "Hidden layers of pi_d and pi_c (the paper's {200, 100, 50}).", LAYERS
-    )
-    activation: str = setting(
-        "relu", "Hidden activation of the policies: relu (paper), tanh, leaky_relu or elu.", one_of(ACTIVATIONS)
-    )
-    init_log_std: float = setting(0.0, "Initial log-std of the parameter noise, in [-1, 1] units (rllab: std 1).")
-    pi_c_input: str = pi_c_input_setting()
-    batch_size: int = setting(
-        10_000, "Samples per epoch (one TRPO update per epoch); the paper uses 10 000.", at_least(1)
-    )
+    num_envs: int = redeclared(OnPolicyConfig, "num_envs", 128)
+    hidden_sizes: tuple[int, ...] = redeclared(OnPolicyConfig, "hidden_sizes", (200, 100, 50), "paper: {200, 100, 50}")
+    activation: str = redeclared(OnPolicyConfig, "activation", "relu", "paper: relu")
+    init_log_std: float = redeclared(OnPolicyConfig, "init_log_std", 0.0, "rllab: std 1")
+    batch_size: int = redeclared(OnPolicyConfig, "batch_size", 10_000, "one TRPO update; the paper: 10 000")
     delta: float = setting(
         0.005,
         "Trust region: the bound on the mean KL(pi_old || pi). Paper: 0.005 (0.01, 0.05 in its step-size figure).",
@@ -111,22 +99,19 @@ class PATRPOConfig(AlgoConfig):
     max_backtracks: int = setting(
         15, "Line-search tries before the update is abandoned (parameters restored).", at_least(1)
     )
-    gamma: float = setting(0.99, "Discount factor.", interval(0, 1))
-    gae_lambda: float = setting(
-        1.0, "GAE lambda: 1.0 is rllab's (Monte-Carlo advantages); 0.95-0.99 lowers variance.", interval(0, 1)
+    gae_lambda: float = redeclared(
+        OnPolicyConfig, "gae_lambda", 1.0, "rllab: 1.0, Monte-Carlo advantages; 0.95-0.99 lowers variance"
     )
     entropy_coef: float = setting(
         0.0,
         "Weight of the policy entropy added to the surrogate (not in the paper); keeps exploring longer.",
         NON_NEGATIVE,
     )
-    normalize_advantages: bool = setting(True, "Standardise advantages within the batch.")
     baseline: str = setting(
         "mlp",
         "Baseline: mlp (a value network, the modern choice) or linear (rllab's linear-feature baseline).",
         one_of(("mlp", "linear")),
     )
-    vf_hidden_sizes: tuple[int, ...] = setting((64, 64), "Hidden layers of the value network.", LAYERS)
     vf_lr: float = setting(1e-3, "Adam learning rate of the value network.", POSITIVE)
     vf_epochs: int = setting(5, "Passes over each batch when fitting the value network.", at_least(1))
     vf_batch_size: int = setting(256, "Minibatch size of the value network's fit.", at_least(1))
@@ -140,19 +125,17 @@ class PATRPOConfig(AlgoConfig):
             "auto or double_backprop with kl_estimator='joint_sample' (its Hessian has no closed form)",
         )
 
-    @classmethod
-    def presets(cls) -> dict[str, Self]:
-        return {
-            "paper": cls(),
-            "tuned": cls(
-                delta=0.02,
-                gae_lambda=0.97,
-                batch_size=5_000,
-                init_log_std=-0.5,
-                entropy_coef=0.01,
-                fvp_subsample=0.2,
-            ),
-        }
+    PRESETS = {
+        "paper": {},
+        "tuned": dict(
+            delta=0.02,
+            gae_lambda=0.97,
+            batch_size=5_000,
+            init_log_std=-0.5,
+            entropy_coef=0.01,
+            fvp_subsample=0.2,
+        ),
+    }
 
 
 class PATRPO(Algorithm):
@@ -160,12 +143,12 @@ class PATRPO(Algorithm):
 
     config_class = PATRPOConfig
     config: PATRPOConfig
+    MODULES = ("policy", "value")  # the value network and its optimiser with baseline="mlp" only
+    OPTIMIZERS = {"value": "vf_optimizer"}
 
     def _build(self) -> None:
         cfg = self.config
-        self.policy = HybridPolicy(
-            self.obs_dim, self.hybrid, cfg.hidden_sizes, cfg.activation, cfg.init_log_std, cfg.pi_c_input
-        )
+        self.policy = hybrid_policy(self)
         if cfg.baseline == "mlp":
             self.value = ValueNetwork(self.obs_dim, cfg.vf_hidden_sizes)
             self._vf_params = list(self.value.parameters())
@@ -173,12 +156,6 @@ class PATRPO(Algorithm):
         else:
             self.linear_baseline = LinearFeatureBaseline(self.obs_dim)
         self.loop = Rollout(self)  # a loaded model starts new episodes
-
-    def _modules(self):
-        return {"policy": self.policy, **({"value": self.value} if self.config.baseline == "mlp" else {})}
-
-    def _optimizers(self):
-        return {"value": self.vf_optimizer} if self.config.baseline == "mlp" else {}
 
     def _extra_state(self):
         if self.config.baseline == "linear":
@@ -229,16 +206,8 @@ class PATRPO(Algorithm):
             "train/param_std": float(self.policy.log_std.detach().exp()[self.policy.mask].mean()),
         }
         if not (np.isfinite(shs) and shs > 0):  # no direction (a vanishing gradient): no step, no line search
-            stats.update(
-                {
-                    "train/update_skipped": 1.0,
-                    "train/line_search_success": 0.0,
-                    "train/backtracks": 0.0,
-                    "losses/surrogate_improvement": 0.0,
-                    "train/kl": 0.0,
-                }
-            )
-            return stats
+            nothing = ("train/line_search_success", "train/backtracks", "losses/surrogate_improvement", "train/kl")
+            return {**stats, "train/update_skipped": 1.0, **dict.fromkeys(nothing, 0.0)}
         full_step = np.sqrt(2.0 * cfg.delta / shs) * direction
         result = backtracking_line_search(
             params, full_step, evaluate, float(objective.detach()), cfg.delta, cfg.backtrack_ratio, cfg.max_backtracks

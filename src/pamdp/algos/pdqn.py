@@ -32,7 +32,6 @@ from __future__ import annotations
 import copy
 import dataclasses
 import math
-from typing import TYPE_CHECKING
 
 import numpy as np
 import torch
@@ -41,41 +40,35 @@ from torch import nn
 
 from pamdp.algos.base import Algorithm
 from pamdp.algos.offpolicy import (
-    BOUNDS,
+    DeterministicActorConfig,
+    EpsilonSchedule,
     OffPolicyConfig,
     OffPolicyLoop,
     OUNoise,
     backprop_actor,
-    linear_epsilon,
+    learning_starts_setting,
     mixed_target,
     shared_setting,
     soft_updater,
+    tau_setting,
     uniform_actions,
 )
 from pamdp.algos.optim import apply_gradients, descend
 from pamdp.algos.settings import (
-    LAYERS,
-    NON_NEGATIVE,
     POSITIVE,
     AlgoConfig,
     Check,
-    at_least,
-    interval,
-    one_of,
     setting,
 )
 from pamdp.distributions import masked_logits
-from pamdp.policies import ACTIVATIONS, in_chunks, mlp
+from pamdp.policies import in_chunks, mlp
 from pamdp.spaces import HybridActionSpace
-
-if TYPE_CHECKING:
-    from typing_extensions import Self
 
 __all__ = ["PDQN", "PDQNConfig", "ParamActor", "QNetwork", "param_blocks"]
 
 
 @dataclasses.dataclass(frozen=True)
-class PDQNConfig(OffPolicyConfig, AlgoConfig):
+class PDQNConfig(DeterministicActorConfig, OffPolicyConfig, AlgoConfig):
     """P-DQN's and MP-DQN's settings. The defaults are the ``paper`` preset: Bester et al.'s Platform settings,
     recalled from their paper rather than checked against its text (provisional); values it does not give are
     marked as assumptions in the help."""
@@ -83,14 +76,8 @@ class PDQNConfig(OffPolicyConfig, AlgoConfig):
     multi_pass: bool = setting(
         False, "MP-DQN: Q_k from a pass that sees only action k's parameters; false: P-DQN's joint input."
     )
-    hidden_sizes: tuple[int, ...] = setting(
-        (128,), "Hidden layers of the actor and the Q-network (Bester et al. on Platform: one layer of 128).", LAYERS
-    )
-    activation: str = setting("relu", "Hidden activation: relu, leaky_relu, tanh or elu.", one_of(ACTIVATIONS))
-    bound: str = setting(
-        "invert",
-        "Keeping parameters in [-1, 1]: invert (inverting gradients, Bester et al.), squash (Tanh) or zero.",
-        one_of(BOUNDS),
+    hidden_sizes: tuple[int, ...] = shared_setting(
+        "hidden_sizes", (128,), "Bester et al. on Platform: one layer of 128"
     )
     param_passthrough: tuple[float, ...] = setting(
         (),
@@ -111,46 +98,21 @@ class PDQNConfig(OffPolicyConfig, AlgoConfig):
     grad_clip: float = shared_setting("grad_clip", 10.0, "assumed: 10")
     batch_size: int = shared_setting("batch_size", 128, "Bester et al.: 128")
     gamma: float = shared_setting("gamma", 0.9, "Bester et al. on Platform: 0.9")
-    tau_q: float = setting(
-        0.1, "Soft target-update rate of the Q-network (Bester et al.: 0.1).", interval(0, 1, low_open=True)
-    )
-    tau_actor: float = setting(
-        0.001, "Soft target-update rate of the actor (Bester et al.: 0.001).", interval(0, 1, low_open=True)
-    )
-    beta: float = setting(
-        0.0,
-        "Weight of the Monte-Carlo return in the Q target, as PADDPG's; 0 (Platform) is the one-step TD target.",
-        interval(0, 1),
-    )
-    epsilon_start: float = setting(
-        1.0, "Exploration rate at the start: the chance of a uniformly random action.", interval(0, 1)
-    )
-    epsilon_end: float = setting(0.01, "Exploration rate after the annealing (Bester et al.: 0.01).", interval(0, 1))
-    epsilon_steps: int = setting(
-        5_000,
-        "Environment samples over which epsilon falls linearly to epsilon_end (Bester et al.: 1000 episodes; "
-        "Platform's early episodes last 2 to 5 steps).",
-        at_least(1),
+    tau_q: float = tau_setting(0.1, "of the Q-network; Bester et al.: 0.1")
+    tau_actor: float = tau_setting(0.001, "of the actor; Bester et al.: 0.001")
+    beta: float = shared_setting("beta", 0.0, "0 on Platform")
+    epsilon_end: float = shared_setting("epsilon_end", 0.01, "Bester et al.: 0.01")
+    epsilon_steps: int = shared_setting(
+        "epsilon_steps", 5_000, "Bester et al.: 1000 episodes; Platform's early episodes last 2 to 5 steps"
     )
     explore_params: bool = setting(
         False,
         "With an epsilon draw, also draw that action's parameters uniformly in [-1, 1] (Xiong et al.); false "
         "keeps the actor's, noise included (assumed for Bester et al.).",
     )
-    ou_sigma: float = setting(
-        0.0001,
-        "Scale of Ornstein-Uhlenbeck noise on the parameters, in [-1, 1] units (Bester et al.: 1e-4); 0: off.",
-        NON_NEGATIVE,
-    )
-    ou_theta: float = setting(
-        0.15,
-        "Mean reversion of the Ornstein-Uhlenbeck noise; 1 gives i.i.d. Gaussian noise.",
-        interval(0, 1, low_open=True),
-    )
+    ou_sigma: float = shared_setting("ou_sigma", 0.0001, "Bester et al.: 1e-4")
     buffer_size: int = shared_setting("buffer_size", 10_000, "Bester et al. on Platform: 10 000")
-    learning_starts: int = setting(
-        500, "Samples in the replay buffer before the first update (assumed: 500).", at_least(0)
-    )
+    learning_starts: int = learning_starts_setting(500, "assumed: 500")
 
     def __post_init__(self):
         super().__post_init__()
@@ -162,24 +124,22 @@ class PDQNConfig(OffPolicyConfig, AlgoConfig):
                 "or no passthrough"
             )
 
-    @classmethod
-    def presets(cls) -> dict[str, Self]:
-        # "paper": Bester et al.'s text as recalled here (not re-read; never their code); grad_clip, learning_starts,
-        # explore_params and the conversion of 1000 episodes to 5 000 samples are assumptions (see the help).
-        # "tuned": the same learning rates and targets with a smaller Q-network and batch, 64 batched env copies
-        # and a quarter of an update per sample (how it learns: benchmarks/later_platform.md).
-        return {
-            "paper": cls(),
-            "tuned": cls(
-                num_envs=64,
-                hidden_sizes=(64,),
-                batch_size=64,
-                updates_per_step=0.25,
-                epsilon_steps=10_000,
-                learning_starts=1_000,
-                buffer_size=20_000,
-            ),
-        }
+    # "paper": Bester et al.'s text as recalled here (not re-read; never their code); grad_clip, learning_starts,
+    # explore_params and the conversion of 1000 episodes to 5 000 samples are assumptions (see the help).
+    # "tuned": the same learning rates and targets with a smaller Q-network and batch, 64 batched env copies
+    # and a quarter of an update per sample (how it learns: benchmarks/later_platform.md).
+    PRESETS = {
+        "paper": {},
+        "tuned": dict(
+            num_envs=64,
+            hidden_sizes=(64,),
+            batch_size=64,
+            updates_per_step=0.25,
+            epsilon_steps=10_000,
+            learning_starts=1_000,
+            buffer_size=20_000,
+        ),
+    }
 
 
 def param_blocks(hybrid: HybridActionSpace) -> np.ndarray:
@@ -275,11 +235,13 @@ class QNetwork(nn.Module):
         super()._load_from_state_dict(state_dict, prefix, *args, **kwargs)
 
 
-class PDQN(Algorithm):
+class PDQN(EpsilonSchedule, Algorithm):
     """P-DQN (Xiong et al. 2018) and, with ``multi_pass``, MP-DQN (Bester et al. 2019). See :class:`PDQNConfig`."""
 
     config_class = PDQNConfig
     config: PDQNConfig
+    MODULES = ("actor", "q_net", "actor_target", "q_target")
+    OPTIMIZERS = {"actor": "actor_optimizer", "q_net": "q_optimizer"}
 
     def _build(self) -> None:
         cfg, h = self.config, self.hybrid
@@ -298,17 +260,11 @@ class PDQN(Algorithm):
         self.loop = OffPolicyLoop(
             self,
             mc_returns=cfg.beta > 0,
-            tail_value=self._target_value,
+            tail_value=self._next_value,
             params=((h.total_param_size,), np.float32),  # every action's, after exploration: what Q learns on
         )
         self.replay = self.loop.buffer
         self._ou = OUNoise(cfg.ou_theta, cfg.ou_sigma)
-
-    def _modules(self):
-        return {"actor": self.actor, "q_net": self.q_net, "actor_target": self.actor_target, "q_target": self.q_target}
-
-    def _optimizers(self):
-        return {"actor": self.actor_optimizer, "q_net": self.q_optimizer}
 
     # -- acting ----------------------------------------------------------------------------------
     def _act(self, obs, deterministic, mask=None):
@@ -317,11 +273,6 @@ class PDQN(Algorithm):
         if not deterministic:  # one epsilon-greedy draw at the final exploration rate
             a, params = self._epsilon_greedy(a, params, self.config.epsilon_end, mask)
         return a, self.actor.select(params, a)
-
-    def epsilon(self, step: int) -> float:
-        """The exploration rate after ``step`` samples: linear from epsilon_start to epsilon_end."""
-        cfg = self.config
-        return linear_epsilon(step, cfg.epsilon_start, cfg.epsilon_end, cfg.epsilon_steps)
 
     def _epsilon_greedy(self, a: torch.Tensor, params: torch.Tensor, eps: float, mask: torch.Tensor | None):
         """With probability ``eps`` a uniform discrete action among the allowed (with ``explore_params``, uniform
@@ -343,21 +294,12 @@ class PDQN(Algorithm):
         a, params = self._epsilon_greedy(a, params.clamp(-1.0, 1.0), self.epsilon(step), mask)
         return a, self.actor.select(params, a), {"params": params.cpu().numpy()}
 
-    def _target_value(self, obs: np.ndarray, mask: np.ndarray | None) -> np.ndarray:
-        """``max_k Q'_k(s, x'(s))`` over the allowed ``k``, the bootstrap of a truncated episode's Monte-Carlo
-        return."""
-        with torch.no_grad():
-            o = self._from_numpy(obs)
-            return self._next_value(o, None if mask is None else self._from_numpy(mask)).cpu().numpy()
-
     def _next_value(self, obs: torch.Tensor, mask: torch.Tensor | None) -> torch.Tensor:
-        """``max_k Q'_k(s, x'(s))`` of the target networks, over the actions ``mask`` allows."""
+        """``max_k Q'_k(s, x'(s))`` of the target networks, over the actions ``mask`` allows: the TD target's
+        bootstrap, and a truncated episode's Monte-Carlo return's."""
         return masked_logits(self.q_target(obs, self.actor_target(obs).clamp(-1.0, 1.0)), mask).max(-1).values
 
     # -- learning --------------------------------------------------------------------------------
-    def _epoch_stats(self, step: int) -> dict[str, float]:
-        return {"train/epsilon": self.epsilon(step)}
-
     def _update(self) -> dict[str, float]:
         """One TD step of the Q-network, one actor step along the bounded ``d sum_k Q_k / dx``, soft target updates."""
         cfg = self.config

@@ -28,6 +28,7 @@ if TYPE_CHECKING:
 __all__ = [
     "AlgoConfig",
     "setting",
+    "redeclared",
     "Check",
     "at_least",
     "interval",
@@ -95,9 +96,18 @@ def setting(default: Any, help: str, check: Check | None = None) -> Any:
     return dataclasses.field(default=default, metadata={"help": help, "check": check})
 
 
+def redeclared(base: type, name: str, default: Any, source: str | None = None) -> Any:
+    """Setting ``name`` of the family config ``base`` declared again with an algorithm's own ``default``, with the
+    help and the check written there; ``source`` says where the value comes from and joins the help ("Transitions
+    per gradient update (Hausknecht & Stone: 32).")."""
+    meta = base.__dataclass_fields__[name].metadata
+    help = meta["help"] if source is None else f"{meta['help'].rstrip('.')} ({source})."
+    return setting(default, help, meta["check"])
+
+
 @dataclasses.dataclass(frozen=True)
 class AlgoConfig:
-    """Settings every algorithm has. Subclasses add their own and a ``presets()`` table."""
+    """Settings every algorithm has. Subclasses add their own and a :attr:`PRESETS` table."""
 
     seed: int = setting(0, "Seeds the networks' initialisation, action sampling and the environments.", at_least(0))
     num_envs: int = setting(
@@ -159,10 +169,13 @@ class AlgoConfig:
         if not ok:
             raise ValueError(f"{type(self).__name__}.{name} = {getattr(self, name)!r}; expected {expected}")
 
+    PRESETS: typing.ClassVar[dict[str, dict[str, Any]]] = {"default": {}}
+    """A subclass's presets as the settings each changes from the defaults; :meth:`presets` makes them."""
+
     @classmethod
     def presets(cls) -> dict[str, Self]:
         """Named settings, e.g. ``"paper"``; the first one is the default."""
-        return {"default": cls()}
+        return {name: cls(**changes) for name, changes in cls.PRESETS.items()}
 
     @classmethod
     def preset(cls, name: str, env_id: str | None = None, env_kwargs: dict | None = None) -> Self:
