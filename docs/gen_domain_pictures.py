@@ -1,8 +1,9 @@
 """Draw one frame of each registered domain for the documentation's domain pages (``docs/domains/img/*.png``).
 
-Each env is made with ``render_mode="rgb_array"``, reset with seed 0 and stepped a few times with seeded random
-actions, so that the picture shows the domain in play rather than its start; ``render()`` gives the frame. Run
-from the repository root after changing an env's drawing: ``python docs/gen_domain_pictures.py``.
+Each env is made with ``render_mode="rgb_array"`` and stepped with seeded random actions, so that the picture
+shows the domain in play rather than its start: the first seed whose episode lasts the domain's number of steps
+gives the frame (``render()``) after them; random actions end many episodes at once (a fall, a shot). Run from
+the repository root after changing an env's drawing: ``python docs/gen_domain_pictures.py``.
 """
 
 from pathlib import Path
@@ -16,40 +17,48 @@ import matplotlib.image  # noqa: E402
 import pamdp  # noqa: E402, F401  (registers the envs)
 
 OUT = Path(__file__).parent / "domains" / "img"
-STEPS = 5  # a few steps in: the agent has moved, the episode is not over yet on any domain
+SEEDS = 100
 
-# page name -> (env id, env kwargs)
+# page name -> (env id, env kwargs, steps before the picture: enough for the agent to have moved visibly)
 DOMAINS = {
-    "platform": ("pamdp/Platform-v0", {}),
-    "half-field-offense": ("pamdp/HalfFieldOffense-v0", {}),
-    "goal": ("pamdp/Goal-v0", {}),
-    "hard-goal": ("pamdp/HardGoal-v0", {}),
-    "catch-point": ("pamdp/CatchPoint-v0", {}),
-    "hard-move": ("pamdp/HardMove-v0", {}),
-    "moving": ("pamdp/Moving-v0", {}),
-    "sliding": ("pamdp/Sliding-v0", {}),
+    "platform": ("pamdp/Platform-v0", {}, 2),
+    "half-field-offense": ("pamdp/HalfFieldOffense-v0", {}, 20),
+    "goal": ("pamdp/Goal-v0", {}, 2),
+    "hard-goal": ("pamdp/HardGoal-v0", {}, 2),
+    "catch-point": ("pamdp/CatchPoint-v0", {}, 5),
+    "hard-move": ("pamdp/HardMove-v0", {}, 5),
+    "moving": ("pamdp/Moving-v0", {}, 60),
+    "sliding": ("pamdp/Sliding-v0", {}, 60),
 }
 
 
-def picture(env_id: str, kwargs: dict):
+def picture(env_id: str, kwargs: dict, steps: int):
+    """The frame after ``steps`` random actions of the first seed whose episode lasts that long, else the last
+    frame of the longest episode."""
     env = gymnasium.make(env_id, render_mode="rgb_array", **kwargs)
-    env.reset(seed=0)
-    env.action_space.seed(0)
-    frame = env.render()
-    for _ in range(STEPS):
-        _, _, terminated, truncated, _ = env.step(env.action_space.sample())
-        if terminated or truncated:
+    best, best_len = None, -1
+    for seed in range(SEEDS):
+        env.reset(seed=seed)
+        env.action_space.seed(seed)
+        frame, length = env.render(), 0
+        while length < steps:
+            _, _, terminated, truncated, _ = env.step(env.action_space.sample())
+            if terminated or truncated:
+                break
+            frame, length = env.render(), length + 1
+        if length > best_len:
+            best, best_len = frame, length
+        if length == steps:
             break
-        frame = env.render()
     env.close()
-    return frame
+    return best
 
 
 def main():
     OUT.mkdir(parents=True, exist_ok=True)
-    for name, (env_id, kwargs) in DOMAINS.items():
+    for name, (env_id, kwargs, steps) in DOMAINS.items():
         path = OUT / f"{name}.png"
-        matplotlib.image.imsave(path, picture(env_id, kwargs))
+        matplotlib.image.imsave(path, picture(env_id, kwargs, steps))
         print(f"{path}: {path.stat().st_size // 1024} KB")
 
 

@@ -103,7 +103,7 @@ def _domain_pictures():
 def test_every_domain_has_a_page_with_its_picture():
     domains = _domain_pictures()
     registered = {env_id for env_id in gymnasium.registry if env_id.startswith("pamdp/")}
-    assert {env_id for env_id, _ in domains.values()} == registered
+    assert {env_id for env_id, *_ in domains.values()} == registered
     mkdocs = (ROOT / "mkdocs.yml").read_text()
     for name in domains:
         page = ROOT / "docs" / "domains" / f"{name}.md"
