@@ -28,8 +28,9 @@ def test_installed_metadata_matches_the_source():
     """What pip installed (the version, the licence) is what the source declares; a mismatch means metadata
     from an older install: reinstall with `pip install -e .`."""
     dist = importlib.metadata.distribution("pamdp")
-    assert dist.version == pamdp.__version__
-    assert dist.metadata["License-Expression"] == PYPROJECT["license"] == "MIT"
+    stale = f"metadata of an older install at {dist.locate_file('')}: run `pip install -e .`"
+    assert dist.version == pamdp.__version__, stale
+    assert dist.metadata["License-Expression"] == PYPROJECT["license"] == "MIT", stale
 
 
 def test_licence_file_is_the_declared_licence():
