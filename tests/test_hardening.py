@@ -138,7 +138,10 @@ def test_evaluate_seeds_its_env_as_train_does_unless_told(trained, capsys):
     [
         ({"deterministic": "no"}, "argument deterministic = 'no'; expected bool"),
         ({"profile": 2016}, "argument profile = 2016; expected str"),
-        ({"deterministc": True}, "takes no argument 'deterministc'; expected some of body_reset, defense_npcs, deterministic"),
+        (
+            {"deterministc": True},
+            "takes no argument 'deterministc'; expected some of body_reset, defense_npcs, deterministic",
+        ),
     ],
 )
 def test_env_arguments_of_the_wrong_name_or_type_are_refused(kwargs, expected, tmp_path, capsys):
