@@ -23,6 +23,7 @@ SEEDS = 100
 DOMAINS = {
     "platform": ("pamdp/Platform-v0", {}, 2),
     "half-field-offense": ("pamdp/HalfFieldOffense-v0", {}, 20),
+    "half-field-offense-goalie": ("pamdp/HalfFieldOffenseGoalie-v0", {}, 20),
     "goal": ("pamdp/Goal-v0", {}, 2),
     "hard-goal": ("pamdp/HardGoal-v0", {}, 2),
     "catch-point": ("pamdp/CatchPoint-v0", {}, 5),
