@@ -14,8 +14,8 @@ import inspect
 import gymnasium
 import numpy as np
 
-from pamdp.envs.streams import RandomStreams
-from pamdp.envs.vector import Domain, DomainVectorEnv, check_render_mode
+from pamdp.envs.streams import RandomStreams, check_seed
+from pamdp.envs.vector import Domain, DomainVectorEnv, build_domain, check_options, check_render_mode
 
 __all__ = ["DomainEnv", "as_batch", "env_classes"]
 
@@ -58,7 +58,7 @@ class DomainEnv(gymnasium.Env):
     """The domain's hooks see the scalar env as a batched one of one copy."""
 
     def __init__(self, render_mode: str | None = None, **variant):
-        self.domain = domain = self.domain_class(**{**self.variant, **variant})
+        self.domain = domain = build_domain(self.domain_class, {**self.variant, **variant})
         check_render_mode(render_mode, self.metadata["render_modes"])
         self.metadata = {**self.metadata, "render_fps": domain.render_fps}
         self.render_mode = render_mode
@@ -82,6 +82,8 @@ class DomainEnv(gymnasium.Env):
         return {k: v[0] for k, v in view.items()} if isinstance(view, dict) else view[0]
 
     def reset(self, *, seed: int | None = None, options: dict | None = None):
+        check_seed(seed)
+        check_options(self.domain, options, 1)
         super().reset(seed=seed)
         self.streams.follow(0, self.np_random)
         if self.domain.reset_draws:
