@@ -218,3 +218,34 @@ def test_a_bad_seed_is_pamdps_value_error_and_a_bad_entry_reseeds_no_copy(env_id
             venv.reset(seed=seed)
     assert env.unwrapped.np_random.bit_generator.state == draws
     assert venv.np_randoms == generators and [g.bit_generator.state for g in venv.np_randoms] == vdraws
+
+
+@pytest.mark.parametrize("env_id, kwargs", CASES, ids=IDS)
+def test_a_refused_reset_keeps_the_step_count_and_the_episode_truncates_at_the_limit(env_id, kwargs):
+    """The envs count their own time limit (no Gymnasium ``TimeLimit``, which zeroes its count before the env can
+    refuse the reset): steps, a refused reset, and the episode still ends at the limit counted from its start."""
+    scalar = entry_of(gymnasium.spec(env_id).entry_point)
+    made = gymnasium.make(env_id, **kwargs)
+    assert not any(isinstance(w, gymnasium.wrappers.TimeLimit) for w in wrappers_of(made))
+    for env in (scalar(max_episode_steps=4, **gymnasium.spec(env_id).kwargs, **kwargs), made):
+        limit = env.unwrapped.max_episode_steps
+        if limit is None:
+            continue
+        env.reset(seed=3)
+        env.action_space.seed(3)
+        for t in range(1, limit + 1):
+            if t == 2:
+                with pytest.raises(ValueError):
+                    env.reset(options={"no such option": 1})
+                with pytest.raises(ValueError):
+                    env.reset(seed="x")
+            _, _, terminated, truncated, _ = env.step(env.action_space.sample())
+            if terminated:
+                break
+            assert truncated == (t == limit), f"t={t}, limit={limit}"
+
+
+def wrappers_of(env):
+    while isinstance(env, gymnasium.Wrapper):
+        yield env
+        env = env.env

@@ -34,7 +34,16 @@ from gymnasium.vector.utils import batch_space
 
 from pamdp.envs.streams import RandomStreams, copy_seeds
 
-__all__ = ["Domain", "DomainVectorEnv", "build_domain", "check_options", "check_render_mode", "split_actions", "column"]
+__all__ = [
+    "Domain",
+    "DomainVectorEnv",
+    "build_domain",
+    "check_options",
+    "check_render_mode",
+    "time_limit",
+    "split_actions",
+    "column",
+]
 
 _TYPES = {bool: (bool, np.bool_), int: (int, np.integer), float: (int, float, np.integer, np.floating), str: (str,)}
 """What a value of a domain argument annotated with the key may be (``bool`` nowhere but under ``bool``)."""
@@ -57,6 +66,20 @@ def build_domain(domain_class: type[Domain], variant: dict) -> Domain:
         if isinstance(value, (bool, np.bool_)) and hints[name] is not bool or not isinstance(value, kinds):
             raise ValueError(f"{domain_class.name} argument {name}={value!r}; expected {hints[name].__name__}")
     return domain_class(**variant)
+
+
+def time_limit(max_episode_steps, domain: Domain) -> int | None:
+    """The shells' ``max_episode_steps`` argument checked: ``"domain"`` (the domain's limit), None or a positive
+    integer."""
+    if max_episode_steps == "domain":
+        return domain.max_episode_steps
+    if max_episode_steps is not None and (
+        isinstance(max_episode_steps, bool)
+        or not isinstance(max_episode_steps, (int, np.integer))
+        or max_episode_steps < 1
+    ):
+        raise ValueError(f"max_episode_steps must be a positive integer or None, got {max_episode_steps!r}")
+    return max_episode_steps
 
 
 def check_options(domain: Domain, options, n: int, shell_keys: tuple[str, ...] = ()) -> None:
@@ -212,14 +235,7 @@ class DomainVectorEnv(VectorEnv):
         if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) or num_envs < 1:
             raise ValueError(f"num_envs must be a positive integer, got {num_envs!r}")
         self.domain = domain = build_domain(self.domain_class, {**self.variant, **variant})
-        if max_episode_steps == "domain":
-            max_episode_steps = domain.max_episode_steps
-        if max_episode_steps is not None and (
-            isinstance(max_episode_steps, bool)
-            or not isinstance(max_episode_steps, (int, np.integer))
-            or max_episode_steps < 1
-        ):
-            raise ValueError(f"max_episode_steps must be a positive integer or None, got {max_episode_steps!r}")
+        max_episode_steps = time_limit(max_episode_steps, domain)
         check_render_mode(render_mode, self.metadata["render_modes"])
         self.metadata = {**self.metadata, "render_fps": domain.render_fps}
         self.num_envs = int(num_envs)
