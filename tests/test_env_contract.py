@@ -249,3 +249,32 @@ def wrappers_of(env):
     while isinstance(env, gymnasium.Wrapper):
         yield env
         env = env.env
+
+
+def unused_nan_cases():
+    """(env_id, kwargs, action k, box j) for every box j that action k does not use: all boxes but k's own where each
+    action has its box, every box for a parameterless action."""
+    for env_id, kwargs in CASES:
+        space = gymnasium.make(env_id, **kwargs).action_space
+        for k in range(min(space[0].n, 4)):
+            for j, box in enumerate(space[1][:4]):
+                if j != k and box.shape != (0,):
+                    marks = ()
+                    if env_id == "pamdp/HardMove-v0":
+                        marks = pytest.mark.xfail(
+                            strict=True, reason="Hard Move reads only the chosen of its 2**n boxes (O(K) otherwise)"
+                        )
+                    yield pytest.param(env_id, kwargs, k, j, marks=marks, id=f"{env_id[6:]}-{kwargs}-a{k}-p{j}")
+
+
+@pytest.mark.parametrize("env_id, kwargs, k, j", list(unused_nan_cases()))
+def test_a_nan_in_an_unused_parameter_is_refused_on_every_domain(env_id, kwargs, k, j):
+    """The rule: every parameter of an action must be finite, used or not (a NaN anywhere is a bug upstream)."""
+    env = gymnasium.make(env_id, **kwargs).unwrapped
+    env.reset(seed=0)
+    before = env._states.copy()
+    params = [((box.low + box.high) / 2).astype(box.dtype) for box in env.action_space[1]]
+    params[j] = np.full(params[j].shape, np.nan, params[j].dtype)
+    with pytest.raises(ValueError, match="finite"):
+        env.step((k, tuple(params)))
+    np.testing.assert_array_equal(env._states, before)
