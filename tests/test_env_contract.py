@@ -278,3 +278,15 @@ def test_a_nan_in_an_unused_parameter_is_refused_on_every_domain(env_id, kwargs,
     with pytest.raises(ValueError, match="finite"):
         env.step((k, tuple(params)))
     np.testing.assert_array_equal(env._states, before)
+
+
+@pytest.mark.parametrize("env_id", ["pamdp/HalfFieldOffense-v0", "pamdp/HalfFieldOffenseGoalie-v0"])
+def test_hfos_option_values_are_checked_before_any_copy_is_reseeded(env_id):
+    venv = make_vec(env_id, {}, 2)
+    venv.reset(seed=1)
+    vdraws = [g.bit_generator.state for g in venv.np_randoms]
+    with pytest.raises(ValueError, match="reset option ball"):
+        venv.reset(seed=[5, 6], options={"ball": (99.0, 0.0)})
+    assert [g.bit_generator.state for g in venv.np_randoms] == vdraws
+    obs, _ = venv.reset(options={"ball": (10.0, 0.0), "body": 0.0})  # the replay options still work
+    assert obs.shape[0] == 2
