@@ -113,9 +113,11 @@ def test_passes_gymnasiums_env_checker_and_its_spaces_are_the_specs(n):
 
 @pytest.mark.parametrize("n", [5, 0, 12, True, 4.0, "4"])
 def test_bad_actuator_counts_are_refused(n):
-    with pytest.raises(ValueError, match=r"expected one of \(4, 6, 8, 10\) actuators"):
+    # a value of another type than n's int is refused by the shell, one of the wrong size by Hard Move
+    expected = r"expected one of \(4, 6, 8, 10\) actuators|argument n=.*; expected int"
+    with pytest.raises(ValueError, match=expected):
         HardMoveEnv(n=n)
-    with pytest.raises(ValueError, match=r"expected one of \(4, 6, 8, 10\) actuators"):
+    with pytest.raises(ValueError, match=expected):
         gymnasium.make_vec("pamdp/HardMove-v0", num_envs=2, vectorization_mode="vector_entry_point", n=n)
 
 

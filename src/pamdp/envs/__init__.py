@@ -22,7 +22,6 @@ _REGISTRATIONS = {
     "pamdp/Platform-v0": dict(
         entry_point="pamdp.envs.platform.env:PlatformEnv",
         vector_entry_point="pamdp.envs.platform.env:PlatformVectorEnv",
-        max_episode_steps=200,
     ),
     "pamdp/HalfFieldOffense-v0": dict(
         entry_point="pamdp.envs.hfo.env:HalfFieldOffenseEnv",
@@ -33,7 +32,9 @@ _REGISTRATIONS = {
         vector_entry_point="pamdp.envs.hfo.env:HalfFieldOffenseVectorEnv",
         kwargs={"defense_npcs": 1},
     ),
-    # Goal, Hard Goal, Moving and Sliding end their episodes by their own step limits (the specs: no TimeLimit).
+    # No spec sets max_episode_steps: the envs keep their domain's time limit themselves (Platform 200, Catch Point
+    # 25, Hard Move 30 steps), so that no Gymnasium TimeLimit zeroes the count before a reset is refused; Goal, Hard
+    # Goal, Moving and Sliding end their episodes by their own step rules.
     "pamdp/Goal-v0": dict(
         entry_point="pamdp.envs.goal.env:GoalEnv",
         vector_entry_point="pamdp.envs.goal.env:GoalVectorEnv",
@@ -46,12 +47,10 @@ _REGISTRATIONS = {
     "pamdp/CatchPoint-v0": dict(
         entry_point="pamdp.envs.catch_point.env:CatchPointEnv",
         vector_entry_point="pamdp.envs.catch_point.env:CatchPointVectorEnv",
-        max_episode_steps=25,
     ),
     "pamdp/HardMove-v0": dict(
         entry_point="pamdp.envs.hard_move.env:HardMoveEnv",
         vector_entry_point="pamdp.envs.hard_move.env:HardMoveVectorEnv",
-        max_episode_steps=30,
     ),
     "pamdp/Moving-v0": dict(
         entry_point="pamdp.envs.gym_hybrid.env:MovingEnv",

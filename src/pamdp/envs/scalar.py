@@ -3,8 +3,9 @@
 It keeps one state row and one :class:`~pamdp.envs.streams.RandomStreams` copy that follows ``np_random``
 (a replaced generator, e.g. ``numpy.random.RandomState(S)`` or a seeded reset, drops the numbers drawn
 ahead of it), and runs the domain's own batched ``parse``, ``reset`` and ``step`` on them: one action is
-checked as a batch of one (:func:`as_batch`), and the batched infos are read back as copy 0's. It neither
-autoresets nor truncates (``gymnasium.make`` adds the registration's ``TimeLimit``).
+checked as a batch of one (:func:`as_batch`), and the batched infos are read back as copy 0's. It does not
+autoreset; it truncates at ``max_episode_steps`` itself (the domain's limit by default: the registrations set
+none, so ``gymnasium.make`` adds no ``TimeLimit``, whose reset would zero the count before a refused reset).
 """
 
 from __future__ import annotations
@@ -14,8 +15,8 @@ import inspect
 import gymnasium
 import numpy as np
 
-from pamdp.envs.streams import RandomStreams
-from pamdp.envs.vector import Domain, DomainVectorEnv, check_render_mode
+from pamdp.envs.streams import RandomStreams, check_seed
+from pamdp.envs.vector import Domain, DomainVectorEnv, build_domain, check_options, check_render_mode, time_limit
 
 __all__ = ["DomainEnv", "as_batch", "env_classes"]
 
@@ -47,6 +48,8 @@ class DomainEnv(gymnasium.Env):
 
     Args:
         render_mode: ``None`` or ``"rgb_array"``.
+        max_episode_steps: episodes are truncated after this many steps (default: the domain's); ``None`` leaves
+            the end to the domain.
         **variant: the domain's constructor arguments.
     """
 
@@ -57,8 +60,10 @@ class DomainEnv(gymnasium.Env):
     num_envs = 1
     """The domain's hooks see the scalar env as a batched one of one copy."""
 
-    def __init__(self, render_mode: str | None = None, **variant):
-        self.domain = domain = self.domain_class(**{**self.variant, **variant})
+    def __init__(self, render_mode: str | None = None, max_episode_steps="domain", **variant):
+        self.domain = domain = build_domain(self.domain_class, {**self.variant, **variant})
+        self.max_episode_steps = time_limit(max_episode_steps, domain)
+        self._elapsed = 0
         check_render_mode(render_mode, self.metadata["render_modes"])
         self.metadata = {**self.metadata, "render_fps": domain.render_fps}
         self.render_mode = render_mode
@@ -82,12 +87,15 @@ class DomainEnv(gymnasium.Env):
         return {k: v[0] for k, v in view.items()} if isinstance(view, dict) else view[0]
 
     def reset(self, *, seed: int | None = None, options: dict | None = None):
+        check_seed(seed)
+        check_options(self.domain, options, 1)
         super().reset(seed=seed)
         self.streams.follow(0, self.np_random)
         if self.domain.reset_draws:
             self.streams.refill(self.domain.reset_draws)
         obs, infos = self.domain.reset(self, np.ones(1, dtype=bool), options, np.array([seed is not None]))
         self._started = True
+        self._elapsed = 0
         return obs[0], _first(infos)
 
     def step(self, action):
@@ -98,7 +106,9 @@ class DomainEnv(gymnasium.Env):
         if self.domain.step_draws:
             self.streams.refill(self.domain.step_draws)
         obs, rewards, terminated, truncated, infos = self.domain.step(self, parsed, self._calm)
-        return obs[0], float(rewards[0]), bool(terminated[0]), bool(truncated[0]), _first(infos)
+        self._elapsed += 1
+        limited = self.max_episode_steps is not None and self._elapsed >= self.max_episode_steps
+        return obs[0], float(rewards[0]), bool(terminated[0]), bool(truncated[0]) or limited, _first(infos)
 
     def render(self):
         return self.domain.frame(self, 0) if self.render_mode == "rgb_array" else None

@@ -19,23 +19,38 @@ import numba
 import numpy as np
 from gymnasium.utils import seeding
 
-__all__ = ["RandomStreams", "copy_seeds"]
+__all__ = ["RandomStreams", "check_seed", "copy_seeds"]
 
 DRAWS = ("standard_normal", "random")
 """The generator methods a stream can draw with (both exist on ``Generator`` and ``RandomState``)."""
 
 
+def is_seed(seed) -> bool:
+    """Whether ``seed`` is one seed Gymnasium takes: an int >= 0 (not a bool)."""
+    return isinstance(seed, (int, np.integer)) and not isinstance(seed, (bool, np.bool_)) and seed >= 0
+
+
+def check_seed(seed) -> None:
+    """The scalar envs' ``reset(seed=...)``: None or an int >= 0, else a ``ValueError`` naming it (before the
+    generator is touched)."""
+    if seed is not None and not is_seed(seed):
+        raise ValueError(f"seed={seed!r}; expected None or an int >= 0")
+
+
 def copy_seeds(seed, num_copies: int) -> list:
     """The seed of each copy for ``reset(seed=seed)``: ``seed + i`` for an int, the list itself for a
-    list of ``num_copies`` ints (or None), ``num_copies`` Nones for None."""
+    list of ``num_copies`` ints (or None), ``num_copies`` Nones for None; every entry is checked before any is
+    used, so that a refused seed reseeds no copy."""
     if seed is None:
         return [None] * num_copies
-    if isinstance(seed, (int, np.integer)) and not isinstance(seed, bool):
+    if is_seed(seed):
         return [int(seed) + i for i in range(num_copies)]
     if isinstance(seed, (list, tuple, np.ndarray)) and len(seed) == num_copies:
-        if all(s is None or (isinstance(s, (int, np.integer)) and not isinstance(s, bool)) for s in seed):
+        if all(s is None or is_seed(s) for s in seed):
             return [None if s is None else int(s) for s in seed]
-    raise ValueError(f"seed={seed!r}; expected None, an int, or a list of {num_copies} ints (or None), one per copy")
+    raise ValueError(
+        f"seed={seed!r}; expected None, an int, or a list of {num_copies} ints (or None), one per copy; ints >= 0"
+    )
 
 
 class RandomStreams:

@@ -22,6 +22,8 @@ generators, or of stand-ins such as a Platform ``ZeroNoise``, replaces them and 
 
 from __future__ import annotations
 
+import inspect
+import typing
 from collections.abc import Sequence
 
 import numba
@@ -32,7 +34,69 @@ from gymnasium.vector.utils import batch_space
 
 from pamdp.envs.streams import RandomStreams, copy_seeds
 
-__all__ = ["Domain", "DomainVectorEnv", "check_render_mode", "split_actions", "column"]
+__all__ = [
+    "Domain",
+    "DomainVectorEnv",
+    "build_domain",
+    "check_options",
+    "check_render_mode",
+    "time_limit",
+    "split_actions",
+    "column",
+]
+
+_TYPES = {bool: (bool, np.bool_), int: (int, np.integer), float: (int, float, np.integer, np.floating), str: (str,)}
+"""What a value of a domain argument annotated with the key may be (``bool`` nowhere but under ``bool``)."""
+
+
+def build_domain(domain_class: type[Domain], variant: dict) -> Domain:
+    """The domain made with the constructor arguments ``variant``, each checked first against the constructor's
+    signature: an unknown name, or a value of another type than its annotation (a bool argument takes only a real
+    bool: ``deterministic="no"`` would otherwise switch it on), is a ``ValueError`` naming the argument, the value
+    and what is expected. The constructor checks the ranges."""
+    params = {n: p for n, p in inspect.signature(domain_class.__init__).parameters.items() if n != "self"}
+    hints = typing.get_type_hints(domain_class.__init__)
+    for name, value in variant.items():
+        if name not in params:
+            expected = ", ".join(params) or "none"
+            raise ValueError(f"{domain_class.name} takes no argument {name!r}; expected some of {expected}")
+        kinds = _TYPES.get(hints.get(name))
+        if kinds is None:
+            continue
+        if isinstance(value, (bool, np.bool_)) and hints[name] is not bool or not isinstance(value, kinds):
+            raise ValueError(f"{domain_class.name} argument {name}={value!r}; expected {hints[name].__name__}")
+    return domain_class(**variant)
+
+
+def time_limit(max_episode_steps, domain: Domain) -> int | None:
+    """The shells' ``max_episode_steps`` argument checked: ``"domain"`` (the domain's limit), None or a positive
+    integer."""
+    if max_episode_steps == "domain":
+        return domain.max_episode_steps
+    if max_episode_steps is not None and (
+        isinstance(max_episode_steps, bool)
+        or not isinstance(max_episode_steps, (int, np.integer))
+        or max_episode_steps < 1
+    ):
+        raise ValueError(f"max_episode_steps must be a positive integer or None, got {max_episode_steps!r}")
+    return max_episode_steps
+
+
+def check_options(domain: Domain, options, n: int, shell_keys: tuple[str, ...] = ()) -> None:
+    """The one rule for ``reset(options=...)``: None or a dict whose keys are among the domain's
+    ``reset_options`` and the shell's ``shell_keys``; anything else is a ``ValueError`` naming the unknown keys and
+    the accepted ones. Then the domain checks the values (:meth:`Domain.check_options`)."""
+    if options is None:
+        return
+    accepted = (*domain.reset_options, *shell_keys)
+    listed = ", ".join(map(repr, accepted)) or "none"
+    if not isinstance(options, dict):
+        raise ValueError(f"reset options={options!r}; expected None or a dict with keys among {listed}")
+    unknown = [k for k in options if k not in accepted]
+    if unknown:
+        hints = "".join(f"; {domain.option_hints[k]}" for k in unknown if k in domain.option_hints)
+        raise ValueError(f"{domain.name} takes no reset option(s) {unknown}; expected any of {listed}{hints}")
+    domain.check_options(options, n)
 
 
 def check_render_mode(render_mode, modes) -> None:
@@ -108,6 +172,10 @@ class Domain:
     """Numbers kept in the scalar env (just a reset's where nothing should be drawn ahead of ``np_random``)."""
     max_episode_steps: int | None = None
     """The registration's time limit, also the batched env's default; None leaves the end to the domain."""
+    reset_options: tuple[str, ...] = ()
+    """The keys ``reset(options=...)`` takes (the batched env's ``reset_mask`` besides); others are refused."""
+    option_hints: dict = {}
+    """A word for a key that is refused but looks meant (Hard Move's ``n``: a constructor argument)."""
 
     def initial_states(self, n: int) -> np.ndarray:
         """The state rows ``(n, state_size)`` before the first reset (and where the domain keeps per-copy arrays
@@ -120,6 +188,10 @@ class Domain:
 
     def parse(self, actions, n: int) -> tuple:
         raise NotImplementedError
+
+    def check_options(self, options: dict, n: int) -> None:
+        """Check the values of ``reset`` options for ``n`` copies (the keys are checked already); ``ValueError``
+        naming a bad one. Runs before any copy is seeded or reset."""
 
     def reset(self, env, mask: np.ndarray, options: dict | None, seeded: np.ndarray) -> tuple:
         """Start an episode in the copies where ``mask`` is true (``seeded``: those just given a seed)."""
@@ -162,15 +234,8 @@ class DomainVectorEnv(VectorEnv):
     def __init__(self, num_envs: int = 1, max_episode_steps="domain", render_mode=None, **variant):
         if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) or num_envs < 1:
             raise ValueError(f"num_envs must be a positive integer, got {num_envs!r}")
-        self.domain = domain = self.domain_class(**{**self.variant, **variant})
-        if max_episode_steps == "domain":
-            max_episode_steps = domain.max_episode_steps
-        if max_episode_steps is not None and (
-            isinstance(max_episode_steps, bool)
-            or not isinstance(max_episode_steps, (int, np.integer))
-            or max_episode_steps < 1
-        ):
-            raise ValueError(f"max_episode_steps must be a positive integer or None, got {max_episode_steps!r}")
+        self.domain = domain = build_domain(self.domain_class, {**self.variant, **variant})
+        max_episode_steps = time_limit(max_episode_steps, domain)
         check_render_mode(render_mode, self.metadata["render_modes"])
         self.metadata = {**self.metadata, "render_fps": domain.render_fps}
         self.num_envs = int(num_envs)
@@ -230,15 +295,17 @@ class DomainVectorEnv(VectorEnv):
     def reset(self, *, seed=None, options: dict | None = None):
         """Reset all copies, or with ``options={"reset_mask": mask}`` only those where ``mask`` is true.
 
-        ``seed``: None, an int (copy i gets ``seed + i``) or a list with one seed (or None) per copy.
+        ``seed``: None, an int (copy i gets ``seed + i``) or a list with one seed (or None) per copy. The seed and
+        the options are checked whole before any copy is seeded or reset: a refused reset changes nothing.
         """
+        check_options(self.domain, options, self.num_envs, shell_keys=("reset_mask",))
         seeded = np.array([s is not None for s in copy_seeds(seed, self.num_envs)])
-        self.streams.seed(seed)
         mask = np.ones(self.num_envs, dtype=bool)
         if options is not None and "reset_mask" in options:
             mask = np.asarray(options["reset_mask"])
             if mask.shape != (self.num_envs,) or mask.dtype != np.bool_:
                 raise ValueError(f"reset_mask must be a bool array of shape ({self.num_envs},), got {mask!r}")
+        self.streams.seed(seed)
         self.streams.refill(self.draws_per_step)
         obs, infos = self.domain.reset(self, mask, options, seeded)
         self._started = True

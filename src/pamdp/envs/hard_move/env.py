@@ -42,6 +42,7 @@ def hard_move_action_space(n: int) -> spaces.Tuple:
 class HardMove(particle.ParticleDomain):
     name = "Hard Move"
     max_episode_steps = 30
+    option_hints = {"n": "n is a constructor argument: gymnasium.make('pamdp/HardMove-v0', n=...)"}
 
     def __init__(self, n: int = 4):
         super().__init__()

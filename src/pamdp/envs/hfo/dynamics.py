@@ -745,19 +745,22 @@ def ending(status, cfg):
 @jit
 def first_bad_action(a, dash_params, turn_params, kick_params):
     """The checks of a batch of actions: ``(i, 0)`` for the first copy whose discrete action is not 0, 1 or 2
-    (an integral float counts as its integer), else ``(i, 1)`` for the first whose chosen action has a parameter
-    that is not finite, else ``(-1, 0)``."""
+    (an integral float counts as its integer), else ``(i, 1)`` for the first with a parameter that is not finite
+    (any of its five: the unused ones too, as on every domain), else ``(-1, 0)``."""
     for i in range(a.shape[0]):
         if not (a[i] == DASH or a[i] == TURN or a[i] == KICK):
             return i, 0
     for i in range(a.shape[0]):
-        if a[i] == DASH:
-            x0, x1 = dash_params[i, 0], dash_params[i, 1]
-        elif a[i] == TURN:
-            x0 = x1 = turn_params[i, 0]
-        else:
-            x0, x1 = kick_params[i, 0], kick_params[i, 1]
-        if not (math.isfinite(x0) and math.isfinite(x1)):
+        d0, d1, t0, k0, k1 = (
+            dash_params[i, 0],
+            dash_params[i, 1],
+            turn_params[i, 0],
+            kick_params[i, 0],
+            kick_params[i, 1],
+        )
+        if not (
+            math.isfinite(d0) and math.isfinite(d1) and math.isfinite(t0) and math.isfinite(k0) and math.isfinite(k1)
+        ):
             return i, 1
     return -1, 0
 

@@ -79,6 +79,7 @@ class HalfFieldOffense(Domain):
             self.profile, deterministic, timeout_terminal, terminal_deltas, first_step_reward, body_reset == "uniform"
         )
         self.goalie = defense_npcs == 1
+        self.reset_options = ("ball", "player", "body") + ("goalie_body",) * self.goalie
         # The goalie's block (8 features) and its uniform number come before the last-action flag.
         self.n_features = self.profile.n_features + (9 if self.profile.n_features == 59 else 8) * self.goalie
         if self.goalie:
@@ -113,6 +114,9 @@ class HalfFieldOffense(Domain):
             if rng is not self._sources[i]:
                 dyn.seed_stream(self.copy_streams[i], rng.random(4))
                 self._sources[i] = rng
+
+    def check_options(self, options, n):
+        reset_options(options, n, shell_keys=("reset_mask",), goalie=self.goalie)
 
     def reset(self, env, mask, options, seeded):
         placements = reset_options(options, env.num_envs, shell_keys=("reset_mask",), goalie=self.goalie)

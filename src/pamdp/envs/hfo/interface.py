@@ -44,7 +44,7 @@ def check_settings(profile: str, body_reset: str, defense_npcs: int = 0) -> None
 
 def parse_actions(actions, n: int):
     """A batch of actions as ``(a, dash, turn, kick)``: int64 (N,) and float64 (N, 2), (N, 1), (N, 2);
-    ``ValueError`` if malformed, or if a copy's chosen action has non-finite parameters."""
+    ``ValueError`` if malformed, or if any parameter of a copy is not finite (the unused ones too)."""
     expected = f"{ACTION_FORM}, batched: (a[{n}], (dash[{n}, 2], turn[{n}, 1], kick[{n}, 2]))"
     try:
         a_raw, params = actions
@@ -61,8 +61,11 @@ def parse_actions(actions, n: int):
         raise ValueError(f"discrete actions {a.tolist()}; expected integers 0 (DASH), 1 (TURN) or 2 (KICK)")
     a = a.astype(np.int64, copy=False)
     if i >= 0:
-        x0, x1 = (dash[i], turn[i, [0, 0]], kick[i])[a[i]]
-        raise ValueError(f"copy {i}: action {a[i]} ({ACTION_NAMES[a[i]]}) has non-finite parameters ({x0}, {x1})")
+        shown = f"dash {dash[i].tolist()}, turn {turn[i].tolist()}, kick {kick[i].tolist()}"
+        raise ValueError(
+            f"copy {i}: action {a[i]} ({ACTION_NAMES[a[i]]}) with non-finite parameters ({shown}); expected every "
+            "parameter finite, used or not"
+        )
     return a, dash, turn, kick
 
 
