@@ -398,7 +398,7 @@ def test_resuming_another_algorithms_run_says_so(trained, capsys):
 def test_ctrl_c_before_the_first_checkpoint_says_there_is_nothing_to_resume(tmp_path, monkeypatch, capsys):
     from pamdp.algos.patrpo import PATRPO
 
-    def interrupted(self):
+    def interrupted(self, budget):
         raise KeyboardInterrupt
 
     monkeypatch.setattr(PATRPO, "_run_epoch", interrupted)

@@ -117,7 +117,8 @@ def test_warm_up_acts_uniformly_and_its_latents_are_reencoded():
     a, x, extras = m._explore(obs, 0, np.zeros(3000, dtype=bool), None)
     np.testing.assert_allclose(np.bincount(a.numpy(), minlength=3) / 3000, [1 / 3] * 3, atol=0.04)
     assert x.min() < -0.95 and x.max() > 0.95 and abs(float(x.mean())) < 0.05
-    m.learn(2000, progress_bar=False)
+    with pytest.warns(UserWarning, match="makes no gradient update"):  # replay only, as meant
+        m.learn(2000, progress_bar=False)
     assert not m.pretrained and m.n_updates == 0  # no update before the warm-up ends
     m.learn(2000, progress_bar=False)
     assert m.pretrained and m.n_updates > 0

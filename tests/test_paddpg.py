@@ -46,7 +46,8 @@ def test_zeroing_gradients_by_hand():
 def test_actor_chasing_an_unbounded_critic_stays_in_bounds(bound):
     cfg = dataclasses.replace(SMALL, bound=bound, actor_lr=3e-2, grad_clip=0.0, learning_starts=10**6)
     model = PADDPG("pamdp/Platform-v0", cfg)
-    model.learn(100, progress_bar=False)
+    with pytest.warns(UserWarning, match="makes no gradient update"):  # replay only, as meant
+        model.learn(100, progress_bar=False)
 
     def greedy():  # a critic that wants every output as large as possible: Q = 10 * sum(out), no hidden layer
         critic = Critic(model.obs_dim, model.out_size, (), "relu")
@@ -119,7 +120,8 @@ def test_epoch_stores_monte_carlo_returns_and_explores():
 
 def test_beta_zero_stores_no_returns_and_learns_from_the_pure_td_target():
     model = PADDPG("pamdp/Platform-v0", dataclasses.replace(SMALL, beta=0.0, learning_starts=10**6))
-    model.learn(200, progress_bar=False)
+    with pytest.warns(UserWarning, match="makes no gradient update"):  # replay only, as meant
+        model.learn(200, progress_bar=False)
     assert "mc" not in model.replay.data and len(model.replay) >= 200
     batch = model.replay.sample(16, np.random.default_rng(0))
     model.replay.sample = lambda n, rng: batch
@@ -135,7 +137,8 @@ def test_beta_zero_stores_no_returns_and_learns_from_the_pure_td_target():
 
 def test_critic_loss_falls_on_a_fixed_batch():
     model = PADDPG("pamdp/Platform-v0", dataclasses.replace(SMALL, learning_starts=10**6, hidden_sizes=(64, 64)))
-    model.learn(200, progress_bar=False)
+    with pytest.warns(UserWarning, match="makes no gradient update"):  # replay only, as meant
+        model.learn(200, progress_bar=False)
     b = model.replay.sample(128, np.random.default_rng(0))
     losses = []
     for _ in range(150):

@@ -124,7 +124,8 @@ def test_expected_value_is_the_mean_over_gumbel_samples_and_its_gradient_is_exac
 
 def test_expected_td_target_averages_the_target_policys_actions():
     model = PASVG0("pamdp/Platform-v0", dataclasses.replace(SMALL, discrete_gradient="expected", learning_starts=10**6))
-    model.learn(200, progress_bar=False)
+    with pytest.warns(UserWarning, match="makes no gradient update"):  # replay only, as meant
+        model.learn(200, progress_bar=False)
     batch = model.replay.sample(16, np.random.default_rng(0))
     model.replay.sample = lambda n, rng: batch
     gen_state = model.torch_gen.get_state()
@@ -171,7 +172,8 @@ def test_epoch_stores_valid_transitions_with_their_noise_and_learns():
         assert np.isfinite(stats[-1][key]), key
     # With the recorded noise, the current policy reproduces the stored action until it is updated.
     fresh = PASVG0("pamdp/Platform-v0", dataclasses.replace(SMALL, learning_starts=10**6))
-    fresh.learn(100, progress_bar=False)
+    with pytest.warns(UserWarning, match="makes no gradient update"):  # replay only, as meant
+        fresh.learn(100, progress_bar=False)
     k = len(fresh.replay)
     with torch.no_grad():
         _, index, _, x = fresh.policy(
@@ -211,7 +213,8 @@ def test_explore_epsilon_draws_uniform_actions_with_their_own_parameters():
     model = PASVG0("pamdp/Platform-v0", dataclasses.replace(SMALL, explore_epsilon=eps, learning_starts=10**6))
     with torch.no_grad():
         model.policy.pi_d[-1].bias.copy_(torch.tensor([30.0, 0.0, 0.0]))
-    model.learn(2000, progress_bar=False)
+    with pytest.warns(UserWarning, match="makes no gradient update"):  # replay only, as meant
+        model.learn(2000, progress_bar=False)
     n = len(model.replay)
     a = model.replay.data["a"][:n].numpy()
     others = np.mean(a != 0)
@@ -226,7 +229,8 @@ def test_explore_epsilon_draws_uniform_actions_with_their_own_parameters():
 
 def test_twin_critics_learn_towards_the_smaller_target(tmp_path):
     model = PASVG0("pamdp/Platform-v0", dataclasses.replace(SMALL, twin_critics=True, learning_starts=10**6))
-    model.learn(200, progress_bar=False)  # fills replay, no update
+    with pytest.warns(UserWarning, match="makes no gradient update"):  # replay only, as meant
+        model.learn(200, progress_bar=False)  # fills replay, no update
     batch = model.replay.sample(16, np.random.default_rng(0))
     model.replay.sample = lambda n, rng: batch
     outs = {}
@@ -248,7 +252,8 @@ def test_twin_critics_learn_towards_the_smaller_target(tmp_path):
 
 def test_policy_delay_updates_the_policy_and_targets_every_kth_step():
     model = PASVG0("pamdp/Platform-v0", dataclasses.replace(SMALL, policy_delay=3, learning_starts=10**6))
-    model.learn(200, progress_bar=False)
+    with pytest.warns(UserWarning, match="makes no gradient update"):  # replay only, as meant
+        model.learn(200, progress_bar=False)
     target = [p.clone() for p in model.policy_target.parameters()]
     for k in range(1, 7):
         model._update()
@@ -285,7 +290,8 @@ def test_entropy_weight_moves_towards_the_target(tmp_path, peaked, target, direc
 
 def test_critic_loss_falls_on_a_fixed_batch():
     model = PASVG0("pamdp/Platform-v0", dataclasses.replace(SMALL, learning_starts=10**6, hidden_sizes=(64, 64)))
-    model.learn(200, progress_bar=False)
+    with pytest.warns(UserWarning, match="makes no gradient update"):  # replay only, as meant
+        model.learn(200, progress_bar=False)
     b = model.replay.sample(128, np.random.default_rng(0))
     target = b["reward"]  # a fixed regression target: the one-step reward
     losses = []

@@ -65,7 +65,8 @@ def test_python_and_the_command_line_give_one_config(tmp_path):
     small = {"epoch_steps": 8, "num_envs": 1}
     flags = [f"--{k.replace('_', '-')}={v}" for k, v in small.items()]
     argv = ["train", "pdqn", "--env", HFO, "--total-steps", "8", "--eval-episodes", "0", "--no-progress"]
-    assert main([*argv, *flags, "--out", str(out)]) == 0
+    with pytest.warns(UserWarning, match="makes no gradient update"):  # 8 steps: the config, not training
+        assert main([*argv, *flags, "--out", str(out)]) == 0
     run = json.loads((out / "run.json").read_text())
     assert run["preset"] == "hfo" and "preset_warning" not in run
     expected = dataclasses.replace(PDQNConfig.preset("hfo"), **small)
@@ -93,7 +94,7 @@ def test_a_preset_made_for_another_env_warns_and_the_run_records_it(tmp_path):
     assert config == PDQNConfig.preset("hfo")  # used as asked
     out = tmp_path / "run"
     argv = ["train", "pdqn", "--preset", "hfo", "--total-steps", "8", "--eval-episodes", "0", "--no-progress"]
-    with pytest.warns(UserWarning, match=message):
+    with pytest.warns(UserWarning, match=message), pytest.warns(UserWarning, match="makes no gradient update"):
         assert main([*argv, "--epoch-steps", "8", "--num-envs", "1", "--out", str(out)]) == 0
     run = json.loads((out / "run.json").read_text())
     assert run["preset"] == "hfo" and re.search(message, run["preset_warning"])

@@ -31,8 +31,10 @@ def evaluate(
     reached or caught on the others), also ``success_rate`` and ``mean_steps_to_success`` (``None`` when no
     episode succeeded), over the episodes that reported it.
     """
-    if episodes < 1:
+    integer = isinstance(episodes, (int, np.integer)) and not isinstance(episodes, (bool, np.bool_))
+    if not (integer or isinstance(episodes, (float, np.floating)) and float(episodes).is_integer()) or episodes < 1:
         raise ValueError(f"episodes = {episodes!r}; expected an integer >= 1")
+    episodes = int(episodes)
     env_id = env_id or model.env_id
     if env_id is None:
         raise ValueError("the model's env is not registered; pass env_id= to evaluate it")

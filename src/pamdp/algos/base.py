@@ -15,6 +15,7 @@ from __future__ import annotations
 import math
 import os
 import time
+import warnings
 from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, ClassVar
@@ -76,6 +77,12 @@ def _count(name: str, value: object, low: int) -> int:
     return int(value)
 
 
+def _shown(shapes: dict[str, list[int]]) -> str:
+    """An env's shapes (:meth:`Algorithm._shapes`) in a few words, however many actions it has."""
+    params = shapes["parameters"]
+    return f"(observation {tuple(shapes['observation'])}, {len(params)} actions, {sum(params)} parameters)"
+
+
 class Algorithm:
     """Base class of pamdp's algorithms; see the module docstring for what a subclass provides."""
 
@@ -118,6 +125,9 @@ class Algorithm:
         self.device = resolve_device(config.device)
         self.num_timesteps = 0
         self.epoch = 0
+        self.num_updates = 0
+        """Gradient updates made so far (each epoch's ``train/updates``), saved in checkpoints: 0 is an untrained
+        model however many samples it has seen."""
         self.np_rng = np.random.default_rng(config.seed)
         # on the device, so that sampling there draws there; on the CPU the same stream as ever
         self.torch_gen = torch.Generator(device=self.device).manual_seed(config.seed)
@@ -132,10 +142,10 @@ class Algorithm:
     def _build(self) -> None:
         raise NotImplementedError
 
-    def _run_epoch(self) -> dict[str, float]:
-        """Collect one epoch of samples and learn from them; returns statistics including ``"steps"``. By default
-        the family loop's epoch."""
-        return self.loop.run_epoch()
+    def _run_epoch(self, budget: int) -> dict[str, float]:
+        """Collect one epoch of samples, at most about ``budget`` (the samples left to train), and learn from them;
+        returns statistics including ``"steps"`` and ``"train/updates"``. By default the family loop's epoch."""
+        return self.loop.run_epoch(budget)
 
     def _epoch_stats(self, step: int) -> dict[str, float]:
         """The algorithm's own figures at the end of an epoch, after ``step`` samples (a schedule's value)."""
@@ -241,7 +251,12 @@ class Algorithm:
         eval_every: int = 0,
         eval_episodes: int = 100,
     ) -> Self:
-        """Train for ``total_timesteps`` more environment steps, in whole epochs.
+        """Train for ``total_timesteps`` more environment steps (samples of all env copies together), in epochs.
+
+        The last epoch is shortened to the samples left; an epoch ends at the first vector step that reaches its
+        count, so a run may pass its budget by less than ``num_envs`` samples. A budget that cannot train (below
+        an off-policy algorithm's ``learning_starts``, HyAR's ``warmup_steps``, or one vector step of the
+        ``num_envs`` copies) is said at the start in a ``UserWarning``; :attr:`num_updates` counts what was learned.
 
         Args:
             callback: called after every epoch with the algorithm and the epoch's statistics; returning
@@ -265,6 +280,11 @@ class Algorithm:
             )
         if eval_every > 0 and self.env_id is None:  # before training, not after its first epoch
             raise ValueError("eval_every needs a registered env (an env id); this model's env has none")
+        if callback is not None and not callable(callback):  # before training, not after its first epoch
+            raise ValueError(f"callback = {callback!r:.60}; expected a function of (model, stats), or None")
+        note = self.loop.budget_note(total_timesteps) if total_timesteps > 0 and self.loop is not None else None
+        if note is not None:
+            warnings.warn(note, UserWarning, stacklevel=2)
         torch.set_num_threads(self.config.torch_threads)
         target = self.num_timesteps + int(total_timesteps)
         logger = Logger(run_dir, resume_step=self.num_timesteps) if run_dir is not None else None
@@ -279,8 +299,9 @@ class Algorithm:
         try:
             while self.num_timesteps < target:
                 t0, cpu0 = time.perf_counter(), time.process_time()
-                stats = self._run_epoch()
+                stats = self._run_epoch(target - self.num_timesteps)
                 self.num_timesteps += int(stats.pop("steps"))
+                self.num_updates += int(stats.get("train/updates", 0))
                 self.epoch += 1
                 elapsed = time.perf_counter() - t0
                 stats.update(
@@ -317,6 +338,10 @@ class Algorithm:
             stats["eval/success_rate"] = result["success_rate"]
         return stats
 
+    def _shapes(self) -> dict[str, list[int]]:
+        """What the networks' sizes follow from: the observation's shape and each action's parameter count."""
+        return {"observation": list(self.observation_space.shape), "parameters": list(self.hybrid.param_sizes)}
+
     def save(self, path: str | os.PathLike, replay: bool | None = None) -> None:
         """Write weights, optimiser states, settings, counters and RNG states to one file, atomically.
 
@@ -334,6 +359,8 @@ class Algorithm:
             "env_kwargs": self.env_kwargs,
             "num_timesteps": self.num_timesteps,
             "epoch": self.epoch,
+            "num_updates": self.num_updates,
+            "shapes": self._shapes(),
             "rng": {
                 "numpy": self.np_rng.bit_generator.state,
                 "torch": self.torch_gen.get_state(),
@@ -373,8 +400,22 @@ class Algorithm:
         else:  # the recorded env arguments still apply when the same env id is named again
             same_id = isinstance(env, str) and env == payload["env_id"]
             algo = cls(env, config, env_kwargs=payload["env_kwargs"] if same_id else None)
+        saved, shapes = payload.get("shapes"), algo._shapes()
+        if saved is not None and saved != shapes:  # before torch's "size mismatch" of every tensor
+            raise ValueError(
+                f"the model was trained on an env of shapes {_shown(saved)}, this env's are {_shown(shapes)}; "
+                "expected an env of the model's shapes"
+            )
         for name, module in algo._modules().items():
-            module.load_state_dict(payload["modules"][name])
+            try:
+                module.load_state_dict(payload["modules"][name])
+            except RuntimeError as exc:  # files written before the shapes were kept
+                if "size mismatch" not in str(exc):
+                    raise
+                raise ValueError(
+                    f"{name}'s weights do not fit this env of shapes {_shown(shapes)}; expected an env of the "
+                    "model's shapes"
+                ) from None
         for name, opt in algo._optimizers().items():
             opt.load_state_dict(payload["optimizers"][name])
         if hasattr(algo.loop, "load_state_dict"):
@@ -383,6 +424,7 @@ class Algorithm:
         algo.preset = payload.get("preset")  # files written before it was kept: None
         algo.num_timesteps = int(payload["num_timesteps"])
         algo.epoch = int(payload["epoch"])
+        algo.num_updates = int(payload.get("num_updates", 0))  # files written before it was kept: 0
         algo.np_rng.bit_generator.state = payload["rng"]["numpy"]
         # a generator's state is the device's own kind (the CPU's Mersenne Twister, CUDA's Philox): a model moved
         # to another kind of device keeps the seed's fresh stream there

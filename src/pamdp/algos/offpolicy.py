@@ -394,9 +394,22 @@ class OffPolicyLoop:
         self.update_credit = 0.0
         self.stepper: VectorStepper | None = None  # the env's copies, from the first epoch on
 
-    def run_epoch(self) -> dict[str, float]:
-        """Collect at least ``config.epoch_steps`` valid transitions, updating as they arrive; returns the epoch's
-        stats with the algorithm's ``_epoch_stats`` at its end (``_explore`` gets the running count of samples)."""
+    def budget_note(self, total: int) -> str | None:
+        """Why ``total`` more samples make no gradient update (the replay would not reach ``learning_starts``), or
+        ``None``."""
+        held, starts = len(self.buffer), self.config.learning_starts
+        if held + total >= starts:
+            return None
+        name = "warmup_steps" if hasattr(self.config, "warmup_steps") else "learning_starts"
+        return (
+            f"total_timesteps = {total:,} makes no gradient update: the first comes once the replay holds {name} = "
+            f"{starts:,} samples and it holds {held:,}; give at least {starts - held:,} steps to train"
+        )
+
+    def run_epoch(self, budget: int | None = None) -> dict[str, float]:
+        """Collect at least ``config.epoch_steps`` valid transitions (``budget`` where fewer are left), updating as
+        they arrive; returns the epoch's stats with the algorithm's ``_epoch_stats`` at its end (``_explore`` gets
+        the running count of samples)."""
         cfg, algo, n_actions = self.config, self.algo, self.hybrid.n_actions
         act, update, start_step, device = algo._explore, algo._update, algo.num_timesteps, algo.device
         if self.stepper is None:
@@ -409,7 +422,8 @@ class OffPolicyLoop:
         sums: dict[str, float] = {}
         reported: dict[str, int] = {}  # per key: the updates that computed it (some run every few updates only)
         n_updates = n_valid = 0
-        while n_valid < cfg.epoch_steps:
+        limit = cfg.epoch_steps if budget is None else min(cfg.epoch_steps, budget)
+        while n_valid < limit:
             obs = torch.from_numpy(np.asarray(stepper.obs, dtype=np.float32))
             mask = None if stepper.masks is None else torch.from_numpy(stepper.masks).to(device)
             with torch.no_grad():  # the observations to the algorithm's device, the actions back

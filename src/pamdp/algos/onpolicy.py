@@ -147,13 +147,23 @@ class Rollout:
             self.t_ep = np.where(step.valid, self.t_ep + 1, 0)
         return {k: np.stack(v) for k, v in rows.items()}
 
-    def run_epoch(self) -> dict[str, float]:
-        """One epoch: :meth:`collect` ``batch_size`` samples, their :func:`advantage_batch` from the algorithm's
-        baseline (``_values(obs, t)``), then its ``_learn`` of the batch (subnormals flushed with
-        ``flush_denormal``). Returns ``_learn``'s stats with the baseline's explained variance, the discrete
-        actions' frequencies, the episodes completed in the epoch, and ``steps``."""
+    def budget_note(self, total: int) -> str | None:
+        """What ``total`` more samples train where it is not about ``total`` (below one vector step), or ``None``."""
+        copies = self.algo.vec_env.num_envs
+        if total >= copies:
+            return None
+        return (
+            f"total_timesteps = {total:,} is below one step of the num_envs = {copies:,} env copies: the run trains "
+            f"one batch of about {copies:,} samples; lower num_envs to train fewer"
+        )
+
+    def run_epoch(self, budget: int | None = None) -> dict[str, float]:
+        """One epoch: :meth:`collect` ``batch_size`` samples (``budget`` where fewer are left), their
+        :func:`advantage_batch` from the algorithm's baseline (``_values(obs, t)``), then its ``_learn`` of the batch
+        (subnormals flushed with ``flush_denormal``). Returns ``_learn``'s stats with the baseline's explained
+        variance, the discrete actions' frequencies, the episodes completed in the epoch, and ``steps``."""
         algo, cfg = self.algo, self.algo.config
-        batch = self.collect(cfg.batch_size)
+        batch = self.collect(cfg.batch_size if budget is None else min(cfg.batch_size, budget))
         data, explained_var = advantage_batch(batch, algo._values, cfg.gamma, cfg.gae_lambda, cfg.normalize_advantages)
         with subnormals_flushed(cfg.flush_denormal):
             stats = algo._learn(data)

@@ -173,6 +173,7 @@ class PATRPO(Algorithm):
     def _learn(self, data: dict[str, np.ndarray]) -> dict[str, float]:
         """The policy's step on an :func:`~pamdp.algos.onpolicy.advantage_batch`, then the baseline's fit."""
         stats = self._update_policy(*update_tensors(data, self.device), mask_tensor(data, self.device))
+        stats["train/updates"] = 1.0 - stats.get("train/update_skipped", 0.0)  # one natural-gradient step a batch
         stats["losses/value_loss"] = self._fit_baseline(data["obs"], data["t"], data["returns"])
         return stats
 

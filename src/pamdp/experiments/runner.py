@@ -302,7 +302,7 @@ def _train(model, spec: RunSpec, out: str | os.PathLike, progress_bar: bool, log
     from pamdp.evaluation import evaluate
 
     out = Path(out)
-    start = time.time()
+    start, start_steps = time.time(), model.num_timesteps
     model.learn(
         max(spec.total_steps - model.num_timesteps, 0),
         progress_bar=progress_bar,
@@ -311,7 +311,11 @@ def _train(model, spec: RunSpec, out: str | os.PathLike, progress_bar: bool, log
         callback=callback,
     )
     model.save(out / FINAL_MODEL, replay=False)  # for acting; checkpoint.pt keeps the buffer for resuming
-    log(f"trained {model.num_timesteps:,} steps in {time.time() - start:.0f} s; model in {out / FINAL_MODEL}")
+    updates = f"{model.num_updates:,} gradient updates" if model.num_updates else "no gradient update: untrained"
+    log(
+        f"trained {model.num_timesteps - start_steps:,} steps in {time.time() - start:.0f} s, "
+        f"{model.num_timesteps:,} of {spec.total_steps:,} in all ({updates}); model in {out / FINAL_MODEL}"
+    )
     if spec.eval_episodes <= 0:
         return {}
     result = evaluate(model, episodes=spec.eval_episodes, seed=10_000 + spec.seed)
