@@ -19,6 +19,8 @@ import pamdp
 from pamdp.algos import ALGORITHMS, algorithm_class
 from pamdp.algos.base import Algorithm
 from pamdp.algos.settings import AlgoConfig
+from pamdp.envs.scalar import DomainEnv
+from pamdp.envs.vector import Domain, DomainVectorEnv
 
 ROOT = Path(__file__).resolve().parents[1]
 PYPROJECT = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
@@ -67,7 +69,7 @@ def _entry_point(target: str):
 
 def _public_objects() -> dict[str, object]:
     """Every public class and function: pamdp's exports, each algorithm and its config with their bases, the
-    wrappers, the evaluation, and each registered env's scalar and batched class."""
+    wrappers, the evaluation, the env shell and each registered env's domain."""
     names = [n for n in pamdp.__all__ if n != "__version__"]  # a string, checked against the metadata above
     objects = {f"pamdp.{n}": getattr(pamdp, n) for n in names}
     objects |= {"Algorithm": Algorithm, "AlgoConfig": AlgoConfig}
@@ -79,8 +81,12 @@ def _public_objects() -> dict[str, object]:
         objects |= {f"{module}.{n}": getattr(mod, n) for n in mod.__all__}
     for env_id, spec in gymnasium.registry.items():
         if env_id.startswith("pamdp/"):
-            for target in (spec.entry_point, spec.vector_entry_point):
-                objects[target] = _entry_point(target)
+            # a registered env's classes are made from its domain by the one shell: the domain and the shell carry
+            # what there is to read (the classes themselves exist only at run time, where the site's reader of
+            # source text cannot see them)
+            domain = _entry_point(spec.entry_point).domain_class
+            objects[f"{domain.__module__}.{domain.__qualname__}"] = domain
+    objects |= {"DomainEnv": DomainEnv, "DomainVectorEnv": DomainVectorEnv, "Domain": Domain}
     return objects
 
 

@@ -60,7 +60,9 @@ class DomainEnv(gymnasium.Env):
     num_envs = 1
     """The domain's hooks see the scalar env as a batched one of one copy."""
 
-    def __init__(self, render_mode: str | None = None, max_episode_steps="domain", **variant):
+    def __init__(
+        self, render_mode: str | None = None, max_episode_steps: int | str | None = "domain", **variant: object
+    ):
         self.domain = domain = build_domain(self.domain_class, {**self.variant, **variant})
         self.max_episode_steps = time_limit(max_episode_steps, domain)
         self._elapsed = 0

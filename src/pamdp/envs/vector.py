@@ -231,7 +231,13 @@ class DomainVectorEnv(VectorEnv):
     variant: dict = {}
     """Constructor arguments of the domain fixed by the class (Hard Goal's ``hard=True``)."""
 
-    def __init__(self, num_envs: int = 1, max_episode_steps="domain", render_mode=None, **variant):
+    def __init__(
+        self,
+        num_envs: int = 1,
+        max_episode_steps: int | str | None = "domain",
+        render_mode: str | None = None,
+        **variant: object,
+    ):
         if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) or num_envs < 1:
             raise ValueError(f"num_envs must be a positive integer, got {num_envs!r}")
         self.domain = domain = build_domain(self.domain_class, {**self.variant, **variant})
