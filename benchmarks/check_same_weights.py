@@ -4,8 +4,8 @@ Each case trains a few hundred samples from a fixed seed (off-policy cases with 
 update path runs) and hashes the weights of every module the algorithm saves, plus its greedy and sampled actions
 on fixed observations. Run it on the commit before a restructuring and after it; the two files must be equal:
 
-    python benchmarks/check_same_weights.py --out /tmp/before.json        # on the old commit
-    python benchmarks/check_same_weights.py --compare /tmp/before.json    # on the new one: exit 1 on a difference
+    python benchmarks/check_same_weights.py --out before.json        # on the old commit
+    python benchmarks/check_same_weights.py --compare before.json    # on the new one: exit 1 on a difference
 
 The fingerprints depend on the PyTorch build and the machine (float rounding of BLAS), so compare on one machine.
 """
