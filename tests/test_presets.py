@@ -190,7 +190,8 @@ def test_an_experiments_env_arguments_choose_the_preset(tmp_path):
 
 def test_an_entry_or_a_run_naming_an_argument_the_env_lacks_is_refused(monkeypatch):
     cls = algorithm_class("pdqn").config_class
-    with pytest.raises(ValueError, match=r"env 'pamdp/HardMove-v0' takes no argument 'N'; expected some of n"):
+    expected = r"env 'pamdp/HardMove-v0' takes no argument 'N'; expected some of max_episode_steps, n, render_mode"
+    with pytest.raises(ValueError, match=expected):
         config_of(["pdqn", "--env", HARD_MOVE, "--env-kwargs", '{"N": 8}'])
     entry = DOMAIN_PRESETS["pdqn", HARD_MOVE, when(n=(8, 10))]
     monkeypatch.setitem(DOMAIN_PRESETS, ("pdqn", HARD_MOVE, when(N=(8,))), entry)
