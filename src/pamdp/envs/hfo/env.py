@@ -155,7 +155,7 @@ class HalfFieldOffense(Domain):
         }
 
     def frame(self, env, i):
-        return draw_half_field(env._states[i])
+        return draw_half_field(env._states[i], goalie=self.goalie)
 
 
 HalfFieldOffenseEnv, HalfFieldOffenseVectorEnv = env_classes(

@@ -10,6 +10,7 @@ import numpy as np
 from gymnasium import spaces
 
 import pamdp.envs.hfo.dynamics as dyn
+from pamdp.envs.hfo import defense
 from pamdp.envs.rendering import Canvas
 
 ACTION_NAMES = ("DASH", "TURN", "KICK")
@@ -122,6 +123,9 @@ def _option(key: str, value, n: int) -> np.ndarray:
 _PX_PER_M = 6.0
 _X_MIN, _X_MAX, _Y_MAX = -3.0, 56.0, 37.0
 _GRASS, _LINE, _GOAL, _BALL, _PLAYER = (60, 140, 60), (240, 240, 240), (200, 200, 200), (250, 250, 250), (30, 80, 220)
+_GOALIE, _CATCH = (220, 40, 40), (255, 220, 0)
+#: The goalie's catch rectangle relative to its body (goalie spec 1.7, 4.1): 0 <= x <= 1.2 ahead, |y| <= 0.5.
+_CATCH_L, _CATCH_HALF_W = 1.2, 0.5
 
 
 def _to_px(x: float, y: float) -> tuple[float, float]:
@@ -158,12 +162,13 @@ def _field_image() -> np.ndarray:
     return canvas.image
 
 
-def draw_half_field(state: np.ndarray) -> np.ndarray:
+def draw_half_field(state: np.ndarray, goalie: bool = False) -> np.ndarray:
     """An ``(H, W, 3)`` uint8 top view of the attacked half of one copy's ``state``: lines, goal, posts,
-    penalty box, ball, player.
+    penalty box, ball, player, and with ``goalie`` (a ``defense`` state row) the goalie.
 
     The player is a blue disc with a white line along its body direction; y grows downwards as in the
-    server's frame.
+    server's frame. The goalie is a red disc with a white body line and the yellow outline of its catch
+    rectangle (1.2 m ahead along its body, 1 m wide; the catch probability is 1 inside it).
     """
     px, py, body, bx, by = (float(state[k]) for k in (dyn.PX, dyn.PY, dyn.BODY, dyn.BX, dyn.BY))
     field = _field_image()
@@ -175,4 +180,18 @@ def draw_half_field(state: np.ndarray) -> np.ndarray:
     canvas.circle(*_to_px(px, py), max(dyn.PLAYER_SIZE * _PX_PER_M, 4.0), _PLAYER)
     theta = math.radians(body)
     canvas.line(*_to_px(px, py), *_to_px(px + 1.2 * math.cos(theta), py + 1.2 * math.sin(theta)), _LINE, 2.0)
+    if goalie:
+        _draw_goalie(canvas, state)
     return canvas.image
+
+
+def _draw_goalie(canvas: Canvas, state: np.ndarray) -> None:
+    gx, gy, body = (float(state[k]) for k in (defense.GX, defense.GY, defense.GBODY))
+    c, s = math.cos(math.radians(body)), math.sin(math.radians(body))
+    box = [(0.0, -_CATCH_HALF_W), (_CATCH_L, -_CATCH_HALF_W), (_CATCH_L, _CATCH_HALF_W), (0.0, _CATCH_HALF_W)]
+    corners = [_to_px(gx + u * c - v * s, gy + u * s + v * c) for u, v in box]
+    for (x0, y0), (x1, y1) in zip(corners, corners[1:] + corners[:1]):
+        canvas.line(x0, y0, x1, y1, _CATCH, 1.5)
+    # The disc and body line on top: the rectangle's back edge runs through the goalie's centre.
+    canvas.circle(*_to_px(gx, gy), max(dyn.PLAYER_SIZE * _PX_PER_M, 4.0), _GOALIE)
+    canvas.line(*_to_px(gx, gy), *_to_px(gx + 1.2 * c, gy + 1.2 * s), _LINE, 2.0)
