@@ -22,14 +22,9 @@ __all__ = [
     "make_vector_env",
     "describe_env",
     "info_action_masks",
-    "AUTO_BATCH_MIN",
     "Step",
     "VectorStepper",
 ]
-
-# A batched env steps its copies in one compiled loop; since the scalar env is the batched one at one copy, even a
-# single copy steps faster batched than through SyncVectorEnv's per-copy Python (benchmarks/platform_speed.md).
-AUTO_BATCH_MIN = 1
 
 
 def env_spec(env_id: str) -> gymnasium.envs.registration.EnvSpec:
@@ -60,15 +55,14 @@ def make_vector_env(
     env_id: str, num_envs: int, env_kwargs: dict | None = None, mode: str = "auto"
 ) -> gymnasium.vector.VectorEnv:
     """``num_envs`` copies of the env: ``"batched"`` (its ``vector_entry_point``), ``"sync"`` (scalar copies
-    stepped in turn) or ``"auto"`` (batched from ``AUTO_BATCH_MIN`` copies on, when the env has a batched
-    version).
+    stepped in turn) or ``"auto"`` (batched whenever the env has a batched version: the scalar env is the batched
+    one at one copy, so even one copy steps faster in one compiled loop than through ``SyncVectorEnv``'s per-copy
+    Python, benchmarks/platform_speed.md).
     """
     if mode not in ("auto", "batched", "sync"):
         raise ValueError(f"vector env mode {mode!r}; expected 'auto', 'batched' or 'sync'")
     spec = env_spec(env_id)
-    batched = spec.vector_entry_point is not None and (
-        mode == "batched" or (mode == "auto" and num_envs >= AUTO_BATCH_MIN)
-    )
+    batched = spec.vector_entry_point is not None and mode != "sync"
     if mode == "batched" and spec.vector_entry_point is None:
         raise ValueError(f"{env_id} has no batched version (no vector_entry_point); use 'sync'")
     vectorization_mode = "vector_entry_point" if batched else "sync"
