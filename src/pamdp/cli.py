@@ -217,6 +217,13 @@ def build_parser() -> argparse.ArgumentParser:
         )
         p.add_argument("--config", default=None, help="TOML or JSON file of settings")
         p.add_argument(
+            "--init-from",
+            default=None,
+            metavar="MODEL",
+            help="start the networks from a model of the same algorithm (a run directory or model file), trained on "
+            "this env or one whose features this env's observation extends (Half Field Offense 1v0 for 1v1)",
+        )
+        p.add_argument(
             "--eval-episodes", type=_count, default=1000, help="greedy evaluation episodes at the end (0: none)"
         )
         p.add_argument(
@@ -309,6 +316,7 @@ def _train_spec(args, cls) -> RunSpec:
         "",
         env_kwargs,
         args.eval_every,
+        args.init_from or "",
     )
 
 
@@ -348,7 +356,7 @@ def cmd_reproduce(args) -> int:
         raise ValueError(f"--out {args.out}: {file} is a file; expected a results directory (new, or one to go on in)")
     seeds = args.seeds
     labels = args.runs
-    jobs = [(spec, str(exp.run_dir(args.out, spec))) for spec in exp.specs(seeds, args.scale, labels)]
+    jobs = exp.jobs(args.out, exp.specs(seeds, args.scale, labels))
     for spec, _ in jobs:
         spec.check()  # every setting and env argument is checked before the first run starts
     if args.status:

@@ -15,7 +15,15 @@ from typing import IO
 
 import torch
 
-__all__ = ["FINAL_MODEL", "CHECKPOINT", "FORMAT", "atomic_save", "atomic_write_text", "read_checkpoint"]
+__all__ = [
+    "FINAL_MODEL",
+    "CHECKPOINT",
+    "FORMAT",
+    "atomic_save",
+    "atomic_write_text",
+    "read_checkpoint",
+    "transfer_weights",
+]
 
 FINAL_MODEL = "final_model.pt"
 CHECKPOINT = "checkpoint.pt"
@@ -95,3 +103,74 @@ def read_checkpoint(path: str | os.PathLike) -> dict:
     if not isinstance(payload, dict) or payload.get("format") != FORMAT:
         raise ValueError(f"{path} is not a pamdp checkpoint (no '{FORMAT}' header)")
     return payload
+
+
+def transfer_weights(model, source: str | os.PathLike, input_columns: list[int | None] | None = None) -> dict[str, str]:
+    """Start ``model``'s networks from those of ``source`` (a model file or run directory of the same algorithm and
+    action space), trained on an env whose observation may differ: a warm start, not a resumption (optimisers,
+    counters and random states stay ``model``'s own).
+
+    ``input_columns``: for each feature of ``model``'s observation, the index of the same feature in ``source``'s
+    observation, or ``None`` for a feature ``source`` never saw, whose input weights start at zero (so the network
+    first computes what ``source``'s did, ignoring the new features). ``None``: the same observation. A network
+    reads the observation first and what follows it (an action's one-hot, a parameter vector) after, so a weight
+    matrix whose input width differs from ``source``'s by the observations' difference has its observation columns
+    mapped and the rest copied. Returns ``{tensor: "copied" or "inputs mapped"}``; any other mismatch is a
+    ``ValueError`` naming the tensor, before ``model`` is changed.
+    """
+    payload = read_checkpoint(source)
+    if payload["algo"] != type(model).__name__:
+        raise ValueError(f"{source} holds a {payload['algo']} model; expected a {type(model).__name__} one")
+    shapes, own = payload.get("shapes") or {}, model._shapes()
+    if shapes.get("parameters") != own["parameters"]:
+        raise ValueError(
+            f"{source}'s actions have parameter counts {shapes.get('parameters')}, this env's {own['parameters']}; "
+            "expected the same action space"
+        )
+    old, new = int(shapes["observation"][0]), int(own["observation"][0])
+    columns = list(range(new)) if input_columns is None else list(input_columns)
+    if len(columns) != new or any(c is not None and not 0 <= c < old for c in columns):
+        raise ValueError(
+            f"input_columns = {input_columns!r:.80}; expected {new} entries, each an index below {old} or None"
+        )
+    if old == new and columns != list(range(new)):  # the input layers would not be told from the hidden ones
+        raise ValueError(f"input_columns = {input_columns!r:.80}; expected None: both observations have {new} features")
+    states, report = {}, {}
+    for name, module in model._modules().items():
+        saved = payload["modules"].get(name)
+        if saved is None:
+            raise ValueError(f"{source} has no network {name!r}; expected a model made with the same settings")
+        states[name] = {}
+        for key, target in module.state_dict().items():
+            weight = saved.get(key)
+            fits = weight is not None and weight.ndim == target.ndim
+            mapped = _map_observation(weight, target, columns, old) if fits else None
+            if mapped is None:
+                raise ValueError(
+                    f"{name}.{key} is {tuple(target.shape)} here and "
+                    f"{None if weight is None else tuple(weight.shape)} in {source}; expected the same settings"
+                )
+            states[name][key], report[f"{name}.{key}"] = mapped, "copied" if mapped is weight else "inputs mapped"
+    for name, module in model._modules().items():
+        module.load_state_dict(states[name])
+    return report
+
+
+def _map_observation(weight: torch.Tensor, target: torch.Tensor, columns: list[int | None], old: int):
+    """``weight`` reshaped to ``target``'s shape along the axis where the two differ by the observations'
+    difference (its first ``old`` entries the observation's, mapped by ``columns``, the rest kept); ``weight``
+    itself where the shapes agree; ``None`` where they differ otherwise."""
+    if weight.shape == target.shape:
+        return weight
+    new = len(columns)
+    differing = [axis for axis in range(weight.ndim) if weight.shape[axis] != target.shape[axis]]
+    axis = differing[0]
+    if len(differing) > 1 or weight.shape[axis] - old != target.shape[axis] - new or weight.shape[axis] < old:
+        return None
+    mapped = torch.zeros_like(target).movedim(axis, 0)
+    source = weight.movedim(axis, 0)
+    for j, i in enumerate(columns):
+        if i is not None:
+            mapped[j] = source[i]
+    mapped[new:] = source[old:]
+    return mapped.movedim(0, axis).contiguous()

@@ -3,7 +3,8 @@
 Each experiment is a TOML file in ``configs/`` (one per figure of the paper, and ``benchmark-suite``): the env,
 the budget, the seeds, optional ``env_kwargs`` for the env's constructor, and a list of runs (a label, an
 algorithm, a preset, setting overrides, and optionally their own ``env``, ``env_kwargs``, ``total_steps`` and
-``eval_every``: a suite of domains gives each its own budget). The experiment's ``env`` and ``total_steps``
+``eval_every``: a suite of domains gives each its own budget; ``init_from``, the label of an earlier run whose
+final model of the same seed starts this one's networks: a curriculum). The experiment's ``env`` and ``total_steps``
 may be left out where every run gives its own.
 """
 
@@ -70,12 +71,23 @@ class Experiment:
                         run["label"],
                         env_kwargs,
                         run.get("eval_every", self.eval_every),
+                        run.get("init_from", ""),
                     )
                 )
         return out
 
     def run_dir(self, root: str | os.PathLike, spec: RunSpec) -> Path:
         return Path(root) / self.name / _slug(spec.label) / f"seed{spec.seed}"
+
+    def jobs(self, root: str | os.PathLike, specs: list[RunSpec]) -> list[tuple[RunSpec, str]]:
+        """``(spec, run directory)`` for each spec, a run's ``init_from`` label turned into that run's directory
+        for the same seed (which must finish first: runs that start from another come after it in the file)."""
+
+        def started(spec: RunSpec) -> RunSpec:
+            source = self.run_dir(root, dataclasses.replace(spec, label=spec.init_from))
+            return dataclasses.replace(spec, init_from=str(source)) if spec.init_from else spec
+
+        return [(started(spec), str(self.run_dir(root, spec))) for spec in specs]
 
 
 def _slug(label: str) -> str:
@@ -117,7 +129,7 @@ def load_experiment(name_or_path: str | os.PathLike) -> Experiment:
 
 MAX_STEPS = 10**12  # as ``pamdp train --total-steps``: a budget beyond this is a typing slip
 _KEYS = {"description", "env", "total_steps", "seeds", "eval_episodes", "eval_every", "env_kwargs", "runs"}
-_RUN_KEYS = {"label", "algo", "preset", "settings", "env", "env_kwargs", "total_steps", "eval_every"}
+_RUN_KEYS = {"label", "algo", "preset", "settings", "env", "env_kwargs", "total_steps", "eval_every", "init_from"}
 
 
 def _whole(value, low: int, high: int | None = None) -> bool:
@@ -175,6 +187,8 @@ def _check_experiment(path: Path, data: dict) -> None:
             refuse(f"runs[{i}].total_steps", run["total_steps"], budget)
         if "eval_every" in run and not _count(run["eval_every"]):
             refuse(f"runs[{i}].eval_every", run["eval_every"], "an integer >= 0")
+        if "init_from" in run and run["init_from"] not in [r.get("label") for r in runs[:i]]:
+            refuse(f"runs[{i}].init_from", run["init_from"], "the label of a run listed before it")
         slug = _slug(str(run["label"]))
         if slug in dirs:
             refuse(f"runs[{i}].label", run["label"], f"a label whose directory differs from {dirs[slug]!r}'s ({slug})")

@@ -55,6 +55,7 @@ class RunSpec:
     label: str = ""
     env_kwargs: tuple[tuple[str, Any], ...] = ()
     eval_every: int = 0  # epochs between greedy evaluations of 100 episodes during training (0: none)
+    init_from: str = ""  # a model file or run directory whose networks start this run's (transfer_weights)
 
     def config(self) -> RunConfig:
         """The run's algorithm and settings: its preset (the env's where it names none, as
@@ -255,6 +256,8 @@ def _prepare(
         run_info["preset_warning"] = warning
     if spec.label:  # what figures and tables call the run (its directory holds a file-name-safe form)
         run_info["label"] = spec.label
+    if spec.init_from:
+        run_info["init_from"] = spec.init_from
     run_file, eval_file = out / "run.json", out / "evaluation.json"
     if (out / CHECKPOINT).exists() or (out / FINAL_MODEL).exists():
         as_written = _read_run_json(run_file)
@@ -289,8 +292,47 @@ def _prepare(
     else:
         _check_fresh_directory(out)
         model = cls(spec.env, config, env_kwargs=dict(spec.env_kwargs))
+        if spec.init_from:
+            _warm_start(model, spec.init_from, log)
     atomic_write_text(run_file, json.dumps({**run_info, "command": sys.argv}, indent=2))
     return model, None
+
+
+def _warm_start(model, source: str, log) -> None:
+    """Start ``model``'s networks from the model in ``source``, its observation's features matched by name where
+    the two envs' observations differ (``feature_names`` of their domains, e.g. Half Field Offense 1v0 and 1v1)."""
+    from pamdp.algos.checkpoints import read_checkpoint, transfer_weights
+
+    payload = read_checkpoint(source)
+    new = model.observation_space.shape[0]
+    old = int((payload.get("shapes") or {}).get("observation", [new])[0])
+    columns = None
+    if old != new:
+        names = _feature_names(model.env_id, model.env_kwargs)
+        source_names = _feature_names(payload.get("env_id"), payload.get("env_kwargs") or {})
+        if names is None or source_names is None or len(source_names) != old:
+            raise ValueError(
+                f"cannot start from {source}: its env's observation has {old} features, this one's {new}, and the "
+                "envs do not name their features; expected a model of an env with this observation"
+            )
+        columns = [source_names.index(n) if n in source_names else None for n in names]
+    mapped = sum(v == "inputs mapped" for v in transfer_weights(model, source, columns).values())
+    new_features = 0 if columns is None else sum(c is None for c in columns)
+    log(f"networks started from {source} ({mapped} input layers mapped, {new_features} new features start at 0)")
+
+
+def _feature_names(env_id: str | None, env_kwargs: dict) -> list[str] | None:
+    """The names of an env's observation features, where its domain gives them."""
+    if env_id is None:
+        return None
+    import gymnasium as gym
+
+    env = gym.make(env_id, **env_kwargs)
+    try:
+        names = getattr(getattr(env.unwrapped, "domain", None), "feature_names", None)
+        return None if names is None else list(names)
+    finally:
+        env.close()
 
 
 def _train(model, spec: RunSpec, out: str | os.PathLike, progress_bar: bool, log=print, callback=None) -> dict:

@@ -41,7 +41,14 @@ from gymnasium import spaces
 
 import pamdp.envs.hfo.defense as defense
 import pamdp.envs.hfo.dynamics as dyn
-from pamdp.envs.hfo.interface import check_settings, draw_half_field, hfo_action_space, parse_actions, reset_options
+from pamdp.envs.hfo.interface import (
+    check_settings,
+    draw_half_field,
+    feature_names,
+    hfo_action_space,
+    parse_actions,
+    reset_options,
+)
 from pamdp.envs.scalar import env_classes
 from pamdp.envs.vector import Domain
 
@@ -87,6 +94,7 @@ class HalfFieldOffense(Domain):
             self.name = "Half Field Offense 1v1"
         self._step_batch = defense.step_batch if self.goalie else dyn.step_batch
         self._reset_batch = defense.reset_batch if self.goalie else dyn.reset_batch
+        self.feature_names = feature_names(self.profile.n_features, self.goalie)
         self.observation_space = spaces.Box(-1.0, 1.0, (self.n_features,), dtype=np.float32)
         self.action_space = hfo_action_space()
 

@@ -32,6 +32,31 @@ def hfo_action_space() -> spaces.Tuple:
     return spaces.Tuple((spaces.Discrete(3), spaces.Tuple(boxes)))
 
 
+_LANDMARKS = (
+    "goal_centre", "goal_post_top", "goal_post_bottom", "penalty_centre", "penalty_corner_top",
+    "penalty_corner_bottom", "field_centre", "corner_top_left", "corner_top_right", "corner_bottom_right",
+    "corner_bottom_left",
+)  # fmt: skip
+_BASIC_FEATURES = (
+    ("self_pos_valid", "self_vel_valid", "self_vel_dir_sin", "self_vel_dir_cos", "self_speed", "body_sin", "body_cos",
+     "stamina", "frozen", "colliding_ball", "colliding_player", "colliding_post", "kickable")
+    + tuple(f"{name}_{part}" for name in _LANDMARKS for part in ("sin", "cos", "proximity"))
+    + ("oob_left", "oob_right", "oob_top", "oob_bottom", "ball_pos_valid", "ball_sin", "ball_cos", "ball_proximity",
+       "ball_vel_valid", "ball_speed", "ball_vel_dir_sin", "ball_vel_dir_cos")
+)  # fmt: skip
+_OPPONENT_FEATURES = ("sin", "cos", "proximity", "body_sin", "body_cos", "speed", "vel_dir_sin", "vel_dir_cos")
+
+
+def feature_names(n_basic_plus_flag: int, goalie: bool) -> tuple[str, ...]:
+    """The name of every observation feature, in order (HFO's low-level feature set): the 58 basic ones, the
+    goalie's block (``opponent0_*``, its uniform number with ``n_basic_plus_flag`` = 59) and the last-action flag
+    where the profile has it. The same feature has the same name in 1v0 and 1v1, so a policy's input weights can be
+    carried from one to the other by name (``pamdp train --init-from``)."""
+    flag = n_basic_plus_flag == 59
+    names = _BASIC_FEATURES + tuple(f"opponent0_{f}" for f in _OPPONENT_FEATURES) * goalie
+    return names + ("opponent0_unum",) * (goalie and flag) + ("last_action_ok",) * flag
+
+
 def check_settings(profile: str, body_reset: str, defense_npcs: int = 0) -> None:
     """Raise ``ValueError`` for an unknown feature profile, body-reset rule or number of defense NPCs (the shell
     checks the render mode)."""

@@ -1,0 +1,102 @@
+"""Starting a model from another's networks (``transfer_weights``, ``pamdp train --init-from``, an experiment's
+``init_from``): Half Field Offense 1v1 extends 1v0's observation by the goalie's block, so a 1v1 model started from a
+1v0 one must act, on any 1v1 observation, as the 1v0 model acts on that observation without the goalie's features."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import pamdp  # noqa: F401  (registers the envs)
+from pamdp.algos import ALGORITHMS, algorithm_class
+from pamdp.algos.checkpoints import transfer_weights
+from pamdp.experiments import load_experiment
+from pamdp.experiments.runner import _warm_start
+
+ONE_V_ZERO, ONE_V_ONE = "pamdp/HalfFieldOffense-v0", "pamdp/HalfFieldOffenseGoalie-v0"
+
+
+@pytest.fixture(scope="module")
+def goalie_observations():
+    """Observations of 1v1 play under random actions: the goalie's features vary."""
+    env = gym.make(ONE_V_ONE)
+    env.action_space.seed(3)
+    obs, _ = env.reset(seed=3)
+    seen = [obs]
+    for _ in range(120):
+        obs, _, terminated, truncated, _ = env.step(env.action_space.sample())
+        seen.append(obs)
+        if terminated or truncated:
+            obs, _ = env.reset()
+    env.close()
+    return np.array(seen[::10], dtype=np.float32)
+
+
+def _without_goalie(obs: np.ndarray) -> np.ndarray:
+    """The 1v0 observation of the same state (the feature table of HFO's low-level set): the 58 basic features,
+    then the last-action flag; the goalie's eight features and its uniform number (58-66) dropped."""
+    return np.concatenate([obs[:, :58], obs[:, 67:]], axis=1)
+
+
+@pytest.mark.parametrize("algo", sorted(ALGORITHMS))
+def test_a_1v1_model_started_from_a_1v0_one_acts_as_it(algo, tmp_path, goalie_observations):
+    cls = algorithm_class(algo)
+    source = cls(ONE_V_ZERO, cls.config_class.preset("tuned" if "tuned" in cls.config_class.presets() else "paper"))
+    source.save(tmp_path / "source.pt")
+    model = cls(ONE_V_ONE, source.config)
+    _warm_start(model, str(tmp_path / "source.pt"), log=lambda msg: None)
+    k_new, p_new = model.predict(goalie_observations, deterministic=True)[0], model.predict(goalie_observations)[1]
+    k_old, p_old = source.predict(_without_goalie(goalie_observations), deterministic=True)
+    np.testing.assert_array_equal(k_new, k_old)
+    for new, old in zip(p_new, p_old):
+        np.testing.assert_allclose(new, old, rtol=1e-4, atol=1e-3)  # float32 sums in another order
+
+
+def test_refused_sources_name_what_differs(tmp_path):
+    patrpo = algorithm_class("patrpo")
+    platform = patrpo("pamdp/Platform-v0")
+    platform.save(tmp_path / "platform.pt")
+    model = patrpo(ONE_V_ONE)
+    with pytest.raises(ValueError, match=r"parameter counts \[1, 1, 1\].*\[2, 1, 2\]"):
+        transfer_weights(model, tmp_path / "platform.pt", [None] * 68)
+    pappo = algorithm_class("pappo")(ONE_V_ZERO)
+    pappo.save(tmp_path / "pappo.pt")
+    with pytest.raises(ValueError, match="holds a PAPPO model; expected a PATRPO one"):
+        transfer_weights(model, tmp_path / "pappo.pt")
+    source = patrpo(ONE_V_ZERO)
+    source.save(tmp_path / "source.pt")
+    before = {k: v.clone() for k, v in model.policy.state_dict().items()}
+    with pytest.raises(ValueError, match="expected 68 entries, each an index below 59 or None"):
+        transfer_weights(model, tmp_path / "source.pt", [0] * 67)
+    with pytest.raises(ValueError, match="expected 68 entries"):
+        transfer_weights(model, tmp_path / "source.pt", [59] * 68)
+    assert all((before[k] == v).all() for k, v in model.policy.state_dict().items())  # refused before any change
+
+
+def test_an_experiment_starts_only_from_an_earlier_run(tmp_path):
+    body = """
+description = "curriculum"
+env = "pamdp/Platform-v0"
+total_steps = 1000
+seeds = [0, 1]
+[[runs]]
+label = "second"
+algo = "patrpo"
+init_from = "{source}"
+[[runs]]
+label = "first"
+algo = "patrpo"
+"""
+    bad = tmp_path / "bad.toml"
+    bad.write_text(body.format(source="first"))
+    with pytest.raises(ValueError, match=r"runs\[0\].init_from = 'first'; expected the label of a run listed before"):
+        load_experiment(bad)
+    good = tmp_path / "good.toml"
+    good.write_text(body.replace('label = "second"', 'label = "zero"\nalgo = "patrpo"\n[[runs]]\nlabel = "second"', 1)
+                    .format(source="zero"))  # fmt: skip
+    exp = load_experiment(good)
+    jobs = exp.jobs(tmp_path / "out", exp.specs())
+    second = [(spec, out) for spec, out in jobs if spec.label == "second"]
+    sources = [str(tmp_path / "out" / "good" / "zero" / f"seed{s}") for s in (0, 1)]
+    assert [spec.init_from for spec, _ in second] == sources
