@@ -87,6 +87,9 @@ def _public_objects() -> dict[str, object]:
             domain = _entry_point(spec.entry_point).domain_class
             objects[f"{domain.__module__}.{domain.__qualname__}"] = domain
     objects |= {"DomainEnv": DomainEnv, "DomainVectorEnv": DomainVectorEnv, "Domain": Domain}
+    if importlib.util.find_spec("pettingzoo") is not None:  # the optional multi-agent interface (issue 47)
+        multiagent = importlib.import_module("pamdp.envs.hfo.multiagent")
+        objects |= {f"pamdp.envs.hfo.multiagent.{n}": getattr(multiagent, n) for n in multiagent.__all__}
     return objects
 
 
