@@ -90,6 +90,8 @@ def test_same_seeds_give_the_single_agent_envs_trajectories(defense_npcs):
                 done = terminated or truncated
                 assert env.agents == ([] if done else ["offense_0"])
             statuses.add(info["status"])
+            with pytest.raises(ResetNeeded):  # the agent has left: stepping on needs a reset
+                env.step({"offense_0": action})
     assert len(statuses) >= 2, statuses  # more than one kind of ending was compared
 
 

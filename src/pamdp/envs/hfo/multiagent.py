@@ -55,7 +55,9 @@ class HalfFieldOffenseParallelEnv(ParallelEnv):
 
     metadata = {"name": "half_field_offense_v0", "render_modes": ["rgb_array"], "is_parallelizable": True}
 
-    def __init__(self, offense_agents: int = 1, defense_npcs: int = 1, render_mode: str | None = None, **settings):
+    def __init__(
+        self, offense_agents: int = 1, defense_npcs: int = 1, render_mode: str | None = None, **settings: object
+    ):
         if isinstance(offense_agents, bool) or offense_agents != 1:
             raise ValueError(f"offense_agents={offense_agents!r}; expected 1 (more offense agents are not implemented)")
         self._env = HalfFieldOffenseEnv(render_mode=render_mode, defense_npcs=defense_npcs, **settings)
@@ -141,7 +143,7 @@ class HalfFieldOffenseParallelEnv(ParallelEnv):
         return single
 
 
-def parallel_env(defense_npcs: int = 1, **kwargs) -> HalfFieldOffenseParallelEnv:
+def parallel_env(defense_npcs: int = 1, **kwargs: object) -> HalfFieldOffenseParallelEnv:
     """HFO's offense as a PettingZoo ``ParallelEnv``, by PettingZoo's naming convention: 1v1 against the goalie by
     default, ``defense_npcs=0`` for the empty goal; ``kwargs`` as :class:`HalfFieldOffenseParallelEnv` takes them."""
     return HalfFieldOffenseParallelEnv(defense_npcs=defense_npcs, **kwargs)
