@@ -9,6 +9,8 @@ and 1v1 against HFO's goalie (``defense_npcs=1``): ``pamdp/HalfFieldOffenseGoali
   a description of its rules) and the server rules a second player brings (catch, tackle, collisions).
 - ``interface``: the action space, the checks of actions and reset options, the drawing.
 - ``scorer``: a hand-written agent that scores almost always, the benchmarks' reference row.
+- ``multiagent``: the offense as a PettingZoo ``ParallelEnv`` (``parallel_env()``, PettingZoo's convention), read
+  from here on first use, so that importing pamdp never imports the optional PettingZoo.
 
 Score on an empty goal from a random start, with HFO's low-level actions and features: a simulation of
 rcssserver 15.2.2 and of HFO's agent and referee (``dynamics``). Actions in HFO's units: DASH(power in
@@ -32,3 +34,13 @@ __all__ = [
     "scripted_scorer",
     "scripted_scorer_batch",
 ]
+
+_MULTIAGENT = ("HalfFieldOffenseParallelEnv", "parallel_env")
+
+
+def __getattr__(name: str):
+    if name in _MULTIAGENT:
+        from pamdp.envs.hfo import multiagent
+
+        return getattr(multiagent, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
