@@ -148,3 +148,16 @@ def test_evaluation_reports_the_success_rate_the_env_saw():
     # success probability 0.6 among the terminated episodes (80%): within 5 standard errors
     assert abs(result["success_rate"] - 0.6) < 5 * np.sqrt(0.24 / 320)
     assert 1 <= result["mean_steps_to_success"] <= 6
+
+
+def test_evaluation_counts_each_ending_that_the_env_reports():
+    """HFO 1v1 reports ``info["status"]`` at every episode's end: the endings' shares are counts over the episodes
+    played, and GOAL's share is the goal rate computed from ``is_success``, another key of the same infos."""
+    model = PATRPO("pamdp/HalfFieldOffenseGoalie-v0", PATRPOConfig(seed=4, num_envs=4, batch_size=200))
+    result = evaluate(model, episodes=12, seed=4, deterministic=False, num_envs=4)
+    endings = result["endings"]
+    assert set(endings) <= {"GOAL", "OUT_OF_BOUNDS", "OUT_OF_TIME", "CAPTURED_BY_DEFENSE"}
+    assert sum(endings.values()) == pytest.approx(1.0)
+    assert all((share * 12) == pytest.approx(round(share * 12)) for share in endings.values())
+    assert endings.get("GOAL", 0.0) == pytest.approx(result["success_rate"])
+    assert "endings" not in evaluate(PATRPO("pamdp/Platform-v0", PATRPOConfig(seed=4)), episodes=3)  # no status

@@ -405,7 +405,12 @@ def _print_report(report: dict) -> None:
 
 # -- evaluate, render ----------------------------------------------------------------------------
 # What a success is where the env's own word says it better than "success" (``info["is_success"]``)
-SUCCESS_WORDS = {"pamdp/HalfFieldOffense-v0": "goal", "pamdp/Goal-v0": "goal", "pamdp/HardGoal-v0": "goal"}
+SUCCESS_WORDS = {
+    "pamdp/HalfFieldOffense-v0": "goal",
+    "pamdp/HalfFieldOffenseGoalie-v0": "goal",
+    "pamdp/Goal-v0": "goal",
+    "pamdp/HardGoal-v0": "goal",
+}
 
 
 def _format_evaluation(result: dict, policy: str = "greedy", env_id: str | None = None) -> str:
@@ -421,6 +426,8 @@ def _format_evaluation(result: dict, policy: str = "greedy", env_id: str | None 
     if rate is not None:
         word = SUCCESS_WORDS.get(env_id, "success")
         text += f"; {word} rate {rate:.3f}" + (f", {steps:.1f} steps to {word}" if steps is not None else "")
+    if len(result.get("endings", {})) > 1:  # how the others ended, where the env says (HFO's statuses)
+        text += "; endings: " + ", ".join(f"{name} {share:.3f}" for name, share in result["endings"].items())
     return text
 
 

@@ -29,7 +29,8 @@ def evaluate(
     over-represented. Returns ``mean_return``, ``std_return``, ``mean_length`` and ``episodes``; when the
     env reports ``info["is_success"]`` at an episode's end (a goal on Half Field Offense and Goal, a target
     reached or caught on the others), also ``success_rate`` and ``mean_steps_to_success`` (``None`` when no
-    episode succeeded), over the episodes that reported it.
+    episode succeeded), over the episodes that reported it; when it reports ``info["status"]`` (Half Field
+    Offense's GOAL, CAPTURED_BY_DEFENSE, ...), also ``endings``, each status's share of those episodes.
     """
     integer = isinstance(episodes, (int, np.integer)) and not isinstance(episodes, (bool, np.bool_))
     if not (integer or isinstance(episodes, (float, np.floating)) and float(episodes).is_integer()) or episodes < 1:
@@ -44,18 +45,22 @@ def evaluate(
     returns: list[float] = []
     lengths: list[int] = []
     succeeded: list[bool | None] = []
+    endings: dict[str, int] = {}
     done_count = np.zeros(num_envs, dtype=np.int64)
     # the env's info["action_mask"], as in training
     stepper = VectorStepper(env, model.hybrid.n_actions, model.config.action_mask, seed)
     try:
         while np.any(done_count < quota):
             step = stepper.step(model.predict(stepper.obs, deterministic=deterministic, action_mask=stepper.masks))
+            status = step.info.get("status") if step.ended.size else None
             for i, ret, length, success in zip(step.ended, step.returns, step.lengths, step.successes):
                 if done_count[i] < quota[i]:
                     returns.append(float(ret))
                     lengths.append(int(length))
                     succeeded.append(success)
                     done_count[i] += 1
+                    if status is not None and step.info.get("_status", np.ones(len(status), bool))[i]:
+                        endings[str(status[i])] = endings.get(str(status[i]), 0) + 1
     finally:
         env.close()
     result = {
@@ -67,4 +72,6 @@ def evaluate(
     summary = success_summary(lengths, succeeded)
     if summary is not None:
         result["success_rate"], result["mean_steps_to_success"] = summary
+    if endings:
+        result["endings"] = {name: count / sum(endings.values()) for name, count in sorted(endings.items())}
     return result
