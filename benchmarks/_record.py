@@ -142,7 +142,8 @@ def seed_by_seed(
     still compares them, each run resuming from its checkpoint or skipped once finished; ``write(arms)`` rewrites
     the record before and after each seed's runs (``train=False``: only before). ``arms``: ``{label: [(RunSpec,
     run dir), ...]}`` in seed order."""
-    arms = {label: [(s, exp.run_dir(out_root, s)) for s in exp.specs(seeds, labels=[label])] for label in labels}
+    jobs = {label: exp.jobs(out_root, exp.specs(seeds, labels=[label])) for label in labels}
+    arms = {label: [(spec, Path(out)) for spec, out in pairs] for label, pairs in jobs.items()}
     write(arms)
     for i in range(len(seeds) if train else 0):
         todo = [arms[label][i] for label in labels if not is_finished(arms[label][i][1], arms[label][i][0])]
@@ -189,7 +190,7 @@ def run_and_record(
     """
     exp = load_experiment(HERE / experiment if experiment.endswith(".toml") else experiment)
     specs = exp.specs(seeds, scale, runs)
-    jobs = [(s, str(exp.run_dir(out_root, s))) for s in specs]
+    jobs = exp.jobs(out_root, specs)
     finished_before = all(is_finished(Path(out), spec) for spec, out in jobs)
     t0 = time.time()
     outcomes = run_all(jobs, workers=workers)

@@ -3,6 +3,8 @@
     nice python benchmarks/bench_hfo_learning.py [--runs "PATRPO tuned,MP-DQN"] [--seeds 0,1,2] [--workers 2]
         [--out DIR] [--record-only]
 
+(Against the goalie, 1v1: bench_hfo_goalie_learning.py, the same record with the capture rate.)
+
 Runs the chosen arms (default: every arm of the file) seed by seed, each resuming from its checkpoint, and after
 every finished run rewrites benchmarks/hfo_learning.md: per arm, each finished seed's greedy goal rate and mean
 steps to goal over 1000 episodes, their medians over seeds (the issue's measure), the cost per sample, and the
@@ -35,21 +37,28 @@ from pamdp.experiments.runner import is_finished
 RECORD = HERE / "hfo_learning.md"
 
 
-def _arm_row(label: str, jobs) -> str:
+CAPTURED = "CAPTURED_BY_DEFENSE"
+
+
+def _arm_row(label: str, jobs, captures: bool = False) -> str:
     """One line of the table: the finished seeds' goal rates and steps, their medians, the cost per sample, and
-    where the unfinished seeds stand."""
+    where the unfinished seeds stand; ``captures``: also each seed's share of episodes the goalie captured."""
     done, costs, partial = [], [], []
     for spec, out in jobs:
         rows = progress_rows(out)
         if is_finished(out, spec):
-            rate, steps = success_of(json.loads((out / "evaluation.json").read_text()))
-            done.append((spec.seed, rate, steps))
+            evaluation = json.loads((out / "evaluation.json").read_text())
+            rate, steps = success_of(evaluation)
+            done.append((spec.seed, rate, steps, evaluation.get("endings", {}).get(CAPTURED, 0.0)))
             costs.append(cpu_ms_per_sample(rows))
         elif rows:
             partial.append(where_unfinished(spec, rows, "eval/success_rate"))
-    per_seed = ", ".join(f"{s}: {r:.3f} in {n:.1f}" if n else f"{s}: {r:.3f}" for s, r, n in done)
-    rates = [r for _, r, _ in done]
-    steps = [n for _, _, n in done if n]
+    per_seed = ", ".join(
+        (f"{s}: {r:.3f} in {n:.1f}" if n else f"{s}: {r:.3f}") + (f" (captured {c:.3f})" if captures else "")
+        for s, r, n, c in done
+    )
+    rates = [r for _, r, _, _ in done]
+    steps = [n for _, _, n, _ in done if n]
     return (
         f"| {label} | {jobs[0][0].total_steps:,} | {len(done)} of {len(jobs)} | {per_seed or '-'} "
         f"| {f'{np.median(rates):.3f}' if rates else '-'} | {f'{np.median(steps):.1f}' if steps else '-'} "
@@ -57,17 +66,19 @@ def _arm_row(label: str, jobs) -> str:
     )
 
 
-def write(exp, arms: dict, out_root: str, command: str) -> None:
+def write(exp, arms: dict, out_root: str, command: str, record: Path = RECORD, captures: bool = False) -> None:
+    """Rewrite ``record`` (its hand-written notes kept) from the runs of ``arms`` under ``out_root``."""
     lines = record_head(exp.description, command, rewritten=True) + [
         "- each arm with the preset its `--env` picks unless named, `action_mask = true` unless the label says "
-        '"no mask" ([hfo_learning.toml](hfo_learning.toml)); goal rate and steps to goal: 1000 greedy episodes '
-        "of each seed's final model",
+        f'"no mask" ([{exp.name}.toml]({exp.name}.toml)); goal rate and steps to goal'
+        + (", and the share of episodes the goalie captured" * captures)
+        + ": 1000 greedy episodes of each seed's final model",
         "",
         "| arm | samples | seeds done | goal rate in steps, per seed | median goal rate | median steps to goal "
         "| CPU ms per sample | unfinished |",
         "|---|---|---|---|---|---|---|---|",
     ]
-    lines += [_arm_row(label, jobs) for label, jobs in arms.items()]
+    lines += [_arm_row(label, jobs, captures) for label, jobs in arms.items()]
     lines += [
         "",
         "CPU ms per sample: the run's CPU time in training (its greedy evaluations left out) over its samples, "
@@ -76,10 +87,10 @@ def write(exp, arms: dict, out_root: str, command: str) -> None:
     ]
     started = [out.parent for jobs in arms.values() for _, out in jobs if progress_rows(out)]
     if started:
-        report = write_report(list(dict.fromkeys(started)), Path(out_root) / exp.name / "report-hfo_learning")
+        report = write_report(list(dict.fromkeys(started)), Path(out_root) / exp.name / f"report-{exp.name}")
         for key, name in (("greedy_success_png", "greedy goal rate"), ("success_png", "training goal rate")):
             if key in report:
-                figure = HERE / "results" / f"hfo_learning_{key.removesuffix('_png')}.png"
+                figure = HERE / "results" / f"{exp.name}_{key.removesuffix('_png')}.png"
                 figure.parent.mkdir(exist_ok=True)
                 shutil.copy(report[key], figure)
                 lines += ["", f"![{name}](results/{figure.name})"]
@@ -88,7 +99,7 @@ def write(exp, arms: dict, out_root: str, command: str) -> None:
             "Greedy goal rate: 100 greedy episodes every `eval_every` epochs, mean +- std over seeds. Training goal "
             "rate: the share of each epoch's (stochastic, exploring) episodes that scored.",
         ]
-    write_record(lines, RECORD)
+    write_record(lines, record)
 
 
 if __name__ == "__main__":
