@@ -40,6 +40,7 @@ __all__ = [
     "cells",
     "stats_table",
     "aggregate_table",
+    "aggregate_line",
     "improvement_table",
     "efficiency_table",
     "plot_profiles",
@@ -186,14 +187,20 @@ def _stratified(by_domain: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     return {d: x for d, x in by_domain.items() if len(x) >= 2}
 
 
-def aggregate_table(summaries: list[dict]) -> str:
-    """Per method: the IQM and mean of its runs over the domains where it has 2 runs or more (its main setting's),
-    stratified by domain, and over the domains that every method has so (the only comparison of like with like)."""
+def _comparable(summaries: list[dict]) -> tuple[dict[str, dict[str, np.ndarray]], list[str]]:
+    """Each method's scores on the domains where it has 2 runs or more (its main setting's), and the domains every
+    such method has, in the suite's order."""
     by_method = {m: _stratified(d) for m, d in _main_cells(summaries).items()}
     by_method = {m: d for m, d in by_method.items() if d}
     shared = set.intersection(*(set(d) for d in by_method.values())) if by_method else set()
     order = [d[0] for d in DOMAINS]
-    shared_names = ", ".join(sorted(shared, key=lambda d: order.index(d) if d in order else len(order)))
+    return by_method, sorted(shared, key=lambda d: (order.index(d) if d in order else len(order), d))
+
+
+def aggregate_table(summaries: list[dict]) -> str:
+    """Per method: the IQM and mean of its runs over the domains where it has 2 runs or more (its main setting's),
+    stratified by domain, and over the domains that every method has so (the only comparison of like with like)."""
+    by_method, shared = _comparable(summaries)
     lines = [
         f"| method | domains | runs | IQM [95 % CI] | mean [95 % CI] | IQM on the {len(shared)} shared domains "
         "[95 % CI] |",
@@ -201,12 +208,35 @@ def aggregate_table(summaries: list[dict]) -> str:
     ]
     for method, by_domain in by_method.items():
         tasks = list(by_domain.values())
-        on_shared = [by_domain[d] for d in sorted(shared)]
+        on_shared = [by_domain[d] for d in shared]
         lines.append(
             f"| {method} | {len(tasks)} | {sum(map(len, tasks))} | {_estimate(tasks, stats.iqm)} | "
             f"{_estimate(tasks, np.mean)} | {_estimate(on_shared, stats.iqm) if on_shared else '-'} |"
         )
-    return "\n".join(lines) + (f"\n\nShared domains: {shared_names}." if shared else "")
+    return "\n".join(lines) + (f"\n\nShared domains: {', '.join(shared)}." if shared else "")
+
+
+def aggregate_line(summaries: list[dict]) -> str:
+    """One sentence of :func:`aggregate_table`: each method's IQM over its domains, best first, then on the shared
+    domains (for a page that has no room for the table)."""
+    by_method, shared = _comparable(summaries)
+
+    def listing(domains_of) -> str:
+        found = []
+        for method, by_domain in by_method.items():
+            tasks = [by_domain[d] for d in domains_of(by_domain)]
+            found.append((float(stats.iqm(np.concatenate(tasks))), method, tasks))
+        parts = [
+            f"{method} **{_estimate(tasks, stats.iqm)}** ({len(tasks)} domains, {sum(map(len, tasks))} runs)"
+            for _, method, tasks in sorted(found, key=lambda f: -f[0])
+        ]
+        return "; ".join(parts)
+
+    return (
+        "IQM of the final figures with 95 % stratified bootstrap intervals, over the domains where a method has 2 "
+        f"runs or more: {listing(list)}. On the {len(shared)} domains all share ({', '.join(shared)}): "
+        f"{listing(lambda _: shared)}."
+    )
 
 
 def improvement_table(summaries: list[dict]) -> str:
@@ -268,9 +298,7 @@ def plot_profiles(summaries: list[dict], path: str | os.PathLike, title: str = "
     """The performance profile of each method over the domains every method has 2 runs or more on (a profile over
     other domains would compare other tasks): the share of its runs scoring above each threshold, with the 95 %
     stratified bootstrap band; ``path`` with ``.png`` and ``.svg`` suffixes (nothing without such a domain)."""
-    by_method = {m: _stratified(d) for m, d in _main_cells(summaries).items()}
-    by_method = {m: d for m, d in by_method.items() if d}
-    shared = sorted(set.intersection(*(set(d) for d in by_method.values()))) if by_method else []
+    by_method, shared = _comparable(summaries)
     if not shared:
         return []
     import matplotlib
