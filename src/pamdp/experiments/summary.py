@@ -37,17 +37,25 @@ per-seed figures (only the final figure and what the entry recorded of the setti
 _EVAL_COLUMNS = {key: f"eval/{key}" for key in ("mean_return", "success_rate", "mean_length")}
 
 
-def git_commit(path: str | os.PathLike | None = None) -> str | None:
-    """The commit checked out where pamdp's source lies (``None`` for an installed package or without git)."""
-    where = Path(path) if path is not None else Path(__file__).parent
+def git_commit() -> str | None:
+    """The commit checked out where pamdp's source lies (changes not committed are not told apart): ``None`` for an
+    installed package (even one installed inside another project's repository, whose commit says nothing of
+    pamdp's code) or without git."""
+    package = Path(__file__).resolve().parents[1]
     try:
         done = subprocess.run(
-            ["git", "-C", str(where), "rev-parse", "HEAD"], capture_output=True, text=True, timeout=10, check=False
+            ["git", "-C", str(package), "rev-parse", "HEAD", "--show-toplevel"],
+            capture_output=True,
+            text=True,
+            timeout=10,
+            check=False,
         )
     except (OSError, subprocess.SubprocessError):
         return None
-    commit = done.stdout.strip()
-    return commit if done.returncode == 0 and re.fullmatch(r"[0-9a-f]{40}", commit) else None
+    lines = done.stdout.split()
+    if done.returncode != 0 or len(lines) != 2 or not re.fullmatch(r"[0-9a-f]{40}", lines[0]):
+        return None
+    return lines[0] if (Path(lines[1]) / "src" / "pamdp").resolve() == package else None
 
 
 def _number(text: str | None) -> float | None:
