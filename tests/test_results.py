@@ -176,3 +176,20 @@ def test_the_statistics_tables_hold_the_hand_computed_cells():
     # B's one evaluation, 0.0 at the end of its budget: never reached, so censored there
     assert efficiency[("| Goal", "B")] == ["2", "- / - / - / 0.00", "> 400 (0 of 2 reached)", "0.00 |"]
     assert ("| Platform", "A") not in efficiency  # no curve logged
+
+
+def test_the_figures_are_drawn_where_there_is_something_to_draw(tmp_path):
+    runs = _synthetic()
+    profiles = results.plot_profiles(runs, tmp_path / "profiles")
+    efficiency = results.plot_efficiency(runs, tmp_path / "efficiency")
+    assert [p.name for p in profiles + efficiency] == [
+        "profiles.png",
+        "profiles.svg",
+        "efficiency.png",
+        "efficiency.svg",
+    ]
+    assert all(0 < p.stat().st_size < 1_000_000 for p in profiles + efficiency)
+    assert "A (7 runs)" in profiles[1].read_text()  # both domains are shared: A's 3 + 4 runs
+    platform_only = [s for s in runs if s["env"] == "pamdp/Platform-v0"]  # no curves
+    assert results.plot_efficiency(platform_only, tmp_path / "none") == []
+    assert results.plot_profiles([runs[0]], tmp_path / "one") == []  # one run: no domain with 2 runs to resample

@@ -40,8 +40,9 @@ def write_report(
 
     ``stats.md`` holds the statistics of the runs' final figures (:func:`.results.report`: means and interquartile
     means with bootstrap intervals per method and domain, across domains, the probability of improvement between
-    methods, and the sample efficiency of the greedy curves), and ``profiles.png`` and ``.svg`` the performance
-    profiles of the methods over the domains they all ran.
+    methods, and the sample efficiency of the greedy curves), ``profiles.png`` and ``.svg`` the performance
+    profiles of the methods over the domains they all ran, and ``efficiency.png`` and ``.svg`` the greedy curves over
+    the fraction of the budget.
     """
     archived = [] if suite_archive is None else load_finals(suite_archive)  # checked before anything is written
     groups = find_groups(roots)
@@ -78,6 +79,7 @@ def write_report(
         (out / "stats.md").write_text(results.report(summaries))
         extra["stats"] = out / "stats.md"
         extra.update({f"profiles_{p.suffix[1:]}": p for p in results.plot_profiles(summaries, out / "profiles")})
+        extra.update({f"efficiency_{p.suffix[1:]}": p for p in results.plot_efficiency(summaries, out / "efficiency")})
     if finals:  # runs on the benchmark suite's domains: their table beside HyAR's, and a figure per domain
         (out / "suite.md").write_text(suite_table(finals) + "\n")
         (out / "suite-finals.json").write_text(json.dumps(finals, indent=1) + "\n")

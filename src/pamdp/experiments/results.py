@@ -13,7 +13,8 @@ so they are aggregated across domains as they are.
 - :func:`improvement_table`: P(X > Y) of every pair of methods on the domains both ran;
 - :func:`efficiency_table`: from the greedy curves, the rate at fractions of the budget, the samples to 90 % of the
   best published rate (censored where never reached) and the normalised area under the curve;
-- :func:`plot_profiles`: the performance profiles (share of runs above each score) with their bands.
+- :func:`plot_profiles`: the performance profiles (share of runs above each score) with their bands;
+- :func:`plot_efficiency`: the greedy curves over the fraction of the budget, with their bands.
 
 An interval over fewer than :data:`MIN_RUNS` runs is not printed: a bootstrap of two runs can only return their
 values, a range that says nothing about a third.
@@ -44,6 +45,7 @@ __all__ = [
     "improvement_table",
     "efficiency_table",
     "plot_profiles",
+    "plot_efficiency",
     "report",
 ]
 
@@ -320,6 +322,13 @@ def plot_profiles(summaries: list[dict], path: str | os.PathLike, title: str = "
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, frameon=False)
     fig.tight_layout()
+    return _save(fig, path)
+
+
+def _save(fig, path: str | os.PathLike) -> list[Path]:
+    """``fig`` as ``path`` with ``.png`` and ``.svg`` suffixes (the SVG without a date, so that it redraws the same)."""
+    import matplotlib.pyplot as plt
+
     written = []
     for suffix in (".png", ".svg"):
         target = Path(path).with_suffix(suffix)
@@ -327,6 +336,54 @@ def plot_profiles(summaries: list[dict], path: str | os.PathLike, title: str = "
         written.append(target)
     plt.close(fig)
     return written
+
+
+def plot_efficiency(summaries: list[dict], path: str | os.PathLike) -> list[Path]:
+    """The greedy curves of each cell with curves, a panel per domain, over the fraction of the budget: the mean over
+    runs of the last evaluation made by each fraction, with the 95 % bootstrap band of that mean where the cell has
+    :data:`MIN_RUNS` runs or more, and the 90 % of the best published figure that the efficiency table counts the
+    samples to; ``path`` with ``.png`` and ``.svg`` suffixes (nothing where no run logged a curve)."""
+    by_domain: dict[str, dict[str, list]] = {}
+    for (row, method), runs in cells(summaries).items():
+        curves = [(curve(s), _budget(s)) for s in runs]
+        curves = [(c, b) for c, b in curves if b is not None and np.isfinite(c[1]).any()]
+        if curves and row == _domain(runs[0]):
+            by_domain.setdefault(row, {})[method] = curves
+    if not by_domain:
+        return []
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    grid = np.linspace(0.02, 1.0, 50)
+    cols = min(len(by_domain), 4)
+    rows = -(-len(by_domain) // cols)
+    fig, axes = plt.subplots(rows, cols, figsize=(2.6 * cols, 2.3 * rows), dpi=110, squeeze=False, sharex=True)
+    for ax, (domain, methods) in zip(axes.flat, by_domain.items()):
+        for method, curves in methods.items():
+            with np.errstate(all="ignore"):
+                at = np.array([stats.rate_at_fractions(*c, budget=b, fractions=grid) for c, b in curves])
+            seen = ~np.isnan(at).any(axis=0)  # from the first fraction every run had been evaluated by
+            mean = at.mean(axis=0)
+            line = ax.plot(grid[seen], mean[seen], label=f"{method} ({len(curves)})", linewidth=1.2)[0]
+            if len(curves) >= MIN_RUNS:
+                bands = [stats.interval([at[:, i]], np.mean, resamples=500) for i in np.flatnonzero(seen)]
+                low, high = np.array([b.low for b in bands]), np.array([b.high for b in bands])
+                ax.fill_between(grid[seen], low, high, color=line.get_color(), alpha=0.2)
+        best = published_best(domain)
+        if best is not None:
+            ax.axhline(TARGET * best, color="grey", linestyle="--", linewidth=0.8)
+        ax.set_title(domain, fontsize=9)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7, frameon=False)
+    for ax in axes.flat[len(by_domain) :]:
+        ax.axis("off")
+    fig.supxlabel("fraction of the budget", fontsize=9)
+    fig.supylabel("greedy figure", fontsize=9)
+    fig.suptitle(f"greedy evaluations (dashed: {TARGET * 100:g} % of the best published figure)", fontsize=9)
+    fig.tight_layout()
+    return _save(fig, path)
 
 
 def report(summaries: list[dict]) -> str:
