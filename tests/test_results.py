@@ -103,6 +103,8 @@ def test_a_summary_round_trips_through_its_file_and_the_cli_writes_the_same(tmp_
     assert [load(p) for p in paths] == summaries
     with pytest.raises(ValueError, match="two runs of 'A on Goal' seed 0"):
         save([summaries[0], summaries[0]], tmp_path / "again")
+    with pytest.raises(ValueError, match="x/A on Goal/seed0 records no seed"):
+        save([{**summaries[0], "seed": None}], tmp_path / "unseeded")
     (tmp_path / "bad.json").write_text(json.dumps({**summaries[0], "format": 2}))
     with pytest.raises(ValueError, match="format 2; expected a pamdp run summary of format 1"):
         load(tmp_path / "bad.json")

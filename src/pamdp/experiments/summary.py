@@ -180,6 +180,8 @@ def save(summaries: list[dict], root: str | os.PathLike) -> list[Path]:
 
     paths: dict[Path, dict] = {}
     for summary in summaries:
+        if not isinstance(summary.get("seed"), int):
+            raise ValueError(f"the run {summary['origin']} records no seed; expected a run.json with its config")
         path = Path(root) / _slug(summary["label"]) / f"seed{summary['seed']}.json"
         if path in paths:
             raise ValueError(
