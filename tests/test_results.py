@@ -123,6 +123,16 @@ def test_pamdp_summarize_writes_each_runs_summary_where_asked(tmp_path, capsys):
     assert "no run directories" in capsys.readouterr().err
 
 
+def test_a_summary_of_a_run_cut_before_its_first_checkpoint_does_not_stop_it_starting_again(tmp_path):
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / "run.json").write_text(json.dumps({"algo": "patrpo", "env": "pamdp/Platform-v0", "config": {"seed": 0}}))
+    (run / "progress.csv").write_text("time/total_timesteps,charts/episodic_return\n500,0.1\n")  # one epoch, killed
+    assert main(["summarize", str(run)]) == 0 and not load(run / "summary.json")["finished"]
+    _train(run, 500)
+    assert load(run / "summary.json")["finished"] and load(run / "summary.json")["seed"] == 3
+
+
 def test_an_archived_suite_entry_becomes_a_summary_of_its_final_figure_only():
     entry = dict(domain="Hard Move n=6", method="PATRPO", seed=2, value=0.971, final=True, source="lost run")
     entry.update(total_steps=None, preset=None, settings=None)

@@ -40,8 +40,9 @@ __all__ = ["RunConfig", "RunSpec", "train_run", "run_lock", "is_finished", "run_
 LOCK_FILE = ".lock"
 HOLDER_FILE = ".lock-holder"  # who holds the lock: beside it, since a locked file is not readable on every system
 _CUT_SHORT = ".cut-short"  # a first epoch's log kept aside when its checkpoint was cut short by a kill
-# What a run directory holds before its first checkpoint: starting it again from step 0 loses nothing.
-_BEFORE_FIRST_CHECKPOINT = {"run.json", "progress.csv", "tb", "stdout.log", LOCK_FILE, HOLDER_FILE}
+# What a run directory holds before its first checkpoint: starting it again from step 0 loses nothing (a summary
+# made of it by ``pamdp summarize`` is made again at the end).
+_BEFORE_FIRST_CHECKPOINT = {"run.json", "progress.csv", "tb", "stdout.log", SUMMARY, LOCK_FILE, HOLDER_FILE}
 
 
 @dataclasses.dataclass(frozen=True)
