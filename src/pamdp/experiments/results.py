@@ -73,6 +73,8 @@ def _domain(summary: dict) -> str:
 
 
 def _uses_return(summary: dict, domain: str) -> bool:
+    """Whether a run's score is its return (Platform's, as HyAR's table; an env that reports no success) or its
+    success rate."""
     if domain == "Platform":
         return True
     if domain in {d[0] for d in DOMAINS}:
