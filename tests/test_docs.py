@@ -95,6 +95,27 @@ def test_the_generated_tables_of_the_docs_are_up_to_date():
     assert done.returncode == 0, f"run `python docs/gen_cli_tables.py`\n{done.stdout}{done.stderr}"
 
 
+def test_the_results_tables_are_the_ones_the_committed_summaries_give():
+    """Issue 44: docs/results.md's tables of the benchmark suite (and suite.md, suite-finals.json beside its figures)
+    are what docs/gen_results.py makes of the summaries in docs/results/summaries."""
+    done = subprocess.run(
+        [sys.executable, str(ROOT / "docs" / "gen_results.py"), "--check"], capture_output=True, text=True
+    )
+    assert done.returncode == 0, f"run `python docs/gen_results.py`\n{done.stdout}{done.stderr}"
+    text = (ROOT / "docs" / "results.md").read_text()
+    for name in ("suite", "suite-stats", "suite-aggregate", "suite-improvement", "suite-efficiency"):
+        assert f"<!-- results:{name} start -->" in text
+
+
+def test_committed_summaries_are_small_and_name_no_machines_path():
+    summaries = sorted((ROOT / "docs" / "results" / "summaries").rglob("*.json"))
+    assert len(summaries) >= 70
+    for path in summaries:
+        text = path.read_text()
+        assert len(text) < 20_000, path
+        assert "/root/" not in text and "/home/" not in text and "/tmp/" not in text, path
+
+
 def test_the_readme_names_every_algorithm_and_experiment_of_the_code():
     from pamdp.algos import ALGORITHMS
     from pamdp.experiments import available_experiments

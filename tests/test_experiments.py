@@ -584,6 +584,22 @@ def test_the_suite_table_counts_as_seeds_only_runs_of_one_budget_and_settings(tm
     assert [name for name, _, _ in groups if "2,000 steps" in name] == ["| PATRPO on Platform (2,000 steps)"]
 
 
+def test_a_plot_computes_each_runs_setting_once(tmp_path, monkeypatch):
+    """The groups, the suite's table and the runs' summaries all need each run's setting (a digest of its settings
+    with the defaults filled in by the algorithm's config): it is computed once per run."""
+    from pamdp.experiments import plots
+    from pamdp.experiments.report import write_report
+
+    calls, setting_of = [], plots.setting_of
+    monkeypatch.setattr(plots, "setting_of", lambda recorded: calls.append(1) or setting_of(recorded))
+    root = tmp_path / "benchmark-suite"
+    for seed in range(3):
+        _recorded_suite_run(root, "PATRPO on Platform", "pamdp/Platform-v0", seed, 0.9, 200_000)
+    report = write_report([root], tmp_path / "fig")
+    assert len(calls) == 3
+    assert "| Platform | PATRPO | 3 | 0.900 [0.900, 0.900] |" in report["stats"].read_text()
+
+
 def test_the_suite_table_takes_hard_move_without_n_as_its_default_n(tmp_path):
     from pamdp.experiments.report import write_report
 

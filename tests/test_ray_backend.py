@@ -83,6 +83,24 @@ def test_the_driver_copy_follows_rewrites_and_appends_and_refuses_an_older_attem
     inbox.close()
 
 
+def test_the_driver_makes_the_runs_summary_again_from_its_own_copy(tmp_path):
+    """A task's summary.json names the task's scratch directory as where the run lies; the driver's names its own."""
+    from pamdp.experiments.summary import summarize
+
+    scratch, out = tmp_path / "scratch" / "pamdp-ray-x" / "run", tmp_path / "sweep" / "arm" / "seed0"
+    scratch.mkdir(parents=True)
+    (scratch / "run.json").write_text(json.dumps({"algo": "patrpo", "env": "pamdp/Platform-v0", "label": "arm"}))
+    (scratch / "progress.csv").write_text("time/total_timesteps,eval/mean_return\n100,0.5\n")
+    (scratch / "summary.json").write_text(json.dumps(summarize(scratch)))
+    inbox = _Inbox()
+    attempt, _ = inbox.open(str(out))
+    assert inbox.write(str(out), attempt, [(p.name, 0, p.read_bytes()) for p in sorted(scratch.iterdir())])
+    inbox.close()
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["origin"] == "sweep/arm/seed0" and summary["evaluations"]["mean_return"] == [0.5]
+    assert summary == summarize(out)
+
+
 def test_a_sweep_holds_its_run_directories_against_other_writers_until_it_ends(tmp_path):
     out = tmp_path / "run"
     with run_lock(out):  # a local `pamdp train` writing there

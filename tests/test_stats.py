@@ -114,6 +114,24 @@ def test_samples_to_reach_is_censored_at_the_budget_when_never_reached():
     assert stats.samples_to_reach([10, 20, 30], [0.2, 0.8, 0.5], 0.9) == (30.0, False)
 
 
+@pytest.mark.parametrize(
+    "runs, median",
+    [
+        ([(30, True), (10, True), (100, False)], (30.0, True)),  # 10 30 | >100: the middle run reached it
+        ([(30, True), (100, False), (100, False)], (100.0, False)),  # 30 | >100 >100: "more than the budget"
+        ([(30, True), (10, True), (20, True), (100, False)], (25.0, True)),  # 10 20 30 >100: (20 + 30) / 2
+        ([(30, True), (10, True), (100, False), (100, False)], (65.0, False)),  # (30 + >100) / 2: more than 65
+    ],
+)
+def test_median_reached_ranks_censored_runs_after_every_reached_one(runs, median):
+    assert stats.median_reached([stats.Reached(float(s), r) for s, r in runs]) == median
+
+
+def test_median_reached_refuses_runs_censored_before_another_reached_the_target():
+    with pytest.raises(ValueError, match="censored at step 50 before another reached the target at 80"):
+        stats.median_reached([stats.Reached(80.0, True), stats.Reached(50.0, False)])
+
+
 def test_normalised_auc_is_the_hand_computed_trapezoid_over_the_budget():
     steps, values = [10, 20, 40], [0.5, 1.0, 1.0]
     # first value held back to 0: 0.5 * 10, then (0.5 + 1) / 2 * 10, 1 * 20, and flat from 40 to 50: 1 * 10

@@ -1,11 +1,13 @@
-"""The ``pamdp`` command: ``train``, ``evaluate``, ``render`` (and, with the experiments, ``reproduce``, ``plot``).
+"""The ``pamdp`` command: ``train``, ``evaluate``, ``render`` (and, with the experiments, ``reproduce``, ``plot``,
+``summarize``).
 
 ``pamdp train patrpo`` trains PATRPO on Platform with the tuned preset, shows a progress bar and ends with
 a greedy evaluation. Every setting of the algorithm's config is also a flag (``--delta 0.01``,
 ``--hidden-sizes 64,64``), and ``--config FILE`` (TOML or JSON) sets several; the order of precedence is
 preset, then file, then flags. A run writes into ``--out DIR``: ``run.json`` (what was asked),
-``progress.csv``, ``tb/`` (TensorBoard), ``checkpoint.pt`` after every epoch, ``final_model.pt`` and
-``evaluation.json``. Starting the same command again with the same ``--out`` resumes from the checkpoint.
+``progress.csv``, ``tb/`` (TensorBoard), ``checkpoint.pt`` after every epoch, ``final_model.pt``,
+``evaluation.json`` and ``summary.json``. Starting the same command again with the same ``--out`` resumes from the
+checkpoint.
 """
 
 from __future__ import annotations
@@ -285,6 +287,17 @@ def build_parser() -> argparse.ArgumentParser:
         "where no run at hand has their domain, method and seed",
     )
 
+    sm = sub.add_parser(
+        "summarize", help="each run's summary.json (settings, costs, greedy evaluations: a few KB) from its directory"
+    )
+    sm.add_argument("dirs", nargs="+", help="run directories, or directories holding them")
+    sm.add_argument(
+        "--out",
+        default=None,
+        help="write OUT/ARM/seedN.json (ARM: the run's label as a directory name) instead of RUN/summary.json, "
+        "e.g. docs/results/summaries/EXPERIMENT",
+    )
+
     rd = sub.add_parser("render", help="write one episode to a GIF (a trained model, or random actions in an env)")
     rd.add_argument("source", help="run directory, model file, or a registered env id (random actions)")
     rd.add_argument("--out", default="episode.gif", help="GIF path (default: %(default)s)")
@@ -394,11 +407,29 @@ def cmd_plot(args) -> int:
     return 0
 
 
+def cmd_summarize(args) -> int:
+    from pamdp.experiments.plots import _run_dirs
+    from pamdp.experiments.summary import save, summarize, write_summary
+
+    runs = []
+    for root in map(Path, args.dirs):
+        if not root.is_dir():
+            raise ValueError(f"{root} is not a directory; expected a run directory or one holding run directories")
+        runs += [root] if (root / "run.json").exists() else _run_dirs(root)
+    if not runs:
+        raise ValueError(f"no run directories (with run.json and progress.csv) under {', '.join(args.dirs)}")
+    written = save([summarize(run) for run in runs], args.out) if args.out else [write_summary(run) for run in runs]
+    print("\n".join(map(str, written)))
+    return 0
+
+
 def _print_report(report: dict) -> None:
     """The results table on stdout, the figures' paths on stderr."""
     print(report["table"].read_text())
     if "suite" in report:
         print(report["suite"].read_text())
+    if "stats" in report:
+        print(report["stats"].read_text())
     figures = [v for k, v in report.items() if k.endswith(("png", "svg"))]
     print(f"figures: {', '.join(map(str, figures))}", file=sys.stderr)
 
@@ -493,6 +524,7 @@ def main(argv: list[str] | None = None) -> int:
         "render": cmd_render,
         "reproduce": cmd_reproduce,
         "plot": cmd_plot,
+        "summarize": cmd_summarize,
     }
     try:
         return handlers[args.command](args)

@@ -9,6 +9,7 @@ samples, where the settings' epochs differ in size).
 from __future__ import annotations
 
 import csv
+import functools
 import json
 import os
 import warnings
@@ -65,7 +66,7 @@ def find_groups(roots: list[str | os.PathLike]) -> dict[str, list[Path]]:
         for run in runs:
             recorded = _recorded(run)
             label = str(recorded.get("label") or "") or (run.parent.name if run != root else run.name)
-            found.setdefault((label, (*_kind(recorded), *setting_of(recorded).values())), []).append(run)
+            found.setdefault((label, (*_kind(recorded), *run_setting(run).values())), []).append(run)
     if not found:
         raise FileNotFoundError(f"no run directories (with progress.csv) under {', '.join(map(str, roots))}")
     kinds: dict[str, list[tuple]] = {}
@@ -139,6 +140,22 @@ def setting_of(recorded: dict) -> dict:
         "preset": recorded.get("preset") if isinstance(recorded.get("preset"), str) else None,
         "settings": digest,
     }
+
+
+@functools.lru_cache(maxsize=4096)
+def _setting_of_file(path: str, stamp: tuple[int, int]) -> dict:
+    return setting_of(_recorded(Path(path).parent))
+
+
+def run_setting(run: str | os.PathLike) -> dict:
+    """:func:`setting_of` a run directory's ``run.json``, computed once per version of the file: a plot groups the
+    runs, the suite's table and the summaries all ask for it, and each time loads the algorithm's config."""
+    path = Path(run).resolve() / "run.json"
+    try:
+        stat = path.stat()
+    except OSError:
+        return setting_of({})
+    return dict(_setting_of_file(str(path), (stat.st_mtime_ns, stat.st_size)))
 
 
 def _recorded(run: Path) -> dict:

@@ -5,9 +5,10 @@ the run directories stay on the driver's machine, where one writer, an actor pin
 keeps them. A task fetches its run directory from it as it stands (so an interrupted run resumes from its
 checkpoint), trains in a scratch directory on whichever node Ray chose, and sends back what changed after
 every epoch (the new checkpoint, ``progress.csv``, ``run.json``, the new tails of the logs) and once more at
-the end. A task whose node or worker process dies is retried (``retries`` times) and resumes from the last
-checkpoint that reached the driver; the resumed run drops the rows of ``progress.csv`` logged after it, so no
-epoch is counted twice. Needs the ``ray`` extra: ``pip install pamdp[ray]``.
+the end, when the driver makes the run's ``summary.json`` again from its own copy (the task's names the scratch
+directory as where the run lies). A task whose node or worker process dies is retried (``retries`` times) and
+resumes from the last checkpoint that reached the driver; the resumed run drops the rows of ``progress.csv`` logged
+after it, so no epoch is counted twice. Needs the ``ray`` extra: ``pip install pamdp[ray]``.
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from pathlib import Path
 
 from pamdp.algos.checkpoints import _atomic_write
 from pamdp.experiments.runner import RunOutcome, RunSpec, _describe, _worker, run_lock
+from pamdp.experiments.summary import SUMMARY, write_summary
 
 __all__ = ["run_all_ray", "RETRIES"]
 
@@ -90,6 +92,8 @@ class _Inbox:
             return False
         for rel, offset, data in sorted(changes, key=lambda c: c[0] == _LAST):
             _write(Path(out) / rel, offset, data)
+        if any(rel == SUMMARY for rel, _, _ in changes):  # made again here: it names where the run lies
+            write_summary(out)
         return True
 
     def close(self) -> None:

@@ -10,8 +10,10 @@ from pathlib import Path
 
 import numpy as np
 
+from pamdp.experiments import results
 from pamdp.experiments.plots import EXTRA_FIGURES, aggregate, find_groups, plot_curves, results_table
 from pamdp.experiments.suite import load_finals, merge_finals, plot_domains, suite_finals, suite_table
+from pamdp.experiments.summary import from_suite_final, summarize
 
 __all__ = ["write_report"]
 
@@ -35,6 +37,12 @@ def write_report(
     suite's domains also get ``suite.md``, their table beside HyAR's published one, ``suite-finals.json``, each
     seed's figure, and a figure per domain (:mod:`pamdp.experiments.suite`). ``suite_archive``: an earlier
     ``suite-finals.json``, whose entries fill the table where no run at hand has their domain, method and seed.
+
+    ``stats.md`` holds the statistics of the runs' final figures (:func:`.results.report`: means and interquartile
+    means with bootstrap intervals per method and domain, across domains, the probability of improvement between
+    methods, and the sample efficiency of the greedy curves), ``profiles.png`` and ``.svg`` the performance
+    profiles of the methods over the domains they all ran, and ``efficiency.png`` and ``.svg`` the greedy curves over
+    the fraction of the budget.
     """
     archived = [] if suite_archive is None else load_finals(suite_archive)  # checked before anything is written
     groups = find_groups(roots)
@@ -66,9 +74,31 @@ def write_report(
     table = out / "results.md"
     table.write_text(results_table(groups) + "\n")
     finals = merge_finals(suite_finals(groups), archived)
+    summaries = _summaries(groups, archived)
+    if summaries:  # the statistics: intervals over runs, across domains, pairwise and over samples
+        (out / "stats.md").write_text(results.report(summaries))
+        extra["stats"] = out / "stats.md"
+        extra.update({f"profiles_{p.suffix[1:]}": p for p in results.plot_profiles(summaries, out / "profiles")})
+        extra.update({f"efficiency_{p.suffix[1:]}": p for p in results.plot_efficiency(summaries, out / "efficiency")})
     if finals:  # runs on the benchmark suite's domains: their table beside HyAR's, and a figure per domain
         (out / "suite.md").write_text(suite_table(finals) + "\n")
         (out / "suite-finals.json").write_text(json.dumps(finals, indent=1) + "\n")
         extra["suite"], extra["suite_finals"] = out / "suite.md", out / "suite-finals.json"
         extra.update({f"{p.stem}_{p.suffix[1:]}": p for p in plot_domains(groups, out)})
     return {"png": png, "svg": svg, "csv": csv_path, "table": table, **extra}
+
+
+def _summaries(groups: dict[str, list[Path]], archived: list[dict]) -> list[dict]:
+    """The summaries of the runs at hand that record their algorithm and env, and of the archived suite entries of
+    final figures whose domain, method and seed no run at hand has."""
+    from pamdp.experiments.plots import _recorded
+
+    at_hand = [
+        {**summarize(run), "label": recorded.get("label") or label}  # as the figures and tables name the run
+        for label, runs in groups.items()
+        for run in runs
+        if {"algo", "env"} <= set(recorded := _recorded(run))
+    ]
+    have = {(e["domain"], e["method"], e["seed"]) for e in results.finals(at_hand)}
+    kept = [e for e in archived if e["final"] and (e["domain"], e["method"], e["seed"]) not in have]
+    return at_hand + [from_suite_final(e) for e in kept]

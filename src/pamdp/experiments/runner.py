@@ -1,9 +1,10 @@
 """Single training runs and the multi-seed runner behind ``pamdp train`` and ``pamdp reproduce``.
 
 A run lives in one directory: ``run.json`` (what was asked), ``progress.csv``, ``tb/``, ``checkpoint.pt``,
-``final_model.pt`` and ``evaluation.json``. :func:`train_run` is resumable: a directory with a final model
-and an evaluation is done and skipped; one with a checkpoint continues from it; settings that differ from
-the recorded ones are refused rather than mixed into one log.
+``final_model.pt``, ``evaluation.json`` and ``summary.json`` (:mod:`pamdp.experiments.summary`, written last).
+:func:`train_run` is resumable: a directory with a final model and an evaluation is done and skipped; one with a
+checkpoint continues from it; settings that differ from the recorded ones are refused rather than mixed into one
+log.
 
 :func:`run_all` executes many runs, side by side in worker processes (one torch thread each), and reports
 a failed run with its error while the others finish.
@@ -28,8 +29,10 @@ from typing import Any, NamedTuple
 
 import filelock
 
+from pamdp._version import __version__
 from pamdp.algos import algorithm_class
 from pamdp.algos.vector_env import check_env_kwargs
+from pamdp.experiments.summary import SUMMARY, git_commit, write_summary
 from pamdp.presets import choose
 
 __all__ = ["RunConfig", "RunSpec", "train_run", "run_lock", "is_finished", "run_all"]
@@ -37,8 +40,9 @@ __all__ = ["RunConfig", "RunSpec", "train_run", "run_lock", "is_finished", "run_
 LOCK_FILE = ".lock"
 HOLDER_FILE = ".lock-holder"  # who holds the lock: beside it, since a locked file is not readable on every system
 _CUT_SHORT = ".cut-short"  # a first epoch's log kept aside when its checkpoint was cut short by a kill
-# What a run directory holds before its first checkpoint: starting it again from step 0 loses nothing.
-_BEFORE_FIRST_CHECKPOINT = {"run.json", "progress.csv", "tb", "stdout.log", LOCK_FILE, HOLDER_FILE}
+# What a run directory holds before its first checkpoint: starting it again from step 0 loses nothing (a summary
+# made of it by ``pamdp summarize`` is made again at the end).
+_BEFORE_FIRST_CHECKPOINT = {"run.json", "progress.csv", "tb", "stdout.log", SUMMARY, LOCK_FILE, HOLDER_FILE}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -250,6 +254,8 @@ def _prepare(
         "preset": preset,
         "total_steps": spec.total_steps,
         "config": config.to_dict(),
+        "pamdp_version": __version__,  # of the code that last trained the run (a resumed run may span several)
+        "git_commit": git_commit(),
     }
     if warning is not None:  # a preset made for another env: said at the run's start and kept with it
         warnings.warn(warning, UserWarning, stacklevel=2)
@@ -280,6 +286,8 @@ def _prepare(
             log(f"{out}: already finished")
             if spec.label and recorded.get("label") != spec.label:  # a run recorded before run.json held labels
                 atomic_write_text(run_file, json.dumps({**as_written, "label": spec.label}, indent=2))
+            if not (out / SUMMARY).exists():  # a run finished before runs wrote their summary
+                write_summary(out)
             return None, json.loads(eval_file.read_text()) if eval_file.exists() else {}
         model = cls.load(out / CHECKPOINT if (out / CHECKPOINT).exists() else out / FINAL_MODEL)
         if model.num_timesteps > spec.total_steps:  # training cannot be undone; its evaluation stays as it is
@@ -358,10 +366,11 @@ def _train(model, spec: RunSpec, out: str | os.PathLike, progress_bar: bool, log
         f"trained {model.num_timesteps - start_steps:,} steps in {time.time() - start:.0f} s, "
         f"{model.num_timesteps:,} of {spec.total_steps:,} in all ({updates}); model in {out / FINAL_MODEL}"
     )
-    if spec.eval_episodes <= 0:
-        return {}
-    result = evaluate(model, episodes=spec.eval_episodes, seed=10_000 + spec.seed)
-    atomic_write_text(out / "evaluation.json", json.dumps(result, indent=2))
+    result = {}
+    if spec.eval_episodes > 0:
+        result = evaluate(model, episodes=spec.eval_episodes, seed=10_000 + spec.seed)
+        atomic_write_text(out / "evaluation.json", json.dumps(result, indent=2))
+    write_summary(out)  # last: it reads the evaluation
     return result
 
 

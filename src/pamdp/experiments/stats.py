@@ -44,6 +44,7 @@ __all__ = [
     "Reached",
     "interval",
     "iqm",
+    "median_reached",
     "normalised_auc",
     "performance_profile",
     "probability_of_improvement",
@@ -253,6 +254,30 @@ def samples_to_reach(steps: ArrayLike, values: ArrayLike, target: float, budget:
     if budget is None and not len(s):
         raise ValueError("a curve with no evaluation and no budget has no step to be censored at")
     return Reached(float(budget if budget is not None else s[-1]), False)
+
+
+def median_reached(results: Sequence[Reached]) -> Reached:
+    """The median over runs of :func:`samples_to_reach`, censored runs included as what they are: later than the
+    step they were censored at.
+
+    A censored run ranks after every run that reached the target (its time is unknown but beyond its budget, and
+    runs of one cell share a budget), so the median is known whenever more than half the runs reached it: the
+    middle run's step (the mean of the two middle ones for an even number of runs). Where a middle run is censored,
+    the result is censored too: ``Reached(b, False)``, "more than b", with the censored middle runs counted at their
+    censoring step. Dropping the censored runs instead would report the fast minority's median.
+    """
+    if not results:
+        raise ValueError("median_reached of no runs")
+    reached = sorted(r.step for r in results if r.reached)
+    censored = sorted(r.step for r in results if not r.reached)
+    if censored and reached and censored[0] < reached[-1]:
+        raise ValueError(
+            f"a run censored at step {censored[0]:g} before another reached the target at {reached[-1]:g}; "
+            "expected the runs of one budget"
+        )
+    ranked = reached + censored
+    middle = ranked[(len(ranked) - 1) // 2 : len(ranked) // 2 + 1]
+    return Reached(float(np.mean(middle)), len(ranked) // 2 < len(reached))
 
 
 def normalised_auc(steps: ArrayLike, values: ArrayLike, budget: float, initial: float | None = None) -> float:

@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from pamdp.algos.logger import success_of
-from pamdp.experiments.plots import setting_of
+from pamdp.experiments.plots import run_setting
 from pamdp.experiments.runner import env_defaults
 
 __all__ = [
@@ -135,7 +135,7 @@ def suite_finals(groups: dict[str, list[Path]]) -> list[dict]:
                 seed = _seed_of(run, recorded)
                 finals.append(dict(domain=domain, method=method, seed=seed, value=figure[0], final=figure[1]))
                 finals[-1]["source"] = Path(*Path(run).resolve().parts[-3:]).as_posix()
-                finals[-1].update(setting_of(recorded))
+                finals[-1].update(run_setting(run))
     return finals
 
 

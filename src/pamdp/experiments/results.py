@@ -1,0 +1,403 @@
+"""Tables and figures of results from runs' summaries (:mod:`.summary`), with the statistics of :mod:`.stats`.
+
+A *cell* is the runs of one method on one domain at one setting (budget, preset and settings, as the suite's table
+counts seeds: :func:`.suite.suite_groups`). A run's *score* is its final greedy figure: on the benchmark suite's
+domains the one HyAR's Table 2 reports (Platform: the return, whose best is 1; elsewhere the success rate), on other
+envs the success rate where the env reports one, else the return; a run not evaluated at the end counts with its
+last greedy evaluation during training. Scores of different domains share the scale [0, 1] on the suite's domains,
+so they are aggregated across domains as they are.
+
+- :func:`stats_table`: per cell, the mean and the interquartile mean of the scores with 95 % stratified bootstrap
+  intervals (with one task, the ordinary bootstrap over the runs);
+- :func:`aggregate_table`: per method, the IQM and mean over the domains it ran, stratified by domain;
+- :func:`improvement_table`: P(X > Y) of every pair of methods on the domains both ran;
+- :func:`efficiency_table`: from the greedy curves, the rate at fractions of the budget, the samples to 90 % of the
+  best published rate (censored where never reached) and the normalised area under the curve;
+- :func:`plot_profiles`: the performance profiles (share of runs above each score) with their bands;
+- :func:`plot_efficiency`: the greedy curves over the fraction of the budget, with their bands.
+
+An interval over fewer than :data:`MIN_RUNS` runs is not printed: a bootstrap of two runs can only return their
+values, a range that says nothing about a third.
+"""
+
+from __future__ import annotations
+
+import itertools
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+
+from pamdp.experiments import stats
+from pamdp.experiments.suite import DOMAINS, HYAR_TABLE, _describe, domain_of, method_of
+
+__all__ = [
+    "MIN_RUNS",
+    "FRACTIONS",
+    "published_best",
+    "score",
+    "finals",
+    "cells",
+    "stats_table",
+    "aggregate_table",
+    "aggregate_line",
+    "improvement_table",
+    "efficiency_table",
+    "plot_profiles",
+    "plot_efficiency",
+    "report",
+]
+
+MIN_RUNS = 3
+"""Fewer runs than this in a cell (or across the domains of an aggregate) get no interval."""
+FRACTIONS = (0.1, 0.25, 0.5, 1.0)
+"""The fractions of the budget at which the greedy curve is read."""
+TARGET = 0.9
+"""Samples to reach this fraction of the best published rate are counted."""
+
+
+def published_best(domain: str) -> float | None:
+    """The best figure HyAR's Table 2 gives on a suite domain (of any method: HyAR-TD3's on all eight)."""
+    found = [float(column[domain].split()[0]) for column in HYAR_TABLE.values() if column.get(domain)]
+    return max(found) if found else None
+
+
+def _domain(summary: dict) -> str:
+    """The suite domain a run is on, else its env id (with its arguments)."""
+    domain = domain_of({"env": summary["env"], "env_kwargs": summary.get("env_kwargs") or {}})
+    if domain is not None:
+        return domain
+    kwargs = summary.get("env_kwargs")
+    return summary["env"] + (" " + json.dumps(kwargs, sort_keys=True) if kwargs else "")
+
+
+def _uses_return(summary: dict, domain: str) -> bool:
+    """Whether a run's score is its return (Platform's, as HyAR's table; an env that reports no success) or its
+    success rate."""
+    if domain == "Platform":
+        return True
+    if domain in {d[0] for d in DOMAINS}:
+        return False
+    final = summary.get("final") or {}
+    return "success_rate" not in final and "success_rate" not in summary["evaluations"]
+
+
+def curve(summary: dict) -> tuple[np.ndarray, np.ndarray]:
+    """A run's greedy evaluations during training: their samples and the figure its score is (rate or return)."""
+    key = "mean_return" if _uses_return(summary, _domain(summary)) else "success_rate"
+    evaluations = summary["evaluations"]
+    values = [np.nan if v is None else v for v in evaluations.get(key, [None] * len(evaluations["samples"]))]
+    return np.asarray(evaluations["samples"], dtype=float), np.asarray(values, dtype=float)
+
+
+def score(summary: dict) -> tuple[float, bool] | None:
+    """A run's score and whether it is its final evaluation's (else its last greedy evaluation during training);
+    ``None`` for a run evaluated neither way."""
+    key = "mean_return" if _uses_return(summary, _domain(summary)) else "success_rate"
+    final = summary.get("final") or {}
+    if final.get(key) is not None:
+        return float(final[key]), True
+    _, values = curve(summary)
+    logged = values[np.isfinite(values)]
+    return (float(logged[-1]), False) if len(logged) else None
+
+
+def finals(summaries: list[dict]) -> list[dict]:
+    """The entries of ``suite-finals.json`` (:func:`.suite.suite_finals`) of the summaries of runs on the suite's
+    domains, so that the suite's table is the same whether made from run directories or from their summaries."""
+    from pamdp.experiments.suite import merge_finals
+
+    entries = []
+    for s in summaries:
+        domain, figure = _domain(s), score(s)
+        if domain not in {d[0] for d in DOMAINS} or figure is None:
+            continue
+        entries.append(
+            dict(
+                domain=domain,
+                method=method_of(s["label"], domain),
+                seed=s.get("seed"),
+                value=figure[0],
+                final=figure[1],
+                source=s["origin"],
+                total_steps=s.get("total_steps"),
+                preset=s.get("preset"),
+                settings=s.get("settings_hash"),
+            )
+        )
+    return merge_finals(entries, [])
+
+
+def cells(summaries: list[dict]) -> dict[tuple[str, str], list[dict]]:
+    """``{(row, method): summaries}``: each domain's cells, a method's main setting (its largest budget, then the
+    one of most runs) under the domain's name, any other setting under ``"domain: what tells it apart"``, as the
+    suite's table labels its rows. Domains in the suite's order, then others by name; methods by name."""
+    groups: dict[tuple[str, str], dict[tuple, list[dict]]] = {}
+    for s in summaries:
+        if score(s) is None:
+            continue
+        domain = _domain(s)
+        setting = (s.get("total_steps"), s.get("preset"), s.get("settings_hash"))
+        groups.setdefault((domain, method_of(s["label"], domain)), {}).setdefault(setting, []).append(s)
+    order = {d[0]: i for i, d in enumerate(DOMAINS)}
+    out: dict[tuple[str, str], list[dict]] = {}
+    for domain, method in sorted(groups, key=lambda k: (order.get(k[0], len(order)), k[0], k[1])):
+        settings = sorted(groups[(domain, method)].items(), key=lambda kv: (kv[0][0] or 0, len(kv[1])), reverse=True)
+        for i, (setting, runs) in enumerate(settings):
+            others = [st for st, _ in settings if st != setting]
+            row = domain if i == 0 else f"{domain}: {_describe(setting, others)}"
+            out[(row, method)] = sorted(runs, key=lambda s: (s.get("seed") is None, s.get("seed") or 0))
+    return out
+
+
+def _main_cells(summaries: list[dict]) -> dict[str, dict[str, np.ndarray]]:
+    """``{method: {domain: scores}}`` of each method's main setting on each domain."""
+    by_method: dict[str, dict[str, np.ndarray]] = {}
+    for (row, method), runs in cells(summaries).items():
+        if row == _domain(runs[0]):
+            by_method.setdefault(method, {})[row] = np.array([score(s)[0] for s in runs])
+    return by_method
+
+
+def _estimate(tasks: list[np.ndarray], statistic) -> str:
+    """``0.950 [0.948, 0.952]``, or the point estimate alone where the runs are too few for an interval."""
+    value = statistic(np.concatenate(tasks))
+    if sum(map(len, tasks)) < MIN_RUNS or min(map(len, tasks)) < 2:
+        return f"{value:.3f} (no interval: n < {MIN_RUNS})" if len(tasks) == 1 else f"{value:.3f}"
+    est = stats.interval(tasks, statistic)
+    return f"{est.value:.3f} [{est.low:.3f}, {est.high:.3f}]"
+
+
+def stats_table(summaries: list[dict]) -> str:
+    """Per cell: its runs, the mean and the IQM of their scores with 95 % bootstrap intervals, and how many are
+    still training (counted with their last greedy evaluation)."""
+    lines = [
+        "| domain | method | runs | mean [95 % CI] | IQM [95 % CI] | published best |",
+        "|---|---|---|---|---|---|",
+    ]
+    for (row, method), runs in cells(summaries).items():
+        scores = np.array([score(s)[0] for s in runs])
+        partial = sum(not score(s)[1] for s in runs)
+        n = f"{len(runs)}" + (f" ({partial} partial*)" if partial else "")
+        best = published_best(_domain(runs[0]))
+        mean, mid = _estimate([scores], np.mean), _estimate([scores], stats.iqm)
+        lines.append(f"| {row} | {method} | {n} | {mean} | {mid} | {'' if best is None else f'{best:.2f}'} |")
+    return "\n".join(lines)
+
+
+def _stratified(by_domain: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """The domains of a method with at least 2 runs: a stratified bootstrap resamples within each."""
+    return {d: x for d, x in by_domain.items() if len(x) >= 2}
+
+
+def _comparable(summaries: list[dict]) -> tuple[dict[str, dict[str, np.ndarray]], list[str]]:
+    """Each method's scores on the domains where it has 2 runs or more (its main setting's), and the domains every
+    such method has, in the suite's order."""
+    by_method = {m: _stratified(d) for m, d in _main_cells(summaries).items()}
+    by_method = {m: d for m, d in by_method.items() if d}
+    shared = set.intersection(*(set(d) for d in by_method.values())) if by_method else set()
+    order = [d[0] for d in DOMAINS]
+    return by_method, sorted(shared, key=lambda d: (order.index(d) if d in order else len(order), d))
+
+
+def aggregate_table(summaries: list[dict]) -> str:
+    """Per method: the IQM and mean of its runs over the domains where it has 2 runs or more (its main setting's),
+    stratified by domain, and over the domains that every method has so (the only comparison of like with like)."""
+    by_method, shared = _comparable(summaries)
+    lines = [
+        f"| method | domains | runs | IQM [95 % CI] | mean [95 % CI] | IQM on the {len(shared)} shared domains "
+        "[95 % CI] |",
+        "|---|---|---|---|---|---|",
+    ]
+    for method, by_domain in by_method.items():
+        tasks = list(by_domain.values())
+        on_shared = [by_domain[d] for d in shared]
+        lines.append(
+            f"| {method} | {len(tasks)} | {sum(map(len, tasks))} | {_estimate(tasks, stats.iqm)} | "
+            f"{_estimate(tasks, np.mean)} | {_estimate(on_shared, stats.iqm) if on_shared else '-'} |"
+        )
+    return "\n".join(lines) + (f"\n\nShared domains: {', '.join(shared)}." if shared else "")
+
+
+def aggregate_line(summaries: list[dict]) -> str:
+    """One sentence of :func:`aggregate_table`: each method's IQM over its domains, best first, then on the shared
+    domains (for a page that has no room for the table)."""
+    by_method, shared = _comparable(summaries)
+
+    def listing(domains_of) -> str:
+        found = []
+        for method, by_domain in by_method.items():
+            tasks = [by_domain[d] for d in domains_of(by_domain)]
+            found.append((float(stats.iqm(np.concatenate(tasks))), method, tasks))
+        parts = [
+            f"{method} **{_estimate(tasks, stats.iqm)}** ({len(tasks)} domains, {sum(map(len, tasks))} runs)"
+            for _, method, tasks in sorted(found, key=lambda f: -f[0])
+        ]
+        return "; ".join(parts)
+
+    return (
+        "IQM of the final figures with 95 % stratified bootstrap intervals, over the domains where a method has 2 "
+        f"runs or more: {listing(list)}. On the {len(shared)} domains all share ({', '.join(shared)}): "
+        f"{listing(lambda _: shared)}."
+    )
+
+
+def improvement_table(summaries: list[dict]) -> str:
+    """P(X > Y) with its 95 % interval for every pair of methods, on the domains where both have 2 runs or more."""
+    by_method = {m: _stratified(d) for m, d in _main_cells(summaries).items()}
+    lines = ["| X | Y | domains | runs of X, of Y | P(X > Y) [95 % CI] |", "|---|---|---|---|---|"]
+    for x, y in itertools.combinations(sorted(by_method), 2):
+        shared = sorted(set(by_method[x]) & set(by_method[y]))
+        if not shared:
+            continue
+        xs, ys = [by_method[x][d] for d in shared], [by_method[y][d] for d in shared]
+        nx, ny = sum(map(len, xs)), sum(map(len, ys))
+        if min(nx, ny) < MIN_RUNS:
+            continue
+        est = stats.probability_of_improvement(xs, ys)
+        p = f"{est.value:.2f} [{float(est.low):.2f}, {float(est.high):.2f}]"
+        lines.append(f"| {x} | {y} | {len(shared)} | {nx}, {ny} | {p} |")
+    return "\n".join(lines)
+
+
+def _budget(summary: dict) -> float | None:
+    budget = summary.get("total_steps")
+    return float(budget) if isinstance(budget, int) and budget > 0 else None
+
+
+def efficiency_table(summaries: list[dict]) -> str:
+    """Per cell with greedy curves: the mean over runs of the greedy figure at 10, 25, 50 and 100 % of the budget,
+    the median samples to reach 90 % of the best published figure (:func:`.stats.median_reached`: ``>`` where the
+    median run did not reach it within the budget, with how many did) and the mean normalised area under the
+    curve. Cells whose runs logged no greedy evaluation during training (or whose summaries came from an archive
+    that kept only final figures) are left out."""
+    head = " / ".join(f"{f * 100:g}" for f in FRACTIONS) + " %"
+    lines = [
+        f"| domain | method | runs with curves | greedy figure at {head} of the budget | "
+        f"samples to {TARGET * 100:g} % of the published best | normalised AUC |",
+        "|---|---|---|---|---|---|",
+    ]
+    for (row, method), runs in cells(summaries).items():
+        curves = [(curve(s), _budget(s)) for s in runs]
+        curves = [(c, b) for c, b in curves if b is not None and np.isfinite(c[1]).any()]
+        if not curves:
+            continue
+        with np.errstate(all="ignore"):
+            at = np.array([stats.rate_at_fractions(*c, budget=b, fractions=FRACTIONS) for c, b in curves])
+            rates = " / ".join("-" if np.isnan(col).all() else f"{np.nanmean(col):.2f}" for col in at.T)
+        auc = np.mean([stats.normalised_auc(*c, budget=b) for c, b in curves])
+        best = published_best(_domain(runs[0]))
+        reach = "-"
+        if best is not None:
+            times = [stats.samples_to_reach(*c, target=TARGET * best, budget=b) for c, b in curves]
+            median = stats.median_reached(times)
+            count = f"{sum(t.reached for t in times)} of {len(times)} reached"
+            reach = f"{'' if median.reached else '> '}{median.step:,.0f} ({count})"
+        lines.append(f"| {row} | {method} | {len(curves)} | {rates} | {reach} | {auc:.2f} |")
+    return "\n".join(lines)
+
+
+def plot_profiles(summaries: list[dict], path: str | os.PathLike, title: str = "") -> list[Path]:
+    """The performance profile of each method over the domains every method has 2 runs or more on (a profile over
+    other domains would compare other tasks): the share of its runs scoring above each threshold, with the 95 %
+    stratified bootstrap band; ``path`` with ``.png`` and ``.svg`` suffixes (nothing without such a domain)."""
+    by_method, shared = _comparable(summaries)
+    if not shared:
+        return []
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    scores = np.concatenate([by_method[m][d] for m in by_method for d in shared])
+    tau = np.linspace(min(0.0, scores.min()), max(1.0, scores.max()), 101)
+    fig, ax = plt.subplots(figsize=(5.0, 3.4), dpi=110)
+    for method, by_domain in by_method.items():
+        profile = stats.performance_profile([by_domain[d] for d in shared], tau)
+        runs = sum(len(by_domain[d]) for d in shared)
+        line = ax.plot(tau, profile.fraction, label=f"{method} ({runs} runs)", linewidth=1.4)[0]
+        ax.fill_between(tau, profile.low, profile.high, color=line.get_color(), alpha=0.2, step=None)
+    ax.set_xlabel("score tau (success rate; Platform: return)")
+    ax.set_ylabel("share of runs scoring above tau")
+    ax.set_title(title or f"over {', '.join(shared)}", fontsize=9)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8, frameon=False)
+    fig.tight_layout()
+    return _save(fig, path)
+
+
+def _save(fig, path: str | os.PathLike) -> list[Path]:
+    """``fig`` as ``path`` with ``.png`` and ``.svg`` suffixes (the SVG without a date, so that it redraws the same)."""
+    import matplotlib.pyplot as plt
+
+    written = []
+    for suffix in (".png", ".svg"):
+        target = Path(path).with_suffix(suffix)
+        fig.savefig(target, metadata={"Date": None} if suffix == ".svg" else None)
+        written.append(target)
+    plt.close(fig)
+    return written
+
+
+def plot_efficiency(summaries: list[dict], path: str | os.PathLike) -> list[Path]:
+    """The greedy curves of each cell with curves, a panel per domain, over the fraction of the budget: the mean over
+    runs of the last evaluation made by each fraction, with the 95 % bootstrap band of that mean where the cell has
+    :data:`MIN_RUNS` runs or more, and the 90 % of the best published figure that the efficiency table counts the
+    samples to; ``path`` with ``.png`` and ``.svg`` suffixes (nothing where no run logged a curve)."""
+    by_domain: dict[str, dict[str, list]] = {}
+    for (row, method), runs in cells(summaries).items():
+        curves = [(curve(s), _budget(s)) for s in runs]
+        curves = [(c, b) for c, b in curves if b is not None and np.isfinite(c[1]).any()]
+        if curves and row == _domain(runs[0]):
+            by_domain.setdefault(row, {})[method] = curves
+    if not by_domain:
+        return []
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    grid = np.linspace(0.02, 1.0, 50)
+    cols = min(len(by_domain), 4)
+    rows = -(-len(by_domain) // cols)
+    fig, axes = plt.subplots(rows, cols, figsize=(2.6 * cols, 2.3 * rows), dpi=110, squeeze=False, sharex=True)
+    for ax, (domain, methods) in zip(axes.flat, by_domain.items()):
+        for method, curves in methods.items():
+            with np.errstate(all="ignore"):
+                at = np.array([stats.rate_at_fractions(*c, budget=b, fractions=grid) for c, b in curves])
+            seen = ~np.isnan(at).any(axis=0)  # from the first fraction every run had been evaluated by
+            mean = at.mean(axis=0)
+            line = ax.plot(grid[seen], mean[seen], label=f"{method} ({len(curves)})", linewidth=1.2)[0]
+            if len(curves) >= MIN_RUNS:
+                bands = [stats.interval([at[:, i]], np.mean, resamples=500) for i in np.flatnonzero(seen)]
+                low, high = np.array([b.low for b in bands]), np.array([b.high for b in bands])
+                ax.fill_between(grid[seen], low, high, color=line.get_color(), alpha=0.2)
+        best = published_best(domain)
+        if best is not None:
+            ax.axhline(TARGET * best, color="grey", linestyle="--", linewidth=0.8)
+        ax.set_title(domain, fontsize=9)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7, frameon=False)
+    for ax in axes.flat[len(by_domain) :]:
+        ax.axis("off")
+    fig.supxlabel("fraction of the budget", fontsize=9)
+    fig.supylabel("greedy figure", fontsize=9)
+    fig.suptitle(f"greedy evaluations (dashed: {TARGET * 100:g} % of the best published figure)", fontsize=9)
+    fig.tight_layout()
+    return _save(fig, path)
+
+
+def report(summaries: list[dict]) -> str:
+    """The statistics of a set of runs as one markdown page: per cell, across domains, pairwise and over samples."""
+    parts = [
+        "Per method and domain (each method's runs of one setting; scores: success rate, Platform's return):",
+        stats_table(summaries),
+        "Across domains (stratified by domain):",
+        aggregate_table(summaries),
+        "Probability of improvement (a run of X beats a run of Y; 0.5: neither tends to do better):",
+        improvement_table(summaries),
+        "Sample efficiency (greedy evaluations during training):",
+        efficiency_table(summaries),
+    ]
+    return "\n\n".join(parts) + "\n"

@@ -1,0 +1,207 @@
+"""Run summaries and the results' tables (issue 44): a summary says what its run's logs say, survives a round trip,
+and the tables of a small hand-made set of summaries hold the hand-computed cells."""
+
+import csv
+import json
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from pamdp import __version__
+from pamdp.cli import main
+from pamdp.experiments import results
+from pamdp.experiments.summary import from_suite_final, load, save, summarize
+
+ROOT = Path(__file__).resolve().parents[1]
+TINY = ["--hidden-sizes", "16", "--vf-hidden-sizes", "16", "--batch-size", "500", "--num-envs", "4"]
+
+
+def _train(out, steps):
+    argv = ["train", "patrpo", "--total-steps", str(steps), "--eval-every", "1", "--eval-episodes", "20"]
+    assert main([*argv, "--out", str(out), "--no-progress", "--seed", "3", *TINY]) == 0
+
+
+def _rows(run):
+    with open(run / "progress.csv", newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def test_the_summary_of_a_real_run_is_what_its_logs_say_and_follows_a_resume(tmp_path, capsys):
+    run = tmp_path / "run"
+    _train(run, 1500)
+    first = json.loads((run / "summary.json").read_text())
+    assert first["samples"] >= 1500 and len(first["evaluations"]["samples"]) == 3
+    _train(run, 2500)  # the same run, further: resumed, and its summary rewritten at the end
+    summary = json.loads((run / "summary.json").read_text())
+    rows, final, recorded = (
+        _rows(run),
+        json.loads((run / "evaluation.json").read_text()),
+        json.loads((run / "run.json").read_text()),
+    )
+    assert len(rows) == summary["epochs"] == 5
+    assert summary["samples"] == int(float(rows[-1]["time/total_timesteps"])) >= 2500
+    assert summary["evaluations"]["samples"] == [int(float(r["time/total_timesteps"])) for r in rows]
+    for key in ("mean_return", "mean_length"):
+        assert summary["evaluations"][key] == pytest.approx([float(r[f"eval/{key}"]) for r in rows], rel=1e-5)
+    assert "success_rate" not in summary["evaluations"]  # Platform reports no success: nothing invented
+    assert summary["gradient_updates"] == sum(int(float(r["train/updates"])) for r in rows) == 5
+    assert summary["cpu_seconds"] == pytest.approx(sum(float(r["time/epoch_cpu_seconds"]) for r in rows), abs=0.06)
+    assert summary["wall_seconds"] == pytest.approx(sum(float(r["time/epoch_seconds"]) for r in rows), abs=0.06)
+    assert summary["final"] == {k: final[k] for k in ("episodes", "mean_return", "std_return", "mean_length")}
+    assert summary["final"]["episodes"] == 20
+    commit = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "HEAD"], capture_output=True, text=True).stdout
+    assert (summary["pamdp_version"], summary["git_commit"]) == (__version__, commit.strip() or None)
+    assert (summary["algo"], summary["env"], summary["seed"], summary["total_steps"]) == (
+        "patrpo",
+        "pamdp/Platform-v0",
+        3,
+        2500,
+    )
+    assert summary["config"] == recorded["config"] and summary["finished"] is True
+    assert summary == summarize(run)  # the same function, applied to the directory again
+    assert (run / "summary.json").stat().st_size < 10_000
+    # `pamdp plot` of the run adds its statistics: one run, so no interval
+    capsys.readouterr()
+    assert main(["plot", str(run), "--out", str(tmp_path / "fig")]) == 0
+    stats_md = (tmp_path / "fig" / "stats.md").read_text()
+    assert f"| Platform | run | 1 | {final['mean_return']:.3f} (no interval: n < 3) |" in stats_md
+    assert stats_md in capsys.readouterr().out
+
+
+def _summary(label, env, seed, value, curve=None, budget=400, env_kwargs=None):
+    """A hand-made summary of a finished run: its final figure and, optionally, greedy evaluations (samples, figure)."""
+    key = "mean_return" if env == "pamdp/Platform-v0" else "success_rate"
+    samples, values = zip(*curve) if curve else ((), ())
+    return {
+        "format": 1,
+        "source": "run directory",
+        "origin": f"x/{label}/seed{seed}",
+        "label": label,
+        "algo": "patrpo",
+        "preset": "tuned",
+        "env": env,
+        "env_kwargs": env_kwargs or {},
+        "seed": seed,
+        "total_steps": budget,
+        "settings_hash": "abc",
+        "config": {},
+        "finished": True,
+        "evaluations": {"samples": list(samples), key: list(values)},
+        "final": {key: value, "mean_return": value},
+    }
+
+
+def test_a_summary_round_trips_through_its_file_and_the_cli_writes_the_same(tmp_path):
+    summaries = [_summary("A on Goal", "pamdp/Goal-v0", s, v, [(100, 0.5), (400, v)]) for s, v in enumerate((0.1, 0.2))]
+    paths = save(summaries, tmp_path / "exp")
+    assert [p.relative_to(tmp_path) for p in paths] == [
+        Path("exp/A_on_Goal/seed0.json"),
+        Path("exp/A_on_Goal/seed1.json"),
+    ]
+    assert [load(p) for p in paths] == summaries
+    with pytest.raises(ValueError, match="two runs of 'A on Goal' seed 0"):
+        save([summaries[0], summaries[0]], tmp_path / "again")
+    with pytest.raises(ValueError, match="x/A on Goal/seed0 records no seed"):
+        save([{**summaries[0], "seed": None}], tmp_path / "unseeded")
+    (tmp_path / "bad.json").write_text(json.dumps({**summaries[0], "format": 2}))
+    with pytest.raises(ValueError, match="format 2; expected a pamdp run summary of format 1"):
+        load(tmp_path / "bad.json")
+
+
+def test_pamdp_summarize_writes_each_runs_summary_where_asked(tmp_path, capsys):
+    run = tmp_path / "exp" / "arm" / "seed3"
+    _train(run, 500)
+    (run / "summary.json").unlink()
+    assert main(["summarize", str(tmp_path / "exp"), "--out", str(tmp_path / "kept")]) == 0
+    assert load(tmp_path / "kept" / "arm" / "seed3.json") == summarize(run)  # label: the arm's directory
+    assert not (run / "summary.json").exists()  # the run tree is only read
+    assert main(["summarize", str(run)]) == 0
+    assert json.loads((run / "summary.json").read_text()) == summarize(run)
+    assert main(["summarize", str(tmp_path / "kept")]) == 2
+    assert "no run directories" in capsys.readouterr().err
+
+
+def test_a_summary_of_a_run_cut_before_its_first_checkpoint_does_not_stop_it_starting_again(tmp_path):
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / "run.json").write_text(json.dumps({"algo": "patrpo", "env": "pamdp/Platform-v0", "config": {"seed": 0}}))
+    (run / "progress.csv").write_text("time/total_timesteps,charts/episodic_return\n500,0.1\n")  # one epoch, killed
+    assert main(["summarize", str(run)]) == 0 and not load(run / "summary.json")["finished"]
+    _train(run, 500)
+    assert load(run / "summary.json")["finished"] and load(run / "summary.json")["seed"] == 3
+
+
+def test_an_archived_suite_entry_becomes_a_summary_of_its_final_figure_only():
+    entry = dict(domain="Hard Move n=6", method="PATRPO", seed=2, value=0.971, final=True, source="lost run")
+    entry.update(total_steps=None, preset=None, settings=None)
+    summary = from_suite_final(entry)
+    assert summary["source"] == "suite-finals.json" and summary["origin"] == "lost run"
+    assert (summary["env"], summary["env_kwargs"], summary["final"]) == (
+        "pamdp/HardMove-v0",
+        {"n": 6},
+        {"success_rate": 0.971},
+    )
+    assert summary["algo"] is None and summary["cpu_seconds"] is None and summary["evaluations"] == {"samples": []}
+    assert results.finals([summary]) == [entry]  # and back: the suite's table reads the same figure
+    platform = from_suite_final({**entry, "domain": "Platform", "value": 0.9})
+    assert platform["final"] == {"mean_return": 0.9}
+    with pytest.raises(ValueError, match="not a final evaluation"):
+        from_suite_final({**entry, "final": False})
+
+
+def _synthetic():
+    """Two methods on Platform and Goal: A with runs 0, 1, 1 on Goal (curves) and four on Platform, B below A."""
+    curve = [(100, 0.1), (200, 0.5), (300, 0.9), (400, 1.0)]
+    runs = [_summary("A on Goal", "pamdp/Goal-v0", s, v, curve) for s, v in enumerate((0.0, 1.0, 1.0))]
+    runs += [_summary("A on Platform", "pamdp/Platform-v0", s, v) for s, v in enumerate((0.9, 0.2, 0.6, 1.0))]
+    runs += [_summary("B on Goal", "pamdp/Goal-v0", s, v - 2.0, [(400, 0.0)]) for s, v in enumerate((0.5, 0.7))]
+    runs += [_summary("B on Platform", "pamdp/Platform-v0", s, v - 2.0) for s, v in enumerate((0.1, 0.3, 0.5))]
+    return runs
+
+
+def _cells(table):
+    return {tuple(line.split(" | ")[:2]): line.split(" | ")[2:] for line in table.splitlines()[2:]}
+
+
+def test_the_statistics_tables_hold_the_hand_computed_cells():
+    runs = _synthetic()
+    cells = _cells(results.stats_table(runs))
+    # Goal, A: runs 0, 1, 1. The mean of three draws is 0 with probability (1/3)^3 = 1/27 > 2.5 % and 1 with
+    # (2/3)^3 > 2.5 %: the 95 % percentile interval is [0, 1]; three runs drop none from the IQM.
+    assert cells[("| Goal", "A")] == ["3", "0.667 [0.000, 1.000]", "0.667 [0.000, 1.000]", "0.78 |"]
+    # Platform, A: sorted 0.2 0.6 0.9 1.0, the IQM their middle two
+    platform = cells[("| Platform", "A")]
+    assert platform[0] == "4" and platform[1].startswith(f"{np.mean([0.9, 0.2, 0.6, 1.0]):.3f} [")
+    assert platform[2].startswith(f"{(0.6 + 0.9) / 2:.3f} [")
+    assert cells[("| Goal", "B")][1:3] == ["-1.400 (no interval: n < 3)"] * 2  # two runs: no interval
+    aggregate = _cells(results.aggregate_table(runs).split("\n\n")[0])
+    pooled = np.sort([0.0, 1.0, 1.0, 0.9, 0.2, 0.6, 1.0])  # 7 runs: one dropped at each end
+    assert aggregate[("| A", "2")][1].startswith(f"{pooled[1:-1].mean():.3f} [")
+    improvement = _cells(results.improvement_table(runs))
+    assert improvement[("| A", "B")] == ["2", "7, 5", "1.00 [1.00, 1.00] |"]  # every run of A beats every run of B
+    efficiency = _cells(results.efficiency_table(runs))
+    # A's curve at 40, 100, 200 and 400 samples: none yet, 0.1, 0.5, 1.0; 90 % of HyAR's 0.78 = 0.702 first reached
+    # at 300; area: 0.1 held back to 0, then trapezoids: (10 + 30 + 70 + 95) / 400 = 0.5125
+    assert efficiency[("| Goal", "A")] == ["3", "- / 0.10 / 0.50 / 1.00", "300 (3 of 3 reached)", "0.51 |"]
+    # B's one evaluation, 0.0 at the end of its budget: never reached, so censored there
+    assert efficiency[("| Goal", "B")] == ["2", "- / - / - / 0.00", "> 400 (0 of 2 reached)", "0.00 |"]
+    assert ("| Platform", "A") not in efficiency  # no curve logged
+
+
+def test_the_figures_are_drawn_where_there_is_something_to_draw(tmp_path):
+    runs = _synthetic()
+    profiles = results.plot_profiles(runs, tmp_path / "profiles")
+    efficiency = results.plot_efficiency(runs, tmp_path / "efficiency")
+    assert [p.name for p in profiles + efficiency] == [
+        "profiles.png",
+        "profiles.svg",
+        "efficiency.png",
+        "efficiency.svg",
+    ]
+    assert all(0 < p.stat().st_size < 1_000_000 for p in profiles + efficiency)
+    assert "A (7 runs)" in profiles[1].read_text()  # both domains are shared: A's 3 + 4 runs
+    platform_only = [s for s in runs if s["env"] == "pamdp/Platform-v0"]  # no curves
+    assert results.plot_efficiency(platform_only, tmp_path / "none") == []
+    assert results.plot_profiles([runs[0]], tmp_path / "one") == []  # one run: no domain with 2 runs to resample
