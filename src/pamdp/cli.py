@@ -229,7 +229,7 @@ def build_parser() -> argparse.ArgumentParser:
         p.add_argument(
             "--wandb",
             action="store_true",
-            help='log to Weights & Biases too: the figures of progress.csv, the config, the final evaluation '
+            help="log to Weights & Biases too: the figures of progress.csv, the config, the final evaluation "
             '(needs pip install "pamdp[wandb]"; WANDB_MODE=offline: local files only)',
         )
         p.add_argument("--wandb-project", default="pamdp", help="W&B project with --wandb (default: %(default)s)")
@@ -325,7 +325,7 @@ def cmd_train(args) -> int:
     run_config = spec.check()  # the settings and the env's arguments, before any directory is created
     stamp = dt.datetime.now().strftime("%Y%m%d-%H%M%S")
     out = Path(args.out or f"runs/{args.algo}-{args.env.split('/')[-1]}-seed{spec.seed}-{stamp}")
-    tracker = _wandb_tracker(args, spec, out) if args.wandb else None
+    tracker = _wandb_tracker(args, spec, run_config.preset, out) if args.wandb else None
     result = None
     try:
         result = train_run(
@@ -354,14 +354,14 @@ def cmd_train(args) -> int:
     return 0
 
 
-def _wandb_tracker(args, spec: RunSpec, out: Path):
-    """``--wandb``'s tracker, refused at once (before the run directory is made) where wandb is not installed."""
+def _wandb_tracker(args, spec: RunSpec, preset: str, out: Path):
+    """``--wandb``'s tracker, refused at once (before the run directory is made) where wandb is not installed. The
+    preset is the run's (the model, made from its settings, names none)."""
     from pamdp.callbacks import WandbCallback
 
+    config = {"preset": preset, "total_steps": spec.total_steps, "run_dir": str(out)}
     try:
-        return WandbCallback(
-            project=args.wandb_project, name=out.name, config={"total_steps": spec.total_steps, "run_dir": str(out)}
-        )
+        return WandbCallback(project=args.wandb_project, name=out.name, config=config)
     except ImportError as exc:
         raise ValueError(str(exc)) from None
 
