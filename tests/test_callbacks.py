@@ -195,7 +195,10 @@ def test_the_threshold_as_the_eval_callbacks_new_best_stops_at_the_first_evaluat
         (lambda: EvalCallback(n_eval_episodes=0), r"^n_eval_episodes = 0; expected an integer >= 1$"),
         (lambda: EvalCallback(metric="return"), r"^metric = 'return'; expected one of 'mean_return', 'success_rate'$"),
         (lambda: EvalCallback(eval_env="pamdp/Nowhere-v0"), r"Nowhere"),
-        (lambda: EvalCallback(callback_on_new_best=print), r"^callback = <built-in function print>; expected a"),
+        (
+            lambda: EvalCallback(callback_on_new_best=print),
+            r"^callback_on_new_best = <built-in function print>; expected a pamdp.callbacks.BaseCallback or None$",
+        ),
         (lambda: StopTrainingOnRewardThreshold("1"), r"^reward_threshold = '1'; expected a finite number$"),
         (lambda: StopTrainingOnRewardThreshold(float("nan")), r"^reward_threshold = nan; expected a finite number$"),
     ],
@@ -311,6 +314,14 @@ def test_pamdp_train_wandb_logs_the_run_its_config_and_its_final_evaluation(offl
     assert {k: summary[f"final/{k}"] for k in ("mean_return", "std_return", "episodes")} == pytest.approx(
         {k: evaluation[k] for k in ("mean_return", "std_return", "episodes")}, rel=1e-12
     )
+
+
+def test_a_wandb_that_cannot_start_is_refused_in_one_line(offline_wandb, tmp_path, monkeypatch, capsys):
+    monkeypatch.setenv("WANDB_MODE", "bogus")
+    argv = ["train", "patrpo", "--total-steps", "300", "--out", str(tmp_path / "run"), "--wandb", "--no-progress"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("pamdp train: error: wandb.init failed: ") and "bogus" in err and err.count("\n") == 1
 
 
 def test_train_wandb_without_wandb_installed_says_how_to_install_it_and_creates_nothing(tmp_path, monkeypatch, capsys):

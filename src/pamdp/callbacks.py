@@ -200,7 +200,8 @@ class EvalCallback(BaseCallback):
     ``pamdp evaluate``): every evaluation plays the same episodes, so their scores compare, and it draws nothing from
     the training's random streams. It runs at the end of the first epoch that reaches each multiple of
     ``eval_freq``; its figures are logged in that epoch's row as ``eval/mean_return``, ``eval/mean_length`` and
-    ``eval/success_rate`` (where the env reports success), the keys of ``learn``'s own ``eval_every``.
+    ``eval/success_rate`` (where the env reports success), the keys of ``learn``'s own ``eval_every`` (at an epoch
+    with both, the row keeps this callback's).
 
     A score (``metric``: ``"mean_return"`` or ``"success_rate"``) above every earlier one of this callback saves the
     model (for acting, without its replay buffer) to ``best_model_save_path/best_model.pt`` when a path is given.
@@ -245,8 +246,8 @@ class EvalCallback(BaseCallback):
         if best_model_save_path is not None:
             self.best_model_save_path = _path("best_model_save_path", best_model_save_path)
         self.metric, self.deterministic = metric, deterministic
-        self.callback_on_new_best = None if callback_on_new_best is None else _callback_object(callback_on_new_best)
-        self.callback_after_eval = None if callback_after_eval is None else _callback_object(callback_after_eval)
+        self.callback_on_new_best = _callback_object("callback_on_new_best", callback_on_new_best)
+        self.callback_after_eval = _callback_object("callback_after_eval", callback_after_eval)
         self.evaluations: list[tuple[int, dict[str, float]]] = []
         """``(num_timesteps, result)`` of every evaluation, in order."""
         self.best_score = -math.inf
@@ -303,9 +304,9 @@ class EvalCallback(BaseCallback):
         return go_on
 
 
-def _callback_object(callback) -> BaseCallback:
-    if not isinstance(callback, BaseCallback):
-        raise ValueError(f"callback = {callback!r:.80}; expected a pamdp.callbacks.BaseCallback")
+def _callback_object(name: str, callback) -> BaseCallback | None:
+    if callback is not None and not isinstance(callback, BaseCallback):
+        raise ValueError(f"{name} = {callback!r:.80}; expected a pamdp.callbacks.BaseCallback or None")
     return callback
 
 
@@ -380,9 +381,16 @@ class WandbCallback(BaseCallback):
 
     def on_training_start(self) -> None:
         if self.run is None:
-            self.run = self._wandb.init(
-                project=self.project, name=self.name, config=self.run_config(), **self.init_kwargs
-            )
+            try:
+                self.run = self._wandb.init(
+                    project=self.project, name=self.name, config=self.run_config(), **self.init_kwargs
+                )
+            except (self._wandb.errors.Error, ValueError) as exc:  # not logged in, a bad setting: in one line
+                reason = " ".join(str(exc).split())
+                raise ValueError(
+                    f"wandb.init failed: {reason}; expected a W&B login (wandb login, WANDB_API_KEY) or "
+                    "WANDB_MODE=offline"
+                ) from None
         self.logger.sinks.append(self._log)
 
     def _log(self, stats: dict[str, float], step: int) -> None:

@@ -310,9 +310,9 @@ class Algorithm:
             unit="step",
             dynamic_ncols=True,
         )
-        callback.init_callback(self, logger)
-        callback.on_training_start()
         try:
+            callback.init_callback(self, logger)
+            callback.on_training_start()
             while self.num_timesteps < target:
                 t0, cpu0 = time.perf_counter(), time.process_time()
                 stats = self._run_epoch(target - self.num_timesteps)
