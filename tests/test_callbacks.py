@@ -259,11 +259,13 @@ def wandb_records(wandb_dir: Path) -> dict[str, list]:
 
 @pytest.fixture
 def offline_wandb(tmp_path, monkeypatch):
-    pytest.importorskip("wandb", reason='wandb is not installed (pip install "pamdp[wandb]")')
+    wandb = pytest.importorskip("wandb", reason='wandb is not installed (pip install "pamdp[wandb]")')
     monkeypatch.setenv("WANDB_MODE", "offline")
     monkeypatch.setenv("WANDB_DIR", str(tmp_path))
     monkeypatch.setenv("WANDB_SILENT", "true")
-    return tmp_path
+    wandb.teardown()  # wandb set up earlier in the process keeps the settings (the directory) it read then
+    yield tmp_path
+    wandb.teardown()
 
 
 def assert_history_is_the_progress_csv(history: list[dict], run_dir: Path):
