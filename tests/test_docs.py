@@ -37,6 +37,11 @@ def test_documented_python_examples_run(code, tmp_path, monkeypatch):
         pytest.importorskip("stable_baselines3")
     if "pettingzoo" in code or "parallel_env" in code:
         pytest.importorskip("pettingzoo")  # an optional extra (multiagent)
+    if "WandbCallback" in code:  # offline, into tmp_path: wandb set up anew reads where
+        wandb = pytest.importorskip("wandb", reason='the W&B example needs pip install "pamdp[wandb]"')
+        monkeypatch.setenv("WANDB_MODE", "offline")
+        monkeypatch.setenv("WANDB_DIR", str(tmp_path))
+        wandb.teardown()
     code = re.sub(r"\.learn\((total_timesteps=)?([\d_]+)", r".learn(\1min(\2, 2_000)", code)
     monkeypatch.chdir(tmp_path)  # examples write runs/, GIFs and checkpoints where they run
     with warnings.catch_warnings():

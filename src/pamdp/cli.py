@@ -235,6 +235,13 @@ def build_parser() -> argparse.ArgumentParser:
             help="epochs between greedy evaluations of 100 episodes during training, logged as eval/* (0: none)",
         )
         p.add_argument("--no-progress", action="store_true", help="no progress bar")
+        p.add_argument(
+            "--wandb",
+            action="store_true",
+            help="log to Weights & Biases too: the figures of progress.csv, the config, the final evaluation "
+            '(needs pip install "pamdp[wandb]"; WANDB_MODE=offline: local files only)',
+        )
+        p.add_argument("--wandb-project", default="pamdp", help="W&B project with --wandb (default: %(default)s)")
         _add_config_flags(p, cls.config_class)
 
     ev = sub.add_parser("evaluate", help="evaluate a trained model (a run directory or a model file)")
@@ -339,9 +346,16 @@ def cmd_train(args) -> int:
     run_config = spec.check()  # the settings and the env's arguments, before any directory is created
     stamp = dt.datetime.now().strftime("%Y%m%d-%H%M%S")
     out = Path(args.out or f"runs/{args.algo}-{args.env.split('/')[-1]}-seed{spec.seed}-{stamp}")
+    tracker = _wandb_tracker(args, spec, run_config.preset, out) if args.wandb else None
+    result = None
     try:
         result = train_run(
-            spec, out, progress_bar=not args.no_progress, log=lambda m: print(m, file=sys.stderr), run_config=run_config
+            spec,
+            out,
+            progress_bar=not args.no_progress,
+            log=lambda m: print(m, file=sys.stderr),
+            run_config=run_config,
+            callback=tracker,
         )
     except KeyboardInterrupt:
         from pamdp.algos.checkpoints import CHECKPOINT
@@ -353,9 +367,24 @@ def cmd_train(args) -> int:
                 "\ninterrupted before the first checkpoint; nothing to resume: run it again to start", file=sys.stderr
             )
         return 130
+    finally:
+        if tracker is not None:
+            tracker.finish(summary=result)
     if result:
         print(_format_evaluation(result, env_id=args.env))
     return 0
+
+
+def _wandb_tracker(args, spec: RunSpec, preset: str, out: Path):
+    """``--wandb``'s tracker, refused at once (before the run directory is made) where wandb is not installed. The
+    preset is the run's (the model, made from its settings, names none)."""
+    from pamdp.callbacks import WandbCallback
+
+    config = {"preset": preset, "total_steps": spec.total_steps, "run_dir": str(out)}
+    try:
+        return WandbCallback(project=args.wandb_project, name=out.name, config=config)
+    except ImportError as exc:
+        raise ValueError(str(exc)) from None
 
 
 # -- reproduce, plot --------------------------------------------------------------------------------

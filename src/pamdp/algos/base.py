@@ -37,6 +37,8 @@ from pamdp.spaces import HybridActionSpace
 if TYPE_CHECKING:
     from typing_extensions import Self  # typing.Self from Python 3.11
 
+    from pamdp.callbacks import BaseCallback
+
 __all__ = ["Algorithm", "resolve_device"]
 
 
@@ -75,6 +77,15 @@ def _count(name: str, value: object, low: int) -> int:
     if not (number and math.isfinite(value) and value == int(value) and value >= low):
         raise ValueError(f"{name} = {value!r}; expected an integer >= {low}")
     return int(value)
+
+
+def _eval_figures(result: dict[str, float]) -> dict[str, float]:
+    """An evaluation's figures as a run logs them: ``eval/mean_return``, ``eval/mean_length`` and, where the env
+    reports success, ``eval/success_rate``."""
+    figures = {"eval/mean_return": result["mean_return"], "eval/mean_length": result["mean_length"]}
+    if "success_rate" in result:
+        figures["eval/success_rate"] = result["success_rate"]
+    return figures
 
 
 def _shown(shapes: dict[str, list[int]]) -> str:
@@ -244,7 +255,7 @@ class Algorithm:
     def learn(
         self,
         total_timesteps: int,
-        callback: Callable[[Algorithm, dict[str, float]], bool | None] | None = None,
+        callback: BaseCallback | list[BaseCallback] | Callable | None = None,
         progress_bar: bool = True,
         run_dir: str | os.PathLike | None = None,
         checkpoint_every: int = 1,
@@ -259,8 +270,10 @@ class Algorithm:
         ``num_envs`` copies) is said at the start in a ``UserWarning``; :attr:`num_updates` counts what was learned.
 
         Args:
-            callback: called after every epoch with the algorithm and the epoch's statistics; returning
-                ``False`` stops training.
+            callback: a :class:`~pamdp.callbacks.BaseCallback`, a list of them, or a function called after every
+                epoch with the algorithm and the epoch's statistics (:mod:`pamdp.callbacks` says when each hook
+                runs). ``False`` from a hook stops training after that epoch, its checkpoint written (with
+                ``run_dir``) whatever ``checkpoint_every``.
             progress_bar: show a tqdm progress bar on the terminal.
             run_dir: where to write ``progress.csv``, TensorBoard logs (``tb/``) and ``checkpoint.pt``.
             checkpoint_every: epochs between checkpoints (with ``run_dir``).
@@ -280,14 +293,15 @@ class Algorithm:
             )
         if eval_every > 0 and self.env_id is None:  # before training, not after its first epoch
             raise ValueError("eval_every needs a registered env (an env id); this model's env has none")
-        if callback is not None and not callable(callback):  # before training, not after its first epoch
-            raise ValueError(f"callback = {callback!r:.60}; expected a function of (model, stats), or None")
+        from pamdp.callbacks import as_callback
+
+        callback = as_callback(callback)  # before training, not after its first epoch
         note = self.loop.budget_note(total_timesteps) if total_timesteps > 0 and self.loop is not None else None
         if note is not None:
             warnings.warn(note, UserWarning, stacklevel=2)
         torch.set_num_threads(self.config.torch_threads)
         target = self.num_timesteps + int(total_timesteps)
-        logger = Logger(run_dir, resume_step=self.num_timesteps) if run_dir is not None else None
+        logger = Logger(run_dir, resume_step=self.num_timesteps)
         start_steps, start_time = self.num_timesteps, time.perf_counter()
         bar = tqdm(
             total=target,
@@ -297,6 +311,8 @@ class Algorithm:
             dynamic_ncols=True,
         )
         try:
+            callback.init_callback(self, logger)
+            callback.on_training_start()
             while self.num_timesteps < target:
                 t0, cpu0 = time.perf_counter(), time.process_time()
                 stats = self._run_epoch(target - self.num_timesteps)
@@ -314,29 +330,31 @@ class Algorithm:
                         "charts/SPS": (self.num_timesteps - start_steps) / (time.perf_counter() - start_time),
                     }
                 )
+                stop = False
                 if eval_every > 0 and self.epoch % eval_every == 0:
-                    stats.update(self._greedy_evaluation(eval_episodes))
-                if logger is not None:
-                    logger.record(stats, self.num_timesteps)
-                    if self.epoch % checkpoint_every == 0:
-                        self.save(Path(run_dir) / CHECKPOINT)
+                    result = self._greedy_evaluation(eval_episodes)
+                    stats.update(_eval_figures(result))
+                    stop = callback.on_evaluation(result) is False
+                logger.record(stats, self.num_timesteps)
+                saved = run_dir is not None and self.epoch % checkpoint_every == 0
+                if saved:
+                    self.save(Path(run_dir) / CHECKPOINT)
                 bar.update(self.num_timesteps - bar.n)
                 if "charts/episodic_return" in stats:
                     bar.set_postfix(ret=f"{stats['charts/episodic_return']:.3f}", epoch=self.epoch)
-                if callback is not None and callback(self, stats) is False:
+                stop = (callback.on_epoch(stats) is False) or stop
+                if stop:
+                    if run_dir is not None and not saved:  # a stopped run resumes from where it stopped
+                        self.save(Path(run_dir) / CHECKPOINT)
                     break
+            callback.on_training_end()
         finally:
             bar.close()
-            if logger is not None:
-                logger.close()
+            logger.close()
         return self
 
     def _greedy_evaluation(self, episodes: int) -> dict[str, float]:
-        result = evaluate(self, episodes=episodes, seed=10_000 + self.config.seed)
-        stats = {"eval/mean_return": result["mean_return"], "eval/mean_length": result["mean_length"]}
-        if "success_rate" in result:
-            stats["eval/success_rate"] = result["success_rate"]
-        return stats
+        return evaluate(self, episodes=episodes, seed=10_000 + self.config.seed)
 
     def _shapes(self) -> dict[str, list[int]]:
         """What the networks' sizes follow from: the observation's shape and each action's parameter count."""

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import os
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -108,19 +109,27 @@ class EpisodeTracker:
 
 
 class Logger:
-    """One CSV row and a set of TensorBoard scalars per epoch, in ``run_dir/progress.csv`` and ``run_dir/tb``.
+    """One CSV row and a set of TensorBoard scalars per epoch, in ``run_dir/progress.csv`` and ``run_dir/tb``, and
+    the same figures to every function of :attr:`sinks` (an experiment tracker's, such as
+    :class:`~pamdp.callbacks.WandbCallback`): the one place a run's figures fan out from.
 
     On resume (``resume_step > 0``) rows logged after the checkpoint being resumed are dropped, so that a
-    killed and restarted run leaves one clean log.
+    killed and restarted run leaves one clean log. Without ``run_dir`` only the sinks get the figures.
     """
 
-    def __init__(self, run_dir: str | os.PathLike, resume_step: int = 0):
+    def __init__(self, run_dir: str | os.PathLike | None = None, resume_step: int = 0):
+        self.sinks: list[Callable[[dict[str, float], int], None]] = []
+        """Functions of ``(figures, step)`` that get what :meth:`record` records."""
+        self.run_dir = None if run_dir is None else Path(run_dir)
+        self.rows: list[dict[str, Any]] = []
+        self._last_step: int | None = None
+        self.writer = None
+        if self.run_dir is None:
+            return
         from torch.utils.tensorboard import SummaryWriter
 
-        self.run_dir = Path(run_dir)
         self.run_dir.mkdir(parents=True, exist_ok=True)
         self.csv_path = self.run_dir / "progress.csv"
-        self.rows: list[dict[str, Any]] = []
         if self.csv_path.exists():
             with open(self.csv_path, newline="") as f:
                 self.rows = [r for r in csv.DictReader(f) if float(r["time/total_timesteps"]) <= resume_step]
@@ -130,19 +139,29 @@ class Logger:
         self.writer = SummaryWriter(str(self.run_dir / "tb"), purge_step=resume_step + 1 if resume_step else None)
 
     def record(self, stats: dict[str, float], step: int) -> None:
-        for key, value in stats.items():
-            self.writer.add_scalar(key, value, step)
-        self.writer.flush()
-        self.rows.append(stats)
-        columns: list[str] = []
-        for row in self.rows:
-            columns += [k for k in row if k not in columns]
-        tmp = self.csv_path.with_suffix(".csv.tmp")
-        with open(tmp, "w", newline="") as f:
-            writer = csv.DictWriter(f, fieldnames=columns)
-            writer.writeheader()
-            writer.writerows(self.rows)
-        os.replace(tmp, self.csv_path)
+        """Log ``stats`` at ``step``; a second call at the step just recorded adds to that step's row (a callback's
+        figures of the epoch, such as :class:`~pamdp.callbacks.EvalCallback`'s)."""
+        same_step, self._last_step = step == self._last_step, step
+        if self.writer is not None:
+            for key, value in stats.items():
+                self.writer.add_scalar(key, value, step)
+            self.writer.flush()
+            if same_step:
+                self.rows[-1] = {**self.rows[-1], **stats}
+            else:
+                self.rows.append(stats)
+            columns: list[str] = []
+            for row in self.rows:
+                columns += [k for k in row if k not in columns]
+            tmp = self.csv_path.with_suffix(".csv.tmp")
+            with open(tmp, "w", newline="") as f:
+                writer = csv.DictWriter(f, fieldnames=columns)
+                writer.writeheader()
+                writer.writerows(self.rows)
+            os.replace(tmp, self.csv_path)
+        for sink in self.sinks:
+            sink(stats, step)
 
     def close(self) -> None:
-        self.writer.close()
+        if self.writer is not None:
+            self.writer.close()
