@@ -100,3 +100,34 @@ algo = "patrpo"
     second = [(spec, out) for spec, out in jobs if spec.label == "second"]
     sources = [str(tmp_path / "out" / "good" / "zero" / f"seed{s}") for s in (0, 1)]
     assert [spec.init_from for spec, _ in second] == sources
+
+
+def test_a_curriculum_runs_its_stages_in_order_whatever_the_jobs_order(tmp_path):
+    """Given the second stage first (as two workers could start it before the first ends), it waits for the first
+    and starts from that stage's final model."""
+    from pamdp.experiments.runner import run_all
+
+    (tmp_path / "c.toml").write_text("""
+description = "two stages"
+env = "pamdp/Platform-v0"
+total_steps = 600
+seeds = [0]
+eval_episodes = 0
+[[runs]]
+label = "first"
+algo = "patrpo"
+settings = { num_envs = 2, batch_size = 200 }
+[[runs]]
+label = "second"
+algo = "patrpo"
+init_from = "first"
+settings = { num_envs = 2, batch_size = 200 }
+""")
+    exp = load_experiment(tmp_path / "c.toml")
+    jobs = exp.jobs(tmp_path / "out", exp.specs())
+    outcomes = run_all(list(reversed(jobs)), workers=1, log=lambda msg: None)
+    assert [o.error for o in outcomes] == [None, None]
+    first, second = (tmp_path / "out" / "c" / label / "seed0" for label in ("first", "second"))
+    log = (second / "stdout.log").read_text()
+    assert f"networks started from {first}" in log
+    assert (first / "final_model.pt").stat().st_mtime < (second / "run.json").stat().st_mtime

@@ -416,8 +416,25 @@ class RunOutcome:
     seconds: float
 
 
+def _waves(jobs: list[tuple[RunSpec, str]]) -> list[list[tuple[RunSpec, str]]]:
+    """``jobs`` in waves that run one after another: a run started from another job's model (``init_from``) comes
+    in a wave after the one that trains it."""
+    waves, left = [], list(jobs)
+    while left:
+        pending = {os.path.normpath(out) for _, out in left}
+        wave = [(spec, out) for spec, out in left if os.path.normpath(spec.init_from or ".") not in pending]
+        if not wave:  # a circle of init_from: run them as given, and each fails on its missing source
+            wave = left
+        waves.append(wave)
+        left = [job for job in left if job not in wave]
+    return waves
+
+
 def run_all(jobs: list[tuple[RunSpec, str]], workers: int = 1, log=print) -> list[RunOutcome]:
-    """Run ``(spec, out_dir)`` jobs, ``workers`` at a time in separate processes (1: in this process)."""
+    """Run ``(spec, out_dir)`` jobs, ``workers`` at a time in separate processes (1: in this process); a run
+    started from another job's model waits for it (:func:`_waves`)."""
+    if len(waves := _waves(jobs)) > 1:
+        return [outcome for wave in waves for outcome in run_all(wave, workers, log)]
     outcomes: list[RunOutcome] = []
     if workers <= 1:
         for spec, out in jobs:
