@@ -128,7 +128,7 @@ def test_bad_actuator_counts_are_refused(n):
         ((3, (np.zeros(1),) * 15), r"invalid parameters \(15 boxes\)"),
         (
             (3, (np.zeros(1),) * 3 + (np.array([np.nan]),) + (np.zeros(1),) * 12),
-            "copy 0: parameter nan of action 3; expected a finite number",
+            r"parameter 3 contains \[nan\]; expected .* each p a finite array",
         ),
         ((3, (np.zeros(2),) * 16), r"the chosen parameters have shapes \[\(1, 2\)\]"),
     ],
@@ -194,8 +194,11 @@ def test_batched_actions_are_checked(n, bad_shape, bad_list):
     with pytest.raises(ValueError, match=rf"discrete actions \[{k}\] at indices \[1\]"):
         venv.step((np.array([0, k]), tuple(boxes)))
     before = venv.states
-    with pytest.raises(ValueError, match=r"copy 1: parameter inf of action 5; expected a finite number"):
-        venv.step((np.array([0, 5]), tuple(boxes[:5] + [np.array([[0.0], [np.inf]])] + boxes[6:])))
+    for chosen in ([0, 5], [0, 1]):  # the box with an infinity chosen by copy 1, and chosen by none
+        bad = boxes[:5] + [np.array([[0.0], [np.inf]], np.float32)] + boxes[6:]
+        for params in (tuple(bad), np.stack(bad)):
+            with pytest.raises(ValueError, match=r"parameter 5 contains \[inf\]; expected .* finite"):
+                venv.step((np.array(chosen), params))
     np.testing.assert_array_equal(venv.states, before)  # checked before any copy moves
     with pytest.raises(ValueError, match=bad_shape):
         venv.step((np.array([5, 5]), tuple(boxes[:5] + [np.zeros((2, 2))] + boxes[6:])))
