@@ -5,6 +5,7 @@ before anything runs, in one line naming it (issue 46). Over every algorithm of 
 from __future__ import annotations
 
 import re
+import sys
 import warnings
 
 import gymnasium
@@ -132,3 +133,25 @@ def test_a_run_that_makes_no_update_warns_at_the_start_and_says_so_at_the_end(tm
     with pytest.warns(UserWarning, match="makes no gradient update"):
         assert main([*argv, "--learning-starts", "100"]) == 0
     assert "no gradient update: untrained" in capsys.readouterr().err
+
+
+def test_the_command_line_shows_a_warning_as_one_line_of_its_own_and_the_api_keeps_pythons_form(
+    tmp_path, capsys, monkeypatch
+):
+    """Python's default ``showwarning`` writes ``warnings.formatwarning``'s text to stderr (pytest records warnings
+    instead, so the test puts that default back)."""
+
+    def shown(message, category, filename, lineno, file=None, line=None):
+        sys.stderr.write(warnings.formatwarning(message, category, filename, lineno, line))
+
+    monkeypatch.setattr(warnings, "showwarning", shown)
+    argv = ["train", "pdqn", "--preset", "hfo", "--total-steps", "40", "--learning-starts", "100", *SMALL_CLI]
+    with warnings.catch_warnings():
+        warnings.simplefilter("always")
+        assert main([*argv, "--out", str(tmp_path / "run")]) == 0
+        err = capsys.readouterr().err.splitlines()
+        warned = [line for line in err if "warning" in line.lower()]
+        assert len(warned) == 2 and all(line.startswith("pamdp: warning: ") for line in warned), warned
+        assert "preset 'hfo' of PDQNConfig was made for" in warned[0] and "makes no gradient update" in warned[1]
+        warnings.warn("from the API", UserWarning, stacklevel=1)
+        assert re.search(r"^\S+\.py:\d+: UserWarning: from the API$", capsys.readouterr().err, re.M)
