@@ -1,12 +1,8 @@
-"""The scalar env: a :class:`~pamdp.envs.vector.Domain` at N = 1 as a ``gymnasium.Env``.
-
-It keeps one state row and one :class:`~pamdp.envs.streams.RandomStreams` copy that follows ``np_random``
-(a replaced generator, e.g. ``numpy.random.RandomState(S)`` or a seeded reset, drops the numbers drawn
-ahead of it), and runs the domain's own batched ``parse``, ``reset`` and ``step`` on them: one action is
-checked as a batch of one (:func:`as_batch`), and the batched infos are read back as copy 0's. It does not
-autoreset; it truncates at ``max_episode_steps`` itself (the domain's limit by default: the registrations set
-none, so ``gymnasium.make`` adds no ``TimeLimit``, whose reset would zero the count before a refused reset).
-"""
+"""The scalar env: a :class:`~pamdp.envs.vector.Domain` at N = 1 as a ``gymnasium.Env``, running the domain's own
+batched ``parse``, ``reset`` and ``step`` on one state row (``docs/environments.md``, "How the environments are
+built"). Its stream follows ``np_random`` (a replaced generator drops the numbers drawn ahead of it); it does not
+autoreset, and counts its own time limit (the registrations set none: Gymnasium's ``TimeLimit`` would zero the
+count before a refused reset)."""
 
 from __future__ import annotations
 
@@ -15,8 +11,8 @@ import inspect
 import gymnasium
 import numpy as np
 
-from pamdp.envs.streams import RandomStreams, check_seed
-from pamdp.envs.vector import Domain, DomainVectorEnv, build_domain, check_options, check_render_mode, time_limit
+from pamdp.envs.streams import check_seed
+from pamdp.envs.vector import Domain, DomainVectorEnv, Shell
 
 __all__ = ["DomainEnv", "as_batch", "env_classes"]
 
@@ -43,7 +39,7 @@ def as_batch(action):
     return np.asarray(a)[None], _OneEach(params) if isinstance(params, (tuple, list)) else params
 
 
-class DomainEnv(gymnasium.Env):
+class DomainEnv(Shell, gymnasium.Env):
     """One copy of a :class:`~pamdp.envs.vector.Domain` (``domain_class``) as a Gymnasium env.
 
     Args:
@@ -53,34 +49,15 @@ class DomainEnv(gymnasium.Env):
         **variant: the domain's constructor arguments.
     """
 
-    metadata = {"render_modes": ["rgb_array"]}
-    domain_class: type[Domain]
-    variant: dict = {}
-    """Constructor arguments of the domain fixed by the class (Hard Goal's ``hard=True``)."""
-    num_envs = 1
-    """The domain's hooks see the scalar env as a batched one of one copy."""
+    num_envs = 1  # the domain's hooks see the scalar env as a batched one of one copy
 
     def __init__(
         self, render_mode: str | None = None, max_episode_steps: int | str | None = "domain", **variant: object
     ):
-        self.domain = domain = build_domain(self.domain_class, {**self.variant, **variant})
-        self.max_episode_steps = time_limit(max_episode_steps, domain)
+        domain = self._build(1, "scalar_buffer_size", max_episode_steps, render_mode, variant)
+        self.action_space, self.observation_space = domain.action_space, domain.observation_space
         self._elapsed = 0
-        check_render_mode(render_mode, self.metadata["render_modes"])
-        self.metadata = {**self.metadata, "render_fps": domain.render_fps}
-        self.render_mode = render_mode
-        self.action_space = domain.action_space
-        self.observation_space = domain.observation_space
-        self.streams = RandomStreams(1, domain.draw, domain.scalar_buffer_size)
-        self._states = domain.initial_states(1)
-        self._started = False
         self._calm = np.zeros(1, dtype=bool)  # a scalar env never resets inside a step
-
-    def __getattr__(self, name: str):
-        # The domain's variant and tables (``n``, ``motions``, ``settings``...) read as the env's own.
-        if name == "domain":
-            raise AttributeError(name)
-        return getattr(self.domain, name)
 
     @property
     def state(self):
@@ -90,7 +67,7 @@ class DomainEnv(gymnasium.Env):
 
     def reset(self, *, seed: int | None = None, options: dict | None = None):
         check_seed(seed)
-        check_options(self.domain, options, 1)
+        self._check_options(options, 1)
         super().reset(seed=seed)
         self.streams.follow(0, self.np_random)
         if self.domain.reset_draws:

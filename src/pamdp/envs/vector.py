@@ -1,24 +1,6 @@
-"""pamdp's one env shell: a domain's copies as a Gymnasium ``VectorEnv``, and what every domain shares.
-
-A domain is a subclass of :class:`Domain` (see its docstring for the contract; ``envs/platform/env.py`` is
-a worked example): sizes, spaces, random numbers per step, one batch action parser and compiled per-copy
-``reset`` / ``step`` / ``observe`` looped over the copies. :class:`DomainVectorEnv` runs N copies of it;
-``pamdp.envs.scalar.DomainEnv`` is the same domain at N = 1. A variant (Hard Goal, Sliding, Hard Move's
-``n``, HFO's settings) is a constructor argument of the domain, passed through the registration's kwargs.
-
-Every copy draws only from its own generator, seeded as Gymnasium seeds the copies of its vector envs:
-``reset(seed=s)`` gives copy i ``seed + i``, ``reset(seed=[s0, s1, ...])`` one seed each. A copy's
-trajectory therefore depends on its seed alone, not on how many copies run beside it, and copy i equals the
-scalar env reset with copy i's seed, step for step, noise included.
-
-Random numbers reach compiled code through :class:`~pamdp.envs.streams.RandomStreams`, one buffer of draws per
-copy, topped up by the shell before a step; the compiled step never calls back.
-
-The shell does the rest: argument checks, seeding, ``options={"reset_mask": mask}``, next-step autoreset
-(the step after an episode ends returns the copy's reset observation, reward 0, both flags false), the
-``max_episode_steps`` truncation, and ``np_randoms`` (the copies' generators; assigning a sequence of
-generators, or of stand-ins such as a Platform ``ZeroNoise``, replaces them and drops the buffers).
-"""
+"""pamdp's one env shell: a :class:`Domain`'s copies as a Gymnasium ``VectorEnv`` (:class:`DomainVectorEnv`), and
+what it shares with the scalar env (:class:`Shell`). The contract, the seeding and the rules the shell keeps:
+``docs/environments.md``, "How the environments are built" and "Writing a new domain"."""
 
 from __future__ import annotations
 
@@ -34,75 +16,11 @@ from gymnasium.vector.utils import batch_space
 
 from pamdp.envs.streams import RandomStreams, copy_seeds
 
-__all__ = [
-    "Domain",
-    "DomainVectorEnv",
-    "build_domain",
-    "check_options",
-    "check_render_mode",
-    "time_limit",
-    "split_actions",
-    "column",
-]
+__all__ = ["Domain", "DomainVectorEnv", "Shell", "split_actions", "column"]
 
 _TYPES = {bool: (bool, np.bool_), int: (int, np.integer), float: (int, float, np.integer, np.floating), str: (str,)}
 """What a value of a domain argument annotated with the key may be (``bool`` nowhere but under ``bool``)."""
-
-
-def build_domain(domain_class: type[Domain], variant: dict) -> Domain:
-    """The domain made with the constructor arguments ``variant``, each checked first against the constructor's
-    signature: an unknown name, or a value of another type than its annotation (a bool argument takes only a real
-    bool: ``deterministic="no"`` would otherwise switch it on), is a ``ValueError`` naming the argument, the value
-    and what is expected. The constructor checks the ranges."""
-    params = {n: p for n, p in inspect.signature(domain_class.__init__).parameters.items() if n != "self"}
-    hints = typing.get_type_hints(domain_class.__init__)
-    for name, value in variant.items():
-        if name not in params:
-            expected = ", ".join(params) or "none"
-            raise ValueError(f"{domain_class.name} takes no argument {name!r}; expected some of {expected}")
-        kinds = _TYPES.get(hints.get(name))
-        if kinds is None:
-            continue
-        if isinstance(value, (bool, np.bool_)) and hints[name] is not bool or not isinstance(value, kinds):
-            raise ValueError(f"{domain_class.name} argument {name}={value!r}; expected {hints[name].__name__}")
-    return domain_class(**variant)
-
-
-def time_limit(max_episode_steps, domain: Domain) -> int | None:
-    """The shells' ``max_episode_steps`` argument checked: ``"domain"`` (the domain's limit), None or a positive
-    integer."""
-    if max_episode_steps == "domain":
-        return domain.max_episode_steps
-    if max_episode_steps is not None and (
-        isinstance(max_episode_steps, bool)
-        or not isinstance(max_episode_steps, (int, np.integer))
-        or max_episode_steps < 1
-    ):
-        raise ValueError(f"max_episode_steps must be a positive integer or None, got {max_episode_steps!r}")
-    return max_episode_steps
-
-
-def check_options(domain: Domain, options, n: int, shell_keys: tuple[str, ...] = ()) -> None:
-    """The one rule for ``reset(options=...)``: None or a dict whose keys are among the domain's
-    ``reset_options`` and the shell's ``shell_keys``; anything else is a ``ValueError`` naming the unknown keys and
-    the accepted ones. Then the domain checks the values (:meth:`Domain.check_options`)."""
-    if options is None:
-        return
-    accepted = (*domain.reset_options, *shell_keys)
-    listed = ", ".join(map(repr, accepted)) or "none"
-    if not isinstance(options, dict):
-        raise ValueError(f"reset options={options!r}; expected None or a dict with keys among {listed}")
-    unknown = [k for k in options if k not in accepted]
-    if unknown:
-        hints = "".join(f"; {domain.option_hints[k]}" for k in unknown if k in domain.option_hints)
-        raise ValueError(f"{domain.name} takes no reset option(s) {unknown}; expected any of {listed}{hints}")
-    domain.check_options(options, n)
-
-
-def check_render_mode(render_mode, modes) -> None:
-    """``ValueError`` unless ``render_mode`` is None or one of ``modes``."""
-    if render_mode is not None and render_mode not in modes:
-        raise ValueError(f"render_mode={render_mode!r} is not supported; expected one of {[None, *modes]}")
+NO_GENERATOR = "each copy has its own generator: read or assign np_randoms (one per copy)"
 
 
 def split_actions(actions, domain: str, n: int, expected: str, n_actions=None, n_params=None) -> tuple:
@@ -136,50 +54,24 @@ def column(p, n: int, name: int | str, expected: str) -> np.ndarray:
 
 
 class Domain:
-    """The contract between a domain and the env shell; a domain subclasses it once, in its ``env.py``.
+    """The contract between a domain and the env shell, subclassed once in the domain's ``env.py``: the class
+    attributes below, ``action_space`` and ``observation_space`` (one copy's), and the methods. An instance is one
+    variant (its constructor's arguments) for one env, and may set its own sizes and keep per-copy arrays."""
 
-    An instance is one variant (its constructor takes the variant's arguments: Hard Move's ``n``, Goal's
-    ``hard``, HFO's settings...) for one env; it may keep per-copy arrays of its own beside the state rows, and
-    a variant may set its own sizes (``state_size``, the spaces) in its constructor: more players, another
-    observation.
-    It sets the class attributes below and ``action_space`` / ``observation_space`` (one copy's), and
-    implements:
-
-    * :meth:`parse`: check a batch of ``n`` actions (``batch_space`` of ``action_space``) and return the
-      arrays its compiled step reads, or raise ``ValueError`` naming the bad part and the expected form. The
-      scalar env hands it one action as a batch of one (:func:`pamdp.envs.scalar.as_batch`);
-    * :meth:`reset` and :meth:`step`: one compiled call each over the copies (``env._states`` rows,
-      ``env.streams`` buffers), returning batched observations, rewards, flags and infos in Gymnasium's
-      merged form (``info[k]`` an array, ``info["_" + k]`` which copies report it);
-    * :meth:`frame`: the picture of copy ``i`` for ``render_mode="rgb_array"`` (and :meth:`substep_frames`
-      where a step runs sub-steps worth showing).
-    """
-
-    name: str
-    """The domain's name in error messages."""
+    name: str  # in error messages
     render_fps: int = 10
-    state_size: int
-    """Length of one copy's state row."""
-    draw: str = "random"
-    """The generator method a copy's numbers come from (see :class:`RandomStreams`)."""
-    reset_draws: int = 0
-    """The most numbers one copy's reset takes."""
-    step_draws: int = 0
-    """The most numbers one copy's step takes before it must be topped up (0: a step draws nothing)."""
-    buffer_size: int = 1
-    """Numbers kept per copy in the batched env."""
-    scalar_buffer_size: int = 1
-    """Numbers kept in the scalar env (just a reset's where nothing should be drawn ahead of ``np_random``)."""
-    max_episode_steps: int | None = None
-    """The registration's time limit, also the batched env's default; None leaves the end to the domain."""
-    reset_options: tuple[str, ...] = ()
-    """The keys ``reset(options=...)`` takes (the batched env's ``reset_mask`` besides); others are refused."""
-    option_hints: dict = {}
-    """A word for a key that is refused but looks meant (Hard Move's ``n``: a constructor argument)."""
+    state_size: int  # length of one copy's state row
+    draw: str = "random"  # the generator method a copy's numbers come from (RandomStreams)
+    reset_draws: int = 0  # the most numbers one copy's reset takes
+    step_draws: int = 0  # the most one copy's step takes before it must be topped up (0: a step draws nothing)
+    buffer_size: int = 1  # numbers kept per copy in the batched env
+    scalar_buffer_size: int = 1  # in the scalar env (a reset's where nothing may be drawn ahead of np_random)
+    max_episode_steps: int | None = None  # the time limit, also the batched env's default; None: the domain's end
+    reset_options: tuple[str, ...] = ()  # the keys reset(options=...) takes (and the batched env's reset_mask)
+    option_hints: dict = {}  # a word for a refused key that looks meant (Hard Move's n: a constructor argument)
 
     def initial_states(self, n: int) -> np.ndarray:
-        """The state rows ``(n, state_size)`` before the first reset (and where the domain keeps per-copy arrays
-        of its own, such as the last actions its pictures show, it allocates them here)."""
+        """The state rows ``(n, state_size)`` before the first reset (and the domain's own per-copy arrays)."""
         return np.zeros((n, self.state_size))
 
     def state(self, states: np.ndarray):
@@ -187,14 +79,18 @@ class Domain:
         return states.copy()
 
     def parse(self, actions, n: int) -> tuple:
+        """Check a batch of ``n`` actions (``batch_space`` of ``action_space``; the scalar env's one action as a
+        batch of one) and return what the compiled step reads, or raise ``ValueError`` naming the bad part and the
+        expected form."""
         raise NotImplementedError
 
     def check_options(self, options: dict, n: int) -> None:
-        """Check the values of ``reset`` options for ``n`` copies (the keys are checked already); ``ValueError``
-        naming a bad one. Runs before any copy is seeded or reset."""
+        """Check the values of ``reset`` options for ``n`` copies (the keys are checked already), before any copy
+        is seeded or reset; ``ValueError`` naming a bad one."""
 
     def reset(self, env, mask: np.ndarray, options: dict | None, seeded: np.ndarray) -> tuple:
-        """Start an episode in the copies where ``mask`` is true (``seeded``: those just given a seed)."""
+        """Start an episode in the copies where ``mask`` is true (``seeded``: those just given a seed): one compiled
+        call over ``env._states`` and ``env.streams``, returning batched observations and merged infos."""
         raise NotImplementedError
 
     def step(self, env, parsed: tuple, resetting: np.ndarray) -> tuple:
@@ -205,31 +101,88 @@ class Domain:
         raise NotImplementedError
 
     def substep_frames(self, env) -> list[np.ndarray]:
-        """The scalar env's frames of its last step: one per sub-step where a step runs several and the domain
-        records them (Platform, Goal; none after a reset), else the one after the step."""
+        """The scalar env's frames of its last step: one per sub-step where the domain records them (Platform,
+        Goal; none after a reset), else the one after the step."""
         return [self.frame(env, 0)]
 
 
-class DomainVectorEnv(VectorEnv):
-    """``num_envs`` copies of a :class:`Domain`, stepped together, with Gymnasium's next-step autoreset.
+class Shell:
+    """What the scalar env and the batched env share: the domain of ``domain_class`` made with the ``variant``, the
+    checks of their arguments and of reset options, the state rows and the random streams; the domain's attributes
+    (``n``, ``motions``, ``settings``...) read as the env's own."""
 
-    Actions are batched like ``batch_space`` of the scalar action space (what
-    :meth:`pamdp.spaces.HybridActionSpace.to_env_batch` produces). The step that ends an episode returns its
-    last observation with ``terminated`` or ``truncated`` set; the next ``step`` ignores that copy's action,
-    resets it, and returns the reset observation with reward 0 and both flags false.
+    metadata = {"render_modes": ["rgb_array"]}
+    domain_class: type[Domain]
+    variant: dict = {}  # constructor arguments of the domain fixed by the class (Hard Goal's hard=True)
+
+    def _build(self, n: int, buffer_size: str, max_episode_steps, render_mode, variant: dict) -> Domain:
+        """Check the arguments (an unknown domain argument, or one of another type than its annotation, is a
+        ``ValueError`` naming it: ``deterministic="no"`` would otherwise switch it on) and set the shell up."""
+        cls, variant = self.domain_class, {**self.variant, **variant}
+        params = [name for name in inspect.signature(cls.__init__).parameters if name != "self"]
+        hints = typing.get_type_hints(cls.__init__)
+        for name, value in variant.items():
+            if name not in params:
+                expected = ", ".join(params) or "none"
+                raise ValueError(f"{cls.name} takes no argument {name!r}; expected some of {expected}")
+            kinds, hint = _TYPES.get(hints.get(name)), hints.get(name)
+            if kinds and (isinstance(value, (bool, np.bool_)) and hint is not bool or not isinstance(value, kinds)):
+                raise ValueError(f"{cls.name} argument {name}={value!r}; expected {hint.__name__}")
+        self.domain = domain = cls(**variant)  # the constructor checks the ranges
+        if max_episode_steps == "domain":
+            max_episode_steps = domain.max_episode_steps
+        elif max_episode_steps is not None and (
+            isinstance(max_episode_steps, bool) or not isinstance(max_episode_steps, (int, np.integer))
+            or max_episode_steps < 1
+        ):  # fmt: skip
+            raise ValueError(f"max_episode_steps must be a positive integer or None, got {max_episode_steps!r}")
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            modes = [None, *self.metadata["render_modes"]]
+            raise ValueError(f"render_mode={render_mode!r} is not supported; expected one of {modes}")
+        self.max_episode_steps, self.render_mode = max_episode_steps, render_mode
+        self.metadata = {**self.metadata, "render_fps": domain.render_fps}
+        self.streams = RandomStreams(n, domain.draw, getattr(domain, buffer_size))
+        self._states = domain.initial_states(n)
+        self._started = False
+        return domain
+
+    def __getattr__(self, name: str):
+        if name == "np_random":  # the batched env's property refused it; Python then asks here, for the hint
+            raise AttributeError(NO_GENERATOR)
+        if name == "domain":
+            raise AttributeError(name)
+        return getattr(self.domain, name)
+
+    def _check_options(self, options, n: int, shell_keys: tuple[str, ...] = ()) -> None:
+        """The one rule for ``reset(options=...)``: None or a dict whose keys are among the domain's
+        ``reset_options`` and ``shell_keys``, else a ``ValueError`` naming the unknown keys and the accepted ones;
+        then the domain checks the values."""
+        if options is None:
+            return
+        domain, accepted = self.domain, (*self.domain.reset_options, *shell_keys)
+        listed = ", ".join(map(repr, accepted)) or "none"
+        if not isinstance(options, dict):
+            raise ValueError(f"reset options={options!r}; expected None or a dict with keys among {listed}")
+        unknown = [k for k in options if k not in accepted]
+        if unknown:
+            hints = "".join(f"; {domain.option_hints[k]}" for k in unknown if k in domain.option_hints)
+            raise ValueError(f"{domain.name} takes no reset option(s) {unknown}; expected any of {listed}{hints}")
+        domain.check_options(options, n)
+
+
+class DomainVectorEnv(Shell, VectorEnv):
+    """``num_envs`` copies of a :class:`Domain`, stepped together, with Gymnasium's next-step autoreset (the step
+    after an episode ends ignores that copy's action and returns its reset observation, reward 0, both flags false).
 
     Args:
         num_envs: number of copies N.
-        max_episode_steps: episodes are truncated after this many agent steps (default: the domain's,
-            which the registration also sets; ``make_vec`` passes it in). ``None`` leaves the end to the domain.
+        max_episode_steps: episodes are truncated after this many agent steps (default: the domain's); ``None``
+            leaves the end to the domain.
         render_mode: ``None`` or ``"rgb_array"``; :meth:`render` then returns one frame per copy.
         **variant: the domain's constructor arguments.
     """
 
-    metadata = {"render_modes": ["rgb_array"], "autoreset_mode": AutoresetMode.NEXT_STEP}
-    domain_class: type[Domain]
-    variant: dict = {}
-    """Constructor arguments of the domain fixed by the class (Hard Goal's ``hard=True``)."""
+    metadata = {**Shell.metadata, "autoreset_mode": AutoresetMode.NEXT_STEP}
 
     def __init__(
         self,
@@ -240,31 +193,13 @@ class DomainVectorEnv(VectorEnv):
     ):
         if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) or num_envs < 1:
             raise ValueError(f"num_envs must be a positive integer, got {num_envs!r}")
-        self.domain = domain = build_domain(self.domain_class, {**self.variant, **variant})
-        max_episode_steps = time_limit(max_episode_steps, domain)
-        check_render_mode(render_mode, self.metadata["render_modes"])
-        self.metadata = {**self.metadata, "render_fps": domain.render_fps}
-        self.num_envs = int(num_envs)
-        self.max_episode_steps = max_episode_steps
-        self.render_mode = render_mode
-        self.single_action_space = domain.action_space
-        self.single_observation_space = domain.observation_space
-        self.action_space = batch_space(self.single_action_space, self.num_envs)
-        self.observation_space = batch_space(self.single_observation_space, self.num_envs)
-        self.streams = RandomStreams(self.num_envs, domain.draw, domain.buffer_size)
-        self._states = domain.initial_states(self.num_envs)
+        self.num_envs = n = int(num_envs)
+        domain = self._build(n, "buffer_size", max_episode_steps, render_mode, variant)
+        self.single_action_space, self.single_observation_space = domain.action_space, domain.observation_space
+        self.action_space = batch_space(self.single_action_space, n)
+        self.observation_space = batch_space(self.single_observation_space, n)
         self.draws_per_step = max(domain.reset_draws, domain.step_draws)
-        self._elapsed = np.zeros(self.num_envs, dtype=np.int64)
-        self._autoreset = np.zeros(self.num_envs, dtype=bool)
-        self._started = False
-
-    def __getattr__(self, name: str):
-        # The domain's variant and tables (``n``, ``motions``, ``settings``...) read as the env's own.
-        if name == "np_random":  # its property refused it; Python then asks here, so the hint is given here
-            raise AttributeError("each copy has its own generator: read or assign np_randoms (one per copy)")
-        if name == "domain":
-            raise AttributeError(name)
-        return getattr(self.domain, name)
+        self._elapsed, self._autoreset = np.zeros(n, dtype=np.int64), np.zeros(n, dtype=bool)
 
     @property
     def states(self) -> np.ndarray:
@@ -276,7 +211,6 @@ class DomainVectorEnv(VectorEnv):
         """The domain's view of the state rows, one entry per copy."""
         return self.domain.state(self._states)
 
-    # -- the copies' generators -------------------------------------------------------------------
     @property
     def np_randoms(self) -> tuple:
         """Each copy's generator; assign a sequence of ``num_envs`` of them to replace them all."""
@@ -291,20 +225,19 @@ class DomainVectorEnv(VectorEnv):
 
     @property
     def np_random(self):
-        raise AttributeError("each copy has its own generator: read or assign np_randoms (one per copy)")
+        raise AttributeError(NO_GENERATOR)
 
     @np_random.setter
     def np_random(self, value):
         raise AttributeError("each copy has its own generator: assign np_randoms (one per copy) instead")
 
-    # -- Gymnasium API ----------------------------------------------------------------------------
     def reset(self, *, seed=None, options: dict | None = None):
         """Reset all copies, or with ``options={"reset_mask": mask}`` only those where ``mask`` is true.
 
         ``seed``: None, an int (copy i gets ``seed + i``) or a list with one seed (or None) per copy. The seed and
         the options are checked whole before any copy is seeded or reset: a refused reset changes nothing.
         """
-        check_options(self.domain, options, self.num_envs, shell_keys=("reset_mask",))
+        self._check_options(options, self.num_envs, shell_keys=("reset_mask",))
         seeded = np.array([s is not None for s in copy_seeds(seed, self.num_envs)])
         mask = np.ones(self.num_envs, dtype=bool)
         if options is not None and "reset_mask" in options:
