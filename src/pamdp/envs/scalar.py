@@ -1,8 +1,6 @@
 """The scalar env: a :class:`~pamdp.envs.vector.Domain` at N = 1 as a ``gymnasium.Env``, running the domain's own
-batched ``parse``, ``reset`` and ``step`` on one state row (``docs/environments.md``, "How the environments are
-built"). Its stream follows ``np_random`` (a replaced generator drops the numbers drawn ahead of it); it does not
-autoreset, and counts its own time limit (the registrations set none: Gymnasium's ``TimeLimit`` would zero the
-count before a refused reset)."""
+batched ``parse``, ``reset`` and ``step`` on one state row, its stream following ``np_random``; no autoreset, its
+own time limit (``docs/environments.md``, "How the environments are built" and "Checked inputs")."""
 
 from __future__ import annotations
 
@@ -18,8 +16,7 @@ __all__ = ["DomainEnv", "as_batch", "env_classes"]
 
 
 class _OneEach(tuple):
-    """The parameters of one action, each read as a batch of one (``p[None]``) when it is read: a parser that
-    reads only the chosen action's parameter (Hard Move's 1 024 boxes) converts only that one."""
+    """One action's parameters, each read as a batch of one (``p[None]``) only when read (Hard Move's 1 024 boxes)."""
 
     def __getitem__(self, i):
         if isinstance(i, slice):
@@ -31,8 +28,7 @@ class _OneEach(tuple):
 
 
 def as_batch(action):
-    """One action ``(a, params)`` as a batch of one, ``(array([a]), (p_0[None], p_1[None], ...))``; anything
-    else is handed on as it is, for the parser to refuse."""
+    """One action ``(a, params)`` as a batch of one; anything else as it is, for the parser to refuse."""
     if not isinstance(action, (tuple, list)) or len(action) != 2:
         return action
     a, params = action
@@ -40,14 +36,8 @@ def as_batch(action):
 
 
 class DomainEnv(Shell, gymnasium.Env):
-    """One copy of a :class:`~pamdp.envs.vector.Domain` (``domain_class``) as a Gymnasium env.
-
-    Args:
-        render_mode: ``None`` or ``"rgb_array"``.
-        max_episode_steps: episodes are truncated after this many steps (default: the domain's); ``None`` leaves
-            the end to the domain.
-        **variant: the domain's constructor arguments.
-    """
+    """One copy of a :class:`~pamdp.envs.vector.Domain` as a Gymnasium env; ``max_episode_steps`` truncates (default:
+    the domain's; None: never), ``render_mode`` None or ``"rgb_array"``, ``**variant`` the domain's arguments."""
 
     num_envs = 1  # the domain's hooks see the scalar env as a batched one of one copy
 
@@ -93,9 +83,8 @@ class DomainEnv(Shell, gymnasium.Env):
         return self.domain.frame(self, 0) if self.render_mode == "rgb_array" else None
 
     def render_substeps(self) -> list[np.ndarray]:
-        """With ``render_mode="rgb_array"``: the frames of the last step, one per sub-step where the domain runs
-        several (Platform, Goal; none after a reset), the last one equal to :meth:`render`'s.
-        ``pamdp.envs.rendering.record_episode`` plays these."""
+        """With ``render_mode="rgb_array"``: the last step's frames, one per sub-step where the domain runs several
+        (Platform, Goal; none after a reset), the last one :meth:`render`'s (``record_episode`` plays them)."""
         if self.render_mode != "rgb_array":
             raise ValueError(f"render_substeps needs render_mode='rgb_array', got {self.render_mode!r}")
         return self.domain.substep_frames(self)
@@ -112,9 +101,8 @@ def _first(infos: dict) -> dict:
 
 
 def env_classes(domain_class: type[Domain], module: str, scalar: str, batched: str, **variant) -> tuple[type, type]:
-    """A domain's scalar env and batched env, classes named ``scalar`` and ``batched`` in ``module`` (the names
-    users import and ``isinstance`` tests), with the constructor arguments ``variant`` fixed. Their signatures
-    list the domain's arguments, as code that inspects an env's constructor (``pamdp.algos``) expects."""
+    """A domain's scalar and batched env, classes ``scalar`` and ``batched`` of ``module`` with ``variant`` fixed, whose
+    signatures list the domain's arguments (as ``pamdp.algos``, inspecting an env's constructor, expects)."""
     what = f"{domain_class.name}" + "".join(f", {k}={v!r}" for k, v in variant.items())
     attrs = {"domain_class": domain_class, "variant": variant, "__module__": module}
     doc = f"{{}} of {what} (see :class:`{module}.{domain_class.__name__}`)."

@@ -10,13 +10,14 @@ from collections.abc import Sequence
 
 import numba
 import numpy as np
+from gymnasium import spaces
 from gymnasium.error import ResetNeeded
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
 from pamdp.envs.streams import RandomStreams, copy_seeds
 
-__all__ = ["Domain", "DomainVectorEnv", "Shell", "split_actions", "column"]
+__all__ = ["Domain", "DomainVectorEnv", "Shell", "split_actions", "column", "hybrid_space", "every_copy"]
 
 _TYPES = {bool: (bool, np.bool_), int: (int, np.integer), float: (int, float, np.integer, np.floating), str: (str,)}
 """What a value of a domain argument annotated with the key may be (``bool`` nowhere but under ``bool``)."""
@@ -24,10 +25,8 @@ NO_GENERATOR = "each copy has its own generator: read or assign np_randoms (one 
 
 
 def split_actions(actions, domain: str, n: int, expected: str, n_actions=None, n_params=None) -> tuple:
-    """Check the form of a batch of ``n`` actions ``(a, params)``: ``a`` an int array of shape ``(n,)``
-    (in ``0..n_actions - 1`` unless ``n_actions`` is None), ``params`` a tuple or list of ``n_params``
-    (None: not checked). Returns ``(a, params)`` as given; a bad part raises ``ValueError`` naming it and
-    the ``expected`` form."""
+    """``(a, params)`` of a batch of ``n`` actions, as given, once ``a`` is an int array ``(n,)`` (in ``0..n_actions
+    - 1``) and ``params`` a tuple or list of ``n_params`` (None: either not checked); else ``ValueError``."""
     if not isinstance(actions, (tuple, list)) or len(actions) != 2:
         raise ValueError(f"invalid batch of {domain} actions {actions!r}; expected {expected}")
     a = np.asarray(actions[0])
@@ -43,9 +42,8 @@ def split_actions(actions, domain: str, n: int, expected: str, n_actions=None, n
 
 
 def column(p, n: int, name: int | str, expected: str) -> np.ndarray:
-    """One parameter of ``n`` copies given with shape ``(n,)`` or ``(n, 1)`` and a numeric dtype, as an
-    array of shape ``(n,)`` (dtype kept); ``ValueError`` otherwise, naming ``name`` (an int ``i`` reads
-    "parameter i")."""
+    """One number of ``n`` copies given ``(n,)`` or ``(n, 1)``, numeric, as an ``(n,)`` array (dtype kept); else a
+    ``ValueError`` naming ``name`` (an int ``i``: "parameter i")."""
     p = np.asarray(p)
     if p.shape not in ((n,), (n, 1)) or p.dtype.kind not in "iuf":
         name = f"parameter {name}" if isinstance(name, int) else name
@@ -53,10 +51,21 @@ def column(p, n: int, name: int | str, expected: str) -> np.ndarray:
     return p.reshape(n)
 
 
+def hybrid_space(*boxes) -> spaces.Tuple:
+    """``Tuple(Discrete(K), Tuple(Box_0, ..., Box_{K-1}))``, float32, from each action's ``(low, high, size)`` (a
+    size of 0: no parameter)."""
+    boxes = tuple(spaces.Box(np.full(m, lo, np.float32), np.full(m, hi, np.float32)) for lo, hi, m in boxes)
+    return spaces.Tuple((spaces.Discrete(len(boxes)), spaces.Tuple(boxes)))
+
+
+def every_copy(**values: np.ndarray) -> dict:
+    """Gymnasium's merged ``info`` of ``values`` that every copy reports (their ``"_" + key`` masks all true)."""
+    return values | {"_" + k: np.ones(len(v), dtype=bool) for k, v in values.items()}
+
+
 class Domain:
-    """The contract between a domain and the env shell, subclassed once in the domain's ``env.py``: the class
-    attributes below, ``action_space`` and ``observation_space`` (one copy's), and the methods. An instance is one
-    variant (its constructor's arguments) for one env, and may set its own sizes and keep per-copy arrays."""
+    """The contract between a domain and the env shell, subclassed in the domain's ``env.py``: the attributes below,
+    ``action_space`` and ``observation_space`` (one copy's) and the methods; an instance is one variant."""
 
     name: str  # in error messages
     render_fps: int = 10
@@ -79,18 +88,14 @@ class Domain:
         return states.copy()
 
     def parse(self, actions, n: int) -> tuple:
-        """Check a batch of ``n`` actions (``batch_space`` of ``action_space``; the scalar env's one action as a
-        batch of one) and return what the compiled step reads, or raise ``ValueError`` naming the bad part and the
-        expected form."""
+        """What the compiled step reads of a batch of ``n`` actions, or a ``ValueError`` naming the bad part."""
         raise NotImplementedError
 
     def check_options(self, options: dict, n: int) -> None:
-        """Check the values of ``reset`` options for ``n`` copies (the keys are checked already), before any copy
-        is seeded or reset; ``ValueError`` naming a bad one."""
+        """Check the values of ``reset`` options (their keys are checked already); ``ValueError`` naming one."""
 
     def reset(self, env, mask: np.ndarray, options: dict | None, seeded: np.ndarray) -> tuple:
-        """Start an episode in the copies where ``mask`` is true (``seeded``: those just given a seed): one compiled
-        call over ``env._states`` and ``env.streams``, returning batched observations and merged infos."""
+        """Start an episode in the copies where ``mask`` is true (``seeded``: those just given a seed)."""
         raise NotImplementedError
 
     def step(self, env, parsed: tuple, resetting: np.ndarray) -> tuple:
@@ -101,15 +106,13 @@ class Domain:
         raise NotImplementedError
 
     def substep_frames(self, env) -> list[np.ndarray]:
-        """The scalar env's frames of its last step: one per sub-step where the domain records them (Platform,
-        Goal; none after a reset), else the one after the step."""
+        """The scalar env's frames of its last step (one per sub-step where the domain records them)."""
         return [self.frame(env, 0)]
 
 
 class Shell:
-    """What the scalar env and the batched env share: the domain of ``domain_class`` made with the ``variant``, the
-    checks of their arguments and of reset options, the state rows and the random streams; the domain's attributes
-    (``n``, ``motions``, ``settings``...) read as the env's own."""
+    """What the scalar and the batched env share: their domain, the checks of their arguments and reset options, the
+    state rows and random streams; the domain's attributes (``n``, ``motions``...) read as the env's own."""
 
     metadata = {"render_modes": ["rgb_array"]}
     domain_class: type[Domain]
@@ -154,9 +157,8 @@ class Shell:
         return getattr(self.domain, name)
 
     def _check_options(self, options, n: int, shell_keys: tuple[str, ...] = ()) -> None:
-        """The one rule for ``reset(options=...)``: None or a dict whose keys are among the domain's
-        ``reset_options`` and ``shell_keys``, else a ``ValueError`` naming the unknown keys and the accepted ones;
-        then the domain checks the values."""
+        """``reset(options=...)``: None or a dict of keys among the domain's and ``shell_keys``, else a ``ValueError``
+        naming the unknown keys and the accepted ones; then the domain checks the values."""
         if options is None:
             return
         domain, accepted = self.domain, (*self.domain.reset_options, *shell_keys)
@@ -171,16 +173,8 @@ class Shell:
 
 
 class DomainVectorEnv(Shell, VectorEnv):
-    """``num_envs`` copies of a :class:`Domain`, stepped together, with Gymnasium's next-step autoreset (the step
-    after an episode ends ignores that copy's action and returns its reset observation, reward 0, both flags false).
-
-    Args:
-        num_envs: number of copies N.
-        max_episode_steps: episodes are truncated after this many agent steps (default: the domain's); ``None``
-            leaves the end to the domain.
-        render_mode: ``None`` or ``"rgb_array"``; :meth:`render` then returns one frame per copy.
-        **variant: the domain's constructor arguments.
-    """
+    """``num_envs`` copies of a :class:`Domain` with Gymnasium's next-step autoreset; ``max_episode_steps`` truncates
+    (default: the domain's; None: never), ``render_mode`` None or ``"rgb_array"``, ``**variant`` the domain's."""
 
     metadata = {**Shell.metadata, "autoreset_mode": AutoresetMode.NEXT_STEP}
 
@@ -279,8 +273,7 @@ _jit = numba.njit(cache=True, nogil=True)
 
 @_jit
 def _outside(a, n_actions) -> bool:
-    """Whether any of ``a`` lies outside ``0..n_actions - 1`` (one compiled pass: ``min`` and ``max`` are two
-    NumPy calls, a good part of checking one action)."""
+    """Whether any of ``a`` lies outside ``0..n_actions - 1`` (in one pass: NumPy's ``min`` and ``max`` are two)."""
     for i in range(a.shape[0]):
         if a[i] < 0 or a[i] >= n_actions:
             return True
@@ -289,9 +282,8 @@ def _outside(a, n_actions) -> bool:
 
 @_jit
 def _end_step(resetting, rewards, terminated, truncated, elapsed, max_steps, autoreset) -> None:
-    """The end of a batched step, copy by copy: a copy that was reset this step gets reward 0, both flags false
-    and its step count back to 0; the others count the step and are truncated at ``max_steps`` (0: never);
-    ``autoreset`` is whether each copy's episode has ended (to be reset on the next step)."""
+    """The end of a batched step: a copy reset in it gets reward 0, both flags false and its count 0; the others
+    count the step, truncated at ``max_steps`` (0: never); ``autoreset``: whose episode has ended."""
     for i in range(resetting.shape[0]):
         if resetting[i]:
             rewards[i] = 0.0

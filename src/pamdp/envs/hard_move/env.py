@@ -1,16 +1,6 @@
-"""Hard Move as a pamdp domain: its contract and its two envs (the task: ``pamdp.envs.hard_move``).
-
-Action ``(a, (p_0, ..., p_{K-1}))`` with ``K = 2 ** n``, batched ``a`` of shape ``(N,)`` and each ``p``
-``(N, 1)`` or ``(N,)``, or all ``K`` stacked in one array ``(K, N, 1)`` or ``(K, N)``, which is faster to
-read at n = 10. Every parameter must be finite, used or not; only each copy's own ``p_a`` is read, as given, not
-clipped: ``|p| > 1`` pushes harder, ``p < 0`` backwards. Observation ``[vx, vy, gx - ax, gy - ay]`` (float64).
-
-Random numbers: a reset draws the agent's then the target's position, ``uniform(-1, 1, 2)`` each, four
-``random()`` numbers of the copy's generator (the scalar env draws none ahead), so assigning
-``numpy.random.RandomState(S)`` to the scalar env's ``np_random`` replays the original driven by
-``np.random.seed(S)``. ``state`` holds copies of the state rows (indices in ``pamdp.envs.particle``),
-``motions`` the table of :func:`~pamdp.envs.hard_move.motions.motion_table`.
-"""
+"""Hard Move as a pamdp domain: its contract and its two envs (the task: ``pamdp.envs.hard_move``). Actions (also
+stacked in one array, faster at n = 10), observations, ``state`` and the resets' draws: ``docs/environments.md``,
+"Catch Point and Hard Move" and "Each domain's batched actions, ``state`` and ``info``"."""
 
 from __future__ import annotations
 
@@ -23,20 +13,16 @@ import pamdp.envs.particle as particle
 from pamdp.envs.hard_move.motions import check_size, motion_table
 from pamdp.envs.hard_move.render import draw_hard_move
 from pamdp.envs.scalar import env_classes
-from pamdp.envs.vector import split_actions
+from pamdp.envs.vector import hybrid_space, split_actions
 
 __all__ = ["HardMove", "HardMoveEnv", "HardMoveVectorEnv", "hard_move_action_space"]
 
-STACK_AT_MOST = 256
-"""Up to this many boxes (n = 4, 6, 8) stacking all the parameters of a batch costs less than taking each
-copy's own; at n = 10 (1024 boxes) taking each copy's own costs less (docs/environments.md gives the speeds)."""
+STACK_AT_MOST = 256  # up to 256 boxes (n = 4, 6, 8) stacking a batch's costs less than taking each copy's own
 
 
 def hard_move_action_space(n: int) -> spaces.Tuple:
     """``Tuple(Discrete(2 ** n), Tuple(Box(-1, 1, (1,)) x 2 ** n))``, float32."""
-    box = {"low": np.float32(-1.0), "high": np.float32(1.0), "shape": (1,), "dtype": np.float32}
-    k = 2 ** check_size(n)
-    return spaces.Tuple((spaces.Discrete(k), spaces.Tuple(tuple(spaces.Box(**box) for _ in range(k)))))
+    return hybrid_space(*[(-1.0, 1.0, 1)] * 2 ** check_size(n))
 
 
 class HardMove(particle.ParticleDomain):
@@ -51,14 +37,10 @@ class HardMove(particle.ParticleDomain):
         self.action_space = hard_move_action_space(self.n)
 
     def parse(self, actions, n):
-        """``a`` (n,) int64 and each copy's own parameter ``p[i] = p_{a[i]}[i]`` (n,) float64, once every parameter
-        of every box is known to be finite.
-
-        The parameters are gathered without a Python loop over the ``K`` boxes or the copies: a sequence of at
-        most :data:`STACK_AT_MOST` boxes for several copies is stacked (in C) and read by fancy indexing, as a
-        stacked array is; from a longer one, or for one copy, ``map`` takes each copy's own box and value
-        (C-level iteration) and :func:`_check_finite` reads all the boxes at once.
-        """
+        """``a`` (n,) int64 and each copy's own parameter ``p[i] = p_{a[i]}[i]`` (n,) float64, every parameter of
+        every box checked finite, with no Python loop over the boxes or the copies: up to :data:`STACK_AT_MOST` boxes
+        (for several copies) are stacked in C; more, or one copy's, are read by :func:`_gather` and
+        :func:`_check_finite`."""
         k = len(self.motions)
         expected = (
             f"(a, (p_0, ..., p_{k - 1})) with a an int array of shape ({n},) in 0..{k - 1} and each p a finite array "
@@ -119,9 +101,8 @@ def _gather(params, a, n: int, expected: str) -> np.ndarray:
 
 
 def _check_finite(params, expected: str) -> None:
-    """Refuse a NaN or an infinity in any box, chosen or not. Contiguous boxes of one dtype are read in two C-level
-    passes (their bytes joined, then one ``isfinite``: ~80 µs for 1 024 boxes, where a Python loop over the boxes
-    cost 1.7 ms a step); other boxes (Python floats, mixed dtypes) are flattened one by one."""
+    """Refuse a NaN or an infinity in any box, chosen or not: contiguous boxes of one dtype in C-level passes (their
+    bytes joined, one ``isfinite``; a Python loop over 1 024 boxes cost 1.7 ms a step), others one by one."""
     boxes = list(tuple.__iter__(params) if isinstance(params, tuple) else params)  # the scalar env's own boxes
     try:
         dtype = boxes[0].dtype
