@@ -5,6 +5,7 @@ what it shares with the scalar env (:class:`Shell`). The contract, the seeding a
 from __future__ import annotations
 
 import inspect
+import re
 import typing
 from collections.abc import Sequence
 
@@ -17,27 +18,32 @@ from gymnasium.vector.utils import batch_space
 
 from pamdp.envs.streams import RandomStreams, copy_seeds
 
-__all__ = ["Domain", "DomainVectorEnv", "Shell", "split_actions", "column", "hybrid_space", "every_copy"]
+__all__ = ["Domain", "DomainVectorEnv", "Shell", "split_actions", "column", "hybrid_space", "every_copy", "shown"]
 
 _TYPES = {bool: (bool, np.bool_), int: (int, np.integer), float: (int, float, np.integer, np.floating), str: (str,)}
 """What a value of a domain argument annotated with the key may be (``bool`` nowhere but under ``bool``)."""
 NO_GENERATOR = "each copy has its own generator: read or assign np_randoms (one per copy)"
 
 
+def shown(value) -> str:
+    """``repr(value)`` in one line, for an error message (an array of several rows spans several)."""
+    return re.sub(r"\s*\n\s*", " ", repr(value))
+
+
 def split_actions(actions, domain: str, n: int, expected: str, n_actions=None, n_params=None) -> tuple:
     """``(a, params)`` of a batch of ``n`` actions, as given, once ``a`` is an int array ``(n,)`` (in ``0..n_actions
     - 1``) and ``params`` a tuple or list of ``n_params`` (None: either not checked); else ``ValueError``."""
     if not isinstance(actions, (tuple, list)) or len(actions) != 2:
-        raise ValueError(f"invalid batch of {domain} actions {actions!r}; expected {expected}")
+        raise ValueError(f"invalid batch of {domain} actions {shown(actions)}; expected {expected}")
     a = np.asarray(actions[0])
     if a.shape != (n,) or a.dtype.kind not in "iu":
-        raise ValueError(f"invalid discrete actions {actions[0]!r}; expected {expected}")
+        raise ValueError(f"invalid discrete actions {shown(actions[0])}; expected {expected}")
     if n_actions is not None and _outside(a, n_actions):
         bad = (a < 0) | (a >= n_actions)
         raise ValueError(f"discrete actions {a[bad]} at indices {np.flatnonzero(bad)}; expected {expected}")
     params = actions[1]
     if n_params is not None and (not isinstance(params, (tuple, list)) or len(params) != n_params):
-        raise ValueError(f"invalid parameters {params!r}; expected {expected}")
+        raise ValueError(f"invalid parameters {shown(params)}; expected {expected}")
     return a, params
 
 
@@ -47,7 +53,7 @@ def column(p, n: int, name: int | str, expected: str) -> np.ndarray:
     p = np.asarray(p)
     if p.shape not in ((n,), (n, 1)) or p.dtype.kind not in "iuf":
         name = f"parameter {name}" if isinstance(name, int) else name
-        raise ValueError(f"invalid {name} of shape {p.shape}: {p!r}; expected {expected}")
+        raise ValueError(f"invalid {name} of shape {p.shape}: {shown(p)}; expected {expected}")
     return p.reshape(n)
 
 
@@ -164,7 +170,7 @@ class Shell:
         domain, accepted = self.domain, (*self.domain.reset_options, *shell_keys)
         listed = ", ".join(map(repr, accepted)) or "none"
         if not isinstance(options, dict):
-            raise ValueError(f"reset options={options!r}; expected None or a dict with keys among {listed}")
+            raise ValueError(f"reset options={shown(options)}; expected None or a dict with keys among {listed}")
         unknown = [k for k in options if k not in accepted]
         if unknown:
             hints = "".join(f"; {domain.option_hints[k]}" for k in unknown if k in domain.option_hints)
@@ -237,7 +243,7 @@ class DomainVectorEnv(Shell, VectorEnv):
         if options is not None and "reset_mask" in options:
             mask = np.asarray(options["reset_mask"])
             if mask.shape != (self.num_envs,) or mask.dtype != np.bool_:
-                raise ValueError(f"reset_mask must be a bool array of shape ({self.num_envs},), got {mask!r}")
+                raise ValueError(f"reset_mask must be a bool array of shape ({self.num_envs},), got {shown(mask)}")
         self.streams.seed(seed)
         self.streams.refill(self.draws_per_step)
         obs, infos = self.domain.reset(self, mask, options, seeded)

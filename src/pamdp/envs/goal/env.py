@@ -10,7 +10,7 @@ from gymnasium import spaces
 import pamdp.envs.goal.dynamics as dyn
 from pamdp.envs.goal.render import RENDER_FPS, draw_goal
 from pamdp.envs.scalar import env_classes
-from pamdp.envs.vector import Domain, every_copy, hybrid_space, split_actions
+from pamdp.envs.vector import Domain, every_copy, hybrid_space, shown, split_actions
 
 __all__ = ["Goal", "GoalEnv", "HardGoalEnv", "GoalVectorEnv", "HardGoalVectorEnv", "hard_goal_shot"]
 
@@ -73,7 +73,7 @@ class Goal(Domain):
         for i, (p, box) in enumerate(zip(params, self.action_space[1])):
             p, size = np.asarray(p), box.shape[0]
             if p.shape not in ((n, size), (n,) if size == 1 else (n, size)) or p.dtype.kind not in "iuf":
-                raise ValueError(f"invalid parameter {i} of shape {p.shape}: {p!r}; expected {expected}")
+                raise ValueError(f"invalid parameter {i} of shape {p.shape}: {shown(p)}; expected {expected}")
             p = p.reshape(n, size).astype(np.float64)
             if not np.isfinite(p).all():
                 raise ValueError(f"parameter {i} contains {p[~np.isfinite(p)]}; expected {expected}")
