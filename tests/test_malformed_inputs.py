@@ -11,9 +11,9 @@ from pathlib import Path
 import gymnasium
 import numpy as np
 import pytest
+from test_hardening import refusal  # one line on stderr, exit status 2
 
 import pamdp  # noqa: F401  (registers the envs)
-from pamdp.cli import main
 from pamdp.envs import _REGISTRATIONS
 
 IDS = list(_REGISTRATIONS)
@@ -87,19 +87,6 @@ def test_a_reset_option_of_the_wrong_shape_is_one_line_and_resets_nothing(env_id
 
 
 # -- the command line ---------------------------------------------------------------------------------------------
-def refusal(argv, capsys) -> str:
-    capsys.readouterr()
-    try:
-        code = main(argv)
-    except SystemExit as exc:
-        code = exc.code
-    err = capsys.readouterr().err
-    assert code == 2 and "Traceback" not in err, err
-    lines = err.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith(f"pamdp {argv[0]}"), err
-    return lines[0]
-
-
 def fingerprint(root: Path) -> dict[str, str]:
     files = [p for p in root.rglob("*") if p.is_file()]
     return {str(p.relative_to(root)): hashlib.sha256(p.read_bytes()).hexdigest() for p in files}
