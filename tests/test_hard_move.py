@@ -15,7 +15,7 @@ import pamdp  # noqa: F401  (registers the envs)
 import pamdp.envs.particle as particle
 from pamdp.envs.hard_move import HardMoveEnv, HardMoveVectorEnv, motion_table
 from pamdp.envs.hard_move.motions import actuators
-from pamdp.spaces import HybridActionSpace
+from pamdp.spaces import BoxRows, HybridActionSpace
 
 CASES = load_cases("hard_move_traces.json")
 MOTIONS = json.loads((DATA / "hard_move_motions.json").read_text())
@@ -177,6 +177,24 @@ def test_stacked_parameters_read_as_the_tuple_of_boxes():
         params = rng.uniform(-1, 1, (1024, 64, 1)).astype(np.float32)
         got, want = venv_stacked.step((a, params)), venv_tuple.step((a, tuple(params[:, :, 0])))
         assert_same_step(got, want, "stacked", keys=())
+
+
+def test_the_algorithms_rows_of_one_block_read_as_their_tuple_and_a_nan_in_any_row_is_refused():
+    """``HybridActionSpace.to_env_batch`` hands Hard Move's boxes as rows of one array (``BoxRows``), which the env
+    checks in one pass: the same steps as the rows handed as a plain tuple, the same refusal of a NaN no copy chose."""
+    space = HybridActionSpace.from_gym(HardMoveEnv(n=10).action_space)
+    venv_rows, venv_tuple = HardMoveVectorEnv(num_envs=16, n=10), HardMoveVectorEnv(num_envs=16, n=10)
+    venv_rows.reset(seed=4)
+    venv_tuple.reset(seed=4)
+    rng = np.random.default_rng(1)
+    for _ in range(30):
+        a, params = space.to_env_batch(rng.integers(0, 1024, 16), rng.uniform(-1, 1, (16, 1)))
+        assert isinstance(params, BoxRows)
+        assert_same_step(venv_rows.step((a, params)), venv_tuple.step((a, tuple(params))), "rows", keys=())
+    params.block[int(np.setdiff1d(np.arange(1024), a)[0]), 3] = np.nan
+    for venv, given in ((venv_rows, params), (venv_tuple, tuple(params))):
+        with pytest.raises(ValueError, match=r"contains \[nan\]; expected"):
+            venv.step((a, given))
 
 
 @pytest.mark.parametrize(

@@ -47,7 +47,7 @@ class HardMove(particle.ParticleDomain):
             f"of shape ({n}, 1) or ({n},), or all of them stacked in one array of shape ({k}, {n}, 1) or ({k}, {n})"
         )
         a, params = split_actions(actions, self.name, n, expected, k)
-        a = a.astype(np.int64, copy=False)
+        a, params = a.astype(np.int64, copy=False), getattr(params, "block", params)  # BoxRows: their one array
         if not isinstance(params, np.ndarray):
             if not isinstance(params, (tuple, list)) or len(params) != k:
                 given = f"{len(params)} boxes" if isinstance(params, (tuple, list)) else f"a {type(params).__name__}"
