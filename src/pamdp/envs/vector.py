@@ -64,9 +64,12 @@ def hybrid_space(*boxes) -> spaces.Tuple:
     return spaces.Tuple((spaces.Discrete(len(boxes)), spaces.Tuple(boxes)))
 
 
-def every_copy(**values: np.ndarray) -> dict:
-    """Gymnasium's merged ``info`` of ``values`` that every copy reports (their ``"_" + key`` masks all true)."""
-    return values | {"_" + k: np.ones(len(v), dtype=bool) for k, v in values.items()}
+def every_copy(n: int, **values: np.ndarray) -> dict:
+    """Gymnasium's merged ``info`` of ``values`` that all ``n`` copies report (their ``"_" + key`` masks all true)."""
+    infos, every = dict(values), np.ones(n, dtype=bool)
+    for key in values:
+        infos["_" + key] = every
+    return infos
 
 
 class Domain:

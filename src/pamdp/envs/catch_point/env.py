@@ -63,7 +63,7 @@ class CatchPoint(particle.ParticleDomain):
         return obs, rewards, terminated, np.zeros(n, dtype=bool), self.infos(env, ~resetting, caught)
 
     def infos(self, env, stepped=None, success=None) -> dict:
-        fails = every_copy(failed_catches=env._states[:, particle.FAILS].astype(np.int64))
+        fails = every_copy(env.num_envs, failed_catches=env._states[:, particle.FAILS].astype(np.int64))
         return fails | super().infos(env, stepped, success)
 
     def frame(self, env, i):

@@ -90,7 +90,7 @@ class Goal(Domain):
     def reset(self, env, mask, options, seeded):
         dyn.reset_copies(env._states, mask, env.streams.buffers, env.streams.cursors)
         self.substeps = 0
-        return self._observe(env), every_copy(substeps=np.zeros(env.num_envs, dtype=np.int64))
+        return self._observe(env), every_copy(env.num_envs, substeps=np.zeros(env.num_envs, dtype=np.int64))
 
     def step(self, env, parsed, resetting):
         """A copy whose numbers run out mid-step stops; its numbers are topped up and the copies still pending
@@ -109,7 +109,7 @@ class Goal(Domain):
             if 0 < trace.shape[0] == substeps[0]:  # a long step: room for more frames
                 self.trace = trace = np.concatenate([trace, np.empty_like(trace)])
         self.substeps = int(substeps[0])
-        infos = every_copy(substeps=substeps)
+        infos = every_copy(n, substeps=substeps)
         infos["is_success"], infos["_is_success"] = terminated & (rewards == dyn.GOAL_REWARD), terminated | truncated
         return self._observe(env), rewards, terminated, truncated, infos
 

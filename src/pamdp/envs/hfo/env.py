@@ -112,7 +112,7 @@ class HalfFieldOffense(Domain):
     def _infos(self, env, status=None) -> dict:
         names = _STATUS_NAMES[status] if status is not None else np.full(env.num_envs, "IN_GAME")
         step = env._states[:, dyn.STEPS].astype(np.int64)
-        return every_copy(status=names, step=step, action_mask=kick_mask(env._states))
+        return every_copy(env.num_envs, status=names, step=step, action_mask=kick_mask(env._states))
 
     def frame(self, env, i):
         return draw_half_field(env._states[i], goalie=self.goalie)

@@ -74,7 +74,7 @@ class Platform(Domain):
     def reset(self, env, mask, options, seeded):
         env._states[mask] = physics.INITIAL_STATE
         self.substeps = 0
-        return self._observe(env), every_copy(substeps=np.zeros(env.num_envs, dtype=np.int64))
+        return self._observe(env), every_copy(env.num_envs, substeps=np.zeros(env.num_envs, dtype=np.int64))
 
     def step(self, env, parsed, resetting):
         (a, p), n, streams = parsed, env.num_envs, env.streams
@@ -85,7 +85,7 @@ class Platform(Domain):
             env._states, a, p, ~resetting, streams.buffers, streams.cursors, rewards, terminated, substeps, trace
         )
         self.substeps = int(substeps[0])
-        return self._observe(env), rewards, terminated, np.zeros(n, dtype=bool), every_copy(substeps=substeps)
+        return self._observe(env), rewards, terminated, np.zeros(n, dtype=bool), every_copy(n, substeps=substeps)
 
     def _observe(self, env):
         out = np.empty((env.num_envs, physics.OBS_SIZE))
