@@ -87,10 +87,11 @@ class Domain:
     max_episode_steps: int | None = None  # the time limit, also the batched env's default; None: the domain's end
     reset_options: tuple[str, ...] = ()  # the keys reset(options=...) takes (and the batched env's reset_mask)
     option_hints: dict = {}  # a word for a refused key that looks meant (Hard Move's n: a constructor argument)
+    initial_state: np.ndarray | None = None  # a copy's state row before its first reset (None: zeros)
 
     def initial_states(self, n: int) -> np.ndarray:
         """The state rows ``(n, state_size)`` before the first reset (and the domain's own per-copy arrays)."""
-        return np.zeros((n, self.state_size))
+        return np.zeros((n, self.state_size)) if self.initial_state is None else np.tile(self.initial_state, (n, 1))
 
     def state(self, states: np.ndarray):
         """What the envs' ``state`` shows of the rows (the scalar env's: copy 0's part of it)."""

@@ -47,7 +47,7 @@ def check_settings(**settings) -> np.ndarray:
 class GymHybrid(Domain):
     name = "gym-hybrid"
     render_fps = RENDER_FPS
-    state_size = dyn.STATE_SIZE
+    state_size, initial_state = dyn.STATE_SIZE, dyn.INITIAL_STATE
     reset_draws = scalar_buffer_size = dyn.DRAWS_PER_RESET
     buffer_size = 64 * dyn.DRAWS_PER_RESET  # 64 resets' numbers: a copy is topped up once every 64 episodes
 
@@ -68,9 +68,6 @@ class GymHybrid(Domain):
         )  # fmt: skip
         self.action_space = gym_hybrid_action_space()
         self.observation_space = spaces.Box(-np.inf, np.inf, shape=(dyn.OBS_SIZE,), dtype=np.float64)
-
-    def initial_states(self, n):
-        return np.tile(dyn.INITIAL_STATE, (n, 1))
 
     def parse(self, actions, n):
         """``a`` (n,) and the accelerate and turn parameters (n,), float32 or float64 as given, not yet clipped."""

@@ -33,7 +33,7 @@ def platform_action_space() -> spaces.Tuple:
 class Platform(Domain):
     name = "Platform"
     render_fps = RENDER_FPS
-    state_size = physics.STATE_SIZE
+    state_size, initial_state = physics.STATE_SIZE, physics.INITIAL_STATE
     draw = "standard_normal"
     step_draws = physics.MAX_DRAWS
     buffer_size = scalar_buffer_size = 2048  # a step takes ~150 normals, at most physics.MAX_DRAWS
@@ -44,9 +44,6 @@ class Platform(Domain):
         self.observation_space = spaces.Box(0.0, 1.0, shape=(physics.OBS_SIZE,), dtype=np.float64)
         self.trace = np.empty((physics.MAX_SUBSTEPS, physics.TRACE_SIZE))  # the scalar env's sub-steps
         self.substeps = 0
-
-    def initial_states(self, n):
-        return np.tile(physics.INITIAL_STATE, (n, 1))
 
     def state(self, states):
         return {
