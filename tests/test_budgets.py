@@ -5,6 +5,7 @@ before anything runs, in one line naming it (issue 46). Over every algorithm of 
 from __future__ import annotations
 
 import re
+import sys
 import warnings
 
 import gymnasium
@@ -38,20 +39,33 @@ def test_a_budget_not_a_whole_number_of_epochs_ends_at_the_budget_and_counts_its
     assert cls.load(tmp_path / "m.pt").num_updates == model.num_updates
 
 
-@pytest.mark.parametrize("algo", list(ALGORITHMS))
+OFF_POLICY = [algo for algo in ALGORITHMS if algo not in ("patrpo", "pappo")]
+
+
+@pytest.mark.parametrize("algo", OFF_POLICY)
 def test_a_budget_that_cannot_train_is_said_at_the_start_and_makes_no_update(algo):
-    """Off-policy: below the warm-up (``learning_starts``, HyAR's ``warmup_steps``: 64 here). On-policy: below one
-    step of the env copies (64 here), which trains a whole vector step."""
-    cls, config = small(algo, num_envs=64 if algo in ("patrpo", "pappo") else 4)
+    """Below the warm-up (``learning_starts``, HyAR's ``warmup_steps``: 64 here)."""
+    cls, config = small(algo)
     with pytest.warns(UserWarning, match=r"total_timesteps = 50 ") as caught:
         model = cls(ENV, config).learn(50, progress_bar=False)
-    message = str(caught[0].message)
-    if algo in ("patrpo", "pappo"):
-        assert "num_envs = 64" in message and model.num_timesteps == 64
-    else:
-        name = "warmup_steps" if algo == "hyar" else "learning_starts"
-        assert f"{name} = 64" in message and "makes no gradient update" in message
-        assert 50 <= model.num_timesteps < 54 and model.num_updates == 0
+    name = "warmup_steps" if algo == "hyar" else "learning_starts"
+    assert f"{name} = 64" in str(caught[0].message) and "makes no gradient update" in str(caught[0].message)
+    assert 50 <= model.num_timesteps < 54 and model.num_updates == 0
+
+
+@pytest.mark.parametrize("algo", ["patrpo", "pappo"])
+def test_an_on_policy_run_trains_its_budget_exactly_even_below_one_vector_step(algo):
+    """64 copies asked for 50 samples train on 50 (not on the 64 of a whole vector step), with one update; 100-sample
+    batches over 4 copies asked for 150 then 37 more end at 150 and 187, whatever the autoresets."""
+    cls, config = small(algo, num_envs=64)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        model = cls(ENV, config).learn(50, progress_bar=False)
+    assert model.num_timesteps == 50 and model.num_updates > 0
+    cls, config = small(algo)
+    model = cls(ENV, config).learn(150, progress_bar=False)
+    assert model.num_timesteps == 150
+    assert model.learn(37, progress_bar=False).num_timesteps == 187
 
 
 @pytest.mark.parametrize("algo", list(ALGORITHMS))
@@ -119,3 +133,25 @@ def test_a_run_that_makes_no_update_warns_at_the_start_and_says_so_at_the_end(tm
     with pytest.warns(UserWarning, match="makes no gradient update"):
         assert main([*argv, "--learning-starts", "100"]) == 0
     assert "no gradient update: untrained" in capsys.readouterr().err
+
+
+def test_the_command_line_shows_a_warning_as_one_line_of_its_own_and_the_api_keeps_pythons_form(
+    tmp_path, capsys, monkeypatch
+):
+    """Python's default ``showwarning`` writes ``warnings.formatwarning``'s text to stderr (pytest records warnings
+    instead, so the test puts that default back)."""
+
+    def shown(message, category, filename, lineno, file=None, line=None):
+        sys.stderr.write(warnings.formatwarning(message, category, filename, lineno, line))
+
+    monkeypatch.setattr(warnings, "showwarning", shown)
+    argv = ["train", "pdqn", "--preset", "hfo", "--total-steps", "40", "--learning-starts", "100", *SMALL_CLI]
+    with warnings.catch_warnings():
+        warnings.simplefilter("always")
+        assert main([*argv, "--out", str(tmp_path / "run")]) == 0
+        err = capsys.readouterr().err.splitlines()
+        warned = [line for line in err if "warning" in line.lower()]
+        assert len(warned) == 2 and all(line.startswith("pamdp: warning: ") for line in warned), warned
+        assert "preset 'hfo' of PDQNConfig was made for" in warned[0] and "makes no gradient update" in warned[1]
+        warnings.warn("from the API", UserWarning, stacklevel=1)
+        assert re.search(r"^\S+\.py:\d+: UserWarning: from the API$", capsys.readouterr().err, re.M)

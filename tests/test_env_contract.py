@@ -259,12 +259,7 @@ def unused_nan_cases():
         for k in range(min(space[0].n, 4)):
             for j, box in enumerate(space[1][:4]):
                 if j != k and box.shape != (0,):
-                    marks = ()
-                    if env_id == "pamdp/HardMove-v0":
-                        marks = pytest.mark.xfail(
-                            strict=True, reason="Hard Move reads only the chosen of its 2**n boxes (O(K) otherwise)"
-                        )
-                    yield pytest.param(env_id, kwargs, k, j, marks=marks, id=f"{env_id[6:]}-{kwargs}-a{k}-p{j}")
+                    yield pytest.param(env_id, kwargs, k, j, id=f"{env_id[6:]}-{kwargs}-a{k}-p{j}")
 
 
 @pytest.mark.parametrize("env_id, kwargs, k, j", list(unused_nan_cases()))

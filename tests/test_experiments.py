@@ -641,3 +641,24 @@ def test_a_run_recorded_before_a_setting_existed_is_a_seed_of_one_recorded_after
     run = {"algo": "patrpo", "total_steps": 1000, "preset": "tuned"}
     assert setting_of({**run, "config": before}) == setting_of({**run, "config": {**now, "seed": 2}})
     assert setting_of({**run, "config": before}) != setting_of({**run, "config": {**now, "delta": 0.5}})
+
+
+def test_the_report_table_counts_each_seeds_gradient_updates_and_flags_an_untrained_arm(tmp_path, capsys):
+    """The arm of a budget below its warm-up made no update: its row says so, where its returns alone look fine."""
+    from pamdp.cli import main
+
+    updates = {"trained": {0: [0, 24, 25], 1: [0, 25, 25]}, "warm-up only": {0: [0, 0, 0]}, "old": {0: None}}
+    for arm, seeds in updates.items():
+        for seed, counts in seeds.items():
+            run = tmp_path / "exp" / arm / f"seed{seed}"
+            run.mkdir(parents=True)
+            if counts is None:  # a run logged before the count was
+                rows = "time/total_timesteps,charts/episodic_return\n1000,0.5\n"
+            else:
+                rows = "time/total_timesteps,charts/episodic_return,train/updates\n" + "".join(
+                    f"{1000 * (i + 1)},0.5,{n}\n" for i, n in enumerate(counts)
+                )
+            (run / "progress.csv").write_text(rows)
+    assert main(["plot", str(tmp_path / "exp"), "--out", str(tmp_path / "fig")]) == 0
+    table = {line.split(" | ")[0][2:]: line.split(" | ")[-1] for line in capsys.readouterr().out.splitlines()[2:5]}
+    assert table == {"trained": "49, 50 |", "warm-up only": "0 (untrained) |", "old": "- |"}

@@ -15,7 +15,7 @@ import pamdp  # noqa: F401  (registers the envs)
 import pamdp.envs.particle as particle
 from pamdp.envs.hard_move import HardMoveEnv, HardMoveVectorEnv, motion_table
 from pamdp.envs.hard_move.motions import actuators
-from pamdp.spaces import HybridActionSpace
+from pamdp.spaces import BoxRows, HybridActionSpace
 
 CASES = load_cases("hard_move_traces.json")
 MOTIONS = json.loads((DATA / "hard_move_motions.json").read_text())
@@ -128,7 +128,7 @@ def test_bad_actuator_counts_are_refused(n):
         ((3, (np.zeros(1),) * 15), r"invalid parameters \(15 boxes\)"),
         (
             (3, (np.zeros(1),) * 3 + (np.array([np.nan]),) + (np.zeros(1),) * 12),
-            "copy 0: parameter nan of action 3; expected a finite number",
+            r"parameter 3 contains \[nan\]; expected .* each p a finite array",
         ),
         ((3, (np.zeros(2),) * 16), r"the chosen parameters have shapes \[\(1, 2\)\]"),
     ],
@@ -179,6 +179,24 @@ def test_stacked_parameters_read_as_the_tuple_of_boxes():
         assert_same_step(got, want, "stacked", keys=())
 
 
+def test_the_algorithms_rows_of_one_block_read_as_their_tuple_and_a_nan_in_any_row_is_refused():
+    """``HybridActionSpace.to_env_batch`` hands Hard Move's boxes as rows of one array (``BoxRows``), which the env
+    checks in one pass: the same steps as the rows handed as a plain tuple, the same refusal of a NaN no copy chose."""
+    space = HybridActionSpace.from_gym(HardMoveEnv(n=10).action_space)
+    venv_rows, venv_tuple = HardMoveVectorEnv(num_envs=16, n=10), HardMoveVectorEnv(num_envs=16, n=10)
+    venv_rows.reset(seed=4)
+    venv_tuple.reset(seed=4)
+    rng = np.random.default_rng(1)
+    for _ in range(30):
+        a, params = space.to_env_batch(rng.integers(0, 1024, 16), rng.uniform(-1, 1, (16, 1)))
+        assert isinstance(params, BoxRows)
+        assert_same_step(venv_rows.step((a, params)), venv_tuple.step((a, tuple(params))), "rows", keys=())
+    params.block[int(np.setdiff1d(np.arange(1024), a)[0]), 3] = np.nan
+    for venv, given in ((venv_rows, params), (venv_tuple, tuple(params))):
+        with pytest.raises(ValueError, match=r"contains \[nan\]; expected"):
+            venv.step((a, given))
+
+
 @pytest.mark.parametrize(
     "n, bad_shape, bad_list",  # n = 4 stacks its 16 boxes, n = 10 takes each copy's own of 1024
     [
@@ -194,8 +212,11 @@ def test_batched_actions_are_checked(n, bad_shape, bad_list):
     with pytest.raises(ValueError, match=rf"discrete actions \[{k}\] at indices \[1\]"):
         venv.step((np.array([0, k]), tuple(boxes)))
     before = venv.states
-    with pytest.raises(ValueError, match=r"copy 1: parameter inf of action 5; expected a finite number"):
-        venv.step((np.array([0, 5]), tuple(boxes[:5] + [np.array([[0.0], [np.inf]])] + boxes[6:])))
+    for chosen in ([0, 5], [0, 1]):  # the box with an infinity chosen by copy 1, and chosen by none
+        bad = boxes[:5] + [np.array([[0.0], [np.inf]], np.float32)] + boxes[6:]
+        for params in (tuple(bad), np.stack(bad)):
+            with pytest.raises(ValueError, match=r"parameter 5 contains \[inf\]; expected .* finite"):
+                venv.step((np.array(chosen), params))
     np.testing.assert_array_equal(venv.states, before)  # checked before any copy moves
     with pytest.raises(ValueError, match=bad_shape):
         venv.step((np.array([5, 5]), tuple(boxes[:5] + [np.zeros((2, 2))] + boxes[6:])))

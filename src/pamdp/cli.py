@@ -21,6 +21,7 @@ import os
 import sys
 import types
 import typing
+import warnings
 from pathlib import Path
 
 from pamdp import __version__
@@ -543,10 +544,16 @@ def cmd_render(args) -> int:
     return 0
 
 
+def _warning_line(message, category, filename, lineno, line=None) -> str:
+    return f"pamdp: warning: {str(message).replace(chr(10), ' ')}\n"
+
+
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     if args.command in ("train", "reproduce", "evaluate"):
         keep_freed_memory()
+    # A warning reads as one line of the command's, not as Python's "file:line: UserWarning:"; the API keeps those.
+    formatwarning, warnings.formatwarning = warnings.formatwarning, _warning_line
     handlers = {
         "train": cmd_train,
         "evaluate": cmd_evaluate,
@@ -571,6 +578,8 @@ def main(argv: list[str] | None = None) -> int:
             message = f"{exc.filename}: {exc.strerror or exc}; expected a readable file or a writable directory"
         print(f"pamdp {args.command}: error: {message}", file=sys.stderr)
         return 2
+    finally:
+        warnings.formatwarning = formatwarning
 
 
 if __name__ == "__main__":

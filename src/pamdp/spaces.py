@@ -15,7 +15,17 @@ from functools import cached_property
 import numpy as np
 from gymnasium import spaces
 
-__all__ = ["HybridActionSpace"]
+__all__ = ["HybridActionSpace", "BoxRows"]
+
+
+class BoxRows(tuple):
+    """A batch's parameter boxes as the rows of one ``(K, N, m)`` array, ``block``: a tuple of boxes to any env, and
+    to one that knows it (Hard Move, whose 1 024 boxes it then checks in one pass) that one array."""
+
+    def __new__(cls, block: np.ndarray):
+        rows = super().__new__(cls, block)
+        rows.block = block
+        return rows
 
 
 @dataclass(frozen=True)
@@ -171,7 +181,7 @@ class HybridActionSpace:
             block = np.empty((self.n_actions, len(a), m), dtype=np.float32)
             block[:] = self._mid32[:, None, :]
             block[a, np.arange(len(a))] = x[:, :m]
-            return (a, tuple(block))
+            return (a, BoxRows(block))
         params = []
         for b, (lo, hi) in enumerate(zip(self.lows, self.highs)):
             p = np.where((a == b)[:, None], x[:, : lo.shape[0]], 0.5 * (lo + hi))

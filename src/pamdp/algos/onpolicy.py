@@ -114,10 +114,12 @@ class Rollout:
         self.action_mask = algo.config.action_mask
         self.stepper: VectorStepper | None = None  # the env's copies, from the first epoch on
 
-    def collect(self, n_samples: int) -> dict[str, np.ndarray]:
+    def collect(self, n_samples: int, exact: bool = False) -> dict[str, np.ndarray]:
         """Step the env with ``(a, x) ~ policy`` until ``n_samples`` valid samples; ``(T, N, ...)`` arrays of
-        :attr:`KEYS` (``t``: the step within the episode; ``terminated`` and ``done`` are false when not valid),
-        and ``mask`` with ``action_mask``.
+        :attr:`KEYS` (``t``: the step within the episode; ``terminated`` and ``done`` are false at autoreset
+        steps, which are not valid), and ``mask`` with ``action_mask``. With ``exact`` the last step's samples past
+        ``n_samples`` are marked not valid too (the end of a budget): they are not trained on, but their rewards
+        still reach the advantages of the steps before them.
 
         The policy runs on the algorithm's device and the env on the CPU: a step moves the observations there and
         the actions back, nothing else.
@@ -145,25 +147,21 @@ class Rollout:
                 rows["mask"].append(step.masks)
             n_valid += int(step.valid.sum())
             self.t_ep = np.where(step.valid, self.t_ep + 1, 0)
+        if exact and n_valid > n_samples:
+            rows["valid"][-1][np.flatnonzero(rows["valid"][-1])[n_samples - n_valid :]] = False
         return {k: np.stack(v) for k, v in rows.items()}
 
-    def budget_note(self, total: int) -> str | None:
-        """What ``total`` more samples train where it is not about ``total`` (below one vector step), or ``None``."""
-        copies = self.algo.vec_env.num_envs
-        if total >= copies:
-            return None
-        return (
-            f"total_timesteps = {total:,} is below one step of the num_envs = {copies:,} env copies: the run trains "
-            f"one batch of about {copies:,} samples; lower num_envs to train fewer"
-        )
+    def budget_note(self, total: int) -> None:
+        """None: any budget trains (its last epoch is cut to the samples left, down to part of one vector step)."""
 
     def run_epoch(self, budget: int | None = None) -> dict[str, float]:
-        """One epoch: :meth:`collect` ``batch_size`` samples (``budget`` where fewer are left), their
+        """One epoch: :meth:`collect` ``batch_size`` samples (exactly ``budget`` where no more are left), their
         :func:`advantage_batch` from the algorithm's baseline (``_values(obs, t)``), then its ``_learn`` of the batch
         (subnormals flushed with ``flush_denormal``). Returns ``_learn``'s stats with the baseline's explained
         variance, the discrete actions' frequencies, the episodes completed in the epoch, and ``steps``."""
         algo, cfg = self.algo, self.algo.config
-        batch = self.collect(cfg.batch_size if budget is None else min(cfg.batch_size, budget))
+        last = budget is not None and budget <= cfg.batch_size
+        batch = self.collect(budget if last else cfg.batch_size, exact=last)
         data, explained_var = advantage_batch(batch, algo._values, cfg.gamma, cfg.gae_lambda, cfg.normalize_advantages)
         with subnormals_flushed(cfg.flush_denormal):
             stats = algo._learn(data)

@@ -137,19 +137,13 @@ def catch_point_copies(states, a, theta, resetting, draws, cursors, obs, rewards
 @jit
 def hard_move_copies(states, a, p, motions, resetting, draws, cursors, obs, rewards, terminated):
     """:func:`catch_point_copies` for Hard Move: copy ``i`` that is not resetting takes
-    :func:`hard_move_step` with ``motions[a[i]]`` (``a`` already checked) and ``p[i]``. Returns the first
-    copy whose ``p`` is not finite (before anything changes), else -1."""
-    n = states.shape[0]
-    for i in range(n):
-        if not math.isfinite(p[i]):
-            return i
-    for i in range(n):
+    :func:`hard_move_step` with ``motions[a[i]]`` and ``p[i]`` (both checked by the parser)."""
+    for i in range(states.shape[0]):
         if resetting[i]:
             cursors[i] = reset(states[i], draws[i], cursors[i])
         else:
             rewards[i], terminated[i] = hard_move_step(states[i], motions[a[i], 0], motions[a[i], 1], p[i])
     observe(states, obs)
-    return -1
 
 
 @jit

@@ -1,12 +1,6 @@
-"""The scalar env: a :class:`~pamdp.envs.vector.Domain` at N = 1 as a ``gymnasium.Env``.
-
-It keeps one state row and one :class:`~pamdp.envs.streams.RandomStreams` copy that follows ``np_random``
-(a replaced generator, e.g. ``numpy.random.RandomState(S)`` or a seeded reset, drops the numbers drawn
-ahead of it), and runs the domain's own batched ``parse``, ``reset`` and ``step`` on them: one action is
-checked as a batch of one (:func:`as_batch`), and the batched infos are read back as copy 0's. It does not
-autoreset; it truncates at ``max_episode_steps`` itself (the domain's limit by default: the registrations set
-none, so ``gymnasium.make`` adds no ``TimeLimit``, whose reset would zero the count before a refused reset).
-"""
+"""The scalar env: a :class:`~pamdp.envs.vector.Domain` at N = 1 as a ``gymnasium.Env``, running the domain's own
+batched ``parse``, ``reset`` and ``step`` on one state row, its stream following ``np_random``; no autoreset, its
+own time limit (``docs/environments.md``, "How the environments are built" and "Checked inputs")."""
 
 from __future__ import annotations
 
@@ -15,15 +9,14 @@ import inspect
 import gymnasium
 import numpy as np
 
-from pamdp.envs.streams import RandomStreams, check_seed
-from pamdp.envs.vector import Domain, DomainVectorEnv, build_domain, check_options, check_render_mode, time_limit
+from pamdp.envs.streams import check_seed
+from pamdp.envs.vector import Domain, DomainVectorEnv, Shell
 
 __all__ = ["DomainEnv", "as_batch", "env_classes"]
 
 
 class _OneEach(tuple):
-    """The parameters of one action, each read as a batch of one (``p[None]``) when it is read: a parser that
-    reads only the chosen action's parameter (Hard Move's 1 024 boxes) converts only that one."""
+    """One action's parameters, each read as a batch of one (``p[None]``) only when read (Hard Move's 1 024 boxes)."""
 
     def __getitem__(self, i):
         if isinstance(i, slice):
@@ -35,52 +28,26 @@ class _OneEach(tuple):
 
 
 def as_batch(action):
-    """One action ``(a, params)`` as a batch of one, ``(array([a]), (p_0[None], p_1[None], ...))``; anything
-    else is handed on as it is, for the parser to refuse."""
+    """One action ``(a, params)`` as a batch of one; anything else as it is, for the parser to refuse."""
     if not isinstance(action, (tuple, list)) or len(action) != 2:
         return action
     a, params = action
     return np.asarray(a)[None], _OneEach(params) if isinstance(params, (tuple, list)) else params
 
 
-class DomainEnv(gymnasium.Env):
-    """One copy of a :class:`~pamdp.envs.vector.Domain` (``domain_class``) as a Gymnasium env.
+class DomainEnv(Shell, gymnasium.Env):
+    """One copy of a :class:`~pamdp.envs.vector.Domain` as a Gymnasium env; ``max_episode_steps`` truncates (default:
+    the domain's; None: never), ``render_mode`` None or ``"rgb_array"``, ``**variant`` the domain's arguments."""
 
-    Args:
-        render_mode: ``None`` or ``"rgb_array"``.
-        max_episode_steps: episodes are truncated after this many steps (default: the domain's); ``None`` leaves
-            the end to the domain.
-        **variant: the domain's constructor arguments.
-    """
-
-    metadata = {"render_modes": ["rgb_array"]}
-    domain_class: type[Domain]
-    variant: dict = {}
-    """Constructor arguments of the domain fixed by the class (Hard Goal's ``hard=True``)."""
-    num_envs = 1
-    """The domain's hooks see the scalar env as a batched one of one copy."""
+    num_envs = 1  # the domain's hooks see the scalar env as a batched one of one copy
 
     def __init__(
         self, render_mode: str | None = None, max_episode_steps: int | str | None = "domain", **variant: object
     ):
-        self.domain = domain = build_domain(self.domain_class, {**self.variant, **variant})
-        self.max_episode_steps = time_limit(max_episode_steps, domain)
+        domain = self._build(1, "scalar_buffer_size", max_episode_steps, render_mode, variant)
+        self.action_space, self.observation_space = domain.action_space, domain.observation_space
         self._elapsed = 0
-        check_render_mode(render_mode, self.metadata["render_modes"])
-        self.metadata = {**self.metadata, "render_fps": domain.render_fps}
-        self.render_mode = render_mode
-        self.action_space = domain.action_space
-        self.observation_space = domain.observation_space
-        self.streams = RandomStreams(1, domain.draw, domain.scalar_buffer_size)
-        self._states = domain.initial_states(1)
-        self._started = False
         self._calm = np.zeros(1, dtype=bool)  # a scalar env never resets inside a step
-
-    def __getattr__(self, name: str):
-        # The domain's variant and tables (``n``, ``motions``, ``settings``...) read as the env's own.
-        if name == "domain":
-            raise AttributeError(name)
-        return getattr(self.domain, name)
 
     @property
     def state(self):
@@ -90,7 +57,7 @@ class DomainEnv(gymnasium.Env):
 
     def reset(self, *, seed: int | None = None, options: dict | None = None):
         check_seed(seed)
-        check_options(self.domain, options, 1)
+        self._check_options(options, 1)
         super().reset(seed=seed)
         self.streams.follow(0, self.np_random)
         if self.domain.reset_draws:
@@ -116,9 +83,8 @@ class DomainEnv(gymnasium.Env):
         return self.domain.frame(self, 0) if self.render_mode == "rgb_array" else None
 
     def render_substeps(self) -> list[np.ndarray]:
-        """With ``render_mode="rgb_array"``: the frames of the last step, one per sub-step where the domain runs
-        several (Platform, Goal; none after a reset), the last one equal to :meth:`render`'s.
-        ``pamdp.envs.rendering.record_episode`` plays these."""
+        """With ``render_mode="rgb_array"``: the last step's frames, one per sub-step where the domain runs several
+        (Platform, Goal; none after a reset), the last one :meth:`render`'s (``record_episode`` plays them)."""
         if self.render_mode != "rgb_array":
             raise ValueError(f"render_substeps needs render_mode='rgb_array', got {self.render_mode!r}")
         return self.domain.substep_frames(self)
@@ -135,9 +101,8 @@ def _first(infos: dict) -> dict:
 
 
 def env_classes(domain_class: type[Domain], module: str, scalar: str, batched: str, **variant) -> tuple[type, type]:
-    """A domain's scalar env and batched env, classes named ``scalar`` and ``batched`` in ``module`` (the names
-    users import and ``isinstance`` tests), with the constructor arguments ``variant`` fixed. Their signatures
-    list the domain's arguments, as code that inspects an env's constructor (``pamdp.algos``) expects."""
+    """A domain's scalar and batched env, classes ``scalar`` and ``batched`` of ``module`` with ``variant`` fixed, whose
+    signatures list the domain's arguments (as ``pamdp.algos``, inspecting an env's constructor, expects)."""
     what = f"{domain_class.name}" + "".join(f", {k}={v!r}" for k, v in variant.items())
     attrs = {"domain_class": domain_class, "variant": variant, "__module__": module}
     doc = f"{{}} of {what} (see :class:`{module}.{domain_class.__name__}`)."

@@ -323,11 +323,12 @@ def plot_curves(
 
 
 def results_table(groups: dict[str, list[Path]]) -> str:
-    """A markdown table of the final greedy evaluations (mean +- std across seeds)."""
+    """A markdown table of the final greedy evaluations (mean +- std across seeds) and each seed's gradient updates
+    (:func:`update_counts`)."""
     lines = [
         "| setting | seeds | greedy return (mean +- std over seeds) | success rate | steps to success "
-        "| last-epoch return |",
-        "|---|---|---|---|---|---|",
+        "| last-epoch return | gradient updates |",
+        "|---|---|---|---|---|---|---|",
     ]
     for label, runs in groups.items():
         evals = [_evaluation(r / "evaluation.json") for r in runs if (r / "evaluation.json").exists()]
@@ -347,8 +348,20 @@ def results_table(groups: dict[str, list[Path]]) -> str:
             to_goal = f"{np.mean(steps):.1f}" if steps else "-"
         else:
             greedy, goal, to_goal = "not evaluated", "-", "-"
-        lines.append(f"| {label} | {len(runs)} | {greedy} | {goal} | {to_goal} | {last} |")
+        lines.append(f"| {label} | {len(runs)} | {greedy} | {goal} | {to_goal} | {last} | {update_counts(runs)} |")
     return "\n".join(lines)
+
+
+def update_counts(runs: list[Path]) -> str:
+    """Each run's gradient updates (its epochs' ``train/updates`` summed, what ``model.num_updates`` counts), a run
+    that made none flagged ``0 (untrained)``, one that logged no count ``-``."""
+    counts = []
+    for run in runs:
+        _, updates = _read_progress(run, "train/updates")
+        logged = updates[np.isfinite(updates)]
+        total = int(logged.sum())
+        counts.append("-" if not len(logged) else f"{total:,}" if total else "0 (untrained)")
+    return ", ".join(counts)
 
 
 def _evaluation(path: Path) -> dict:

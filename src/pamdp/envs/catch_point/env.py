@@ -1,27 +1,17 @@
-"""Catch Point as a pamdp domain: its contract and its two envs (the task: ``pamdp.envs.catch_point``).
-
-Action ``(a, (theta, catch))``, batched ``a`` of shape ``(N,)``, ``theta`` ``(N, 1)`` or ``(N,)``, used as
-given (sine and cosine are periodic) but finite, ``catch`` ``(N, 0)`` (``(N, 1)`` is accepted and ignored).
-Observation ``[vx, vy, gx - ax, gy - ay]`` (float64): the agent's velocity, the target relative to the
-agent. ``info``: ``failed_catches`` and, after a step, ``is_success`` (this step caught the point).
-
-Random numbers: a reset draws the agent's then the target's position, ``uniform(-1, 1, 2)`` each, four
-``random()`` numbers of the copy's generator (the scalar env draws none ahead), so assigning
-``numpy.random.RandomState(S)`` to the scalar env's ``np_random`` replays the original driven by
-``np.random.seed(S)``; ``state`` holds copies of the state rows (indices in ``pamdp.envs.particle``).
-"""
+"""Catch Point as a pamdp domain: its contract and its two envs (the task: ``pamdp.envs.catch_point``). Actions,
+observations, ``state``, ``info`` and the resets' draws: ``docs/environments.md``, "Catch Point and Hard Move" and
+"Each domain's batched actions, ``state`` and ``info``"."""
 
 from __future__ import annotations
 
 import functools
 
 import numpy as np
-from gymnasium import spaces
 
 import pamdp.envs.particle as particle
 from pamdp.envs.catch_point.render import draw_catch_point
 from pamdp.envs.scalar import env_classes
-from pamdp.envs.vector import column, split_actions
+from pamdp.envs.vector import column, every_copy, hybrid_space, split_actions
 
 __all__ = ["CatchPoint", "CatchPointEnv", "CatchPointVectorEnv", "catch_point_action_space", "THETA_MAX"]
 
@@ -29,11 +19,9 @@ THETA_MAX = float(np.float32(np.pi))
 """The angle box is [-π, π] in float32, 3.1415927410125732 (HyAR's glue sends float32(p) * float32(π))."""
 
 
-def catch_point_action_space() -> spaces.Tuple:
+def catch_point_action_space():
     """``Tuple(Discrete(2), Tuple(Box(-π, π, (1,)), Box(0,)))``, float32."""
-    theta = spaces.Box(np.float32(-THETA_MAX), np.float32(THETA_MAX), shape=(1,), dtype=np.float32)
-    catch = spaces.Box(-1.0, 1.0, shape=(0,), dtype=np.float32)
-    return spaces.Tuple((spaces.Discrete(2), spaces.Tuple((theta, catch))))
+    return hybrid_space((-THETA_MAX, THETA_MAX, 1), (-1.0, 1.0, 0))
 
 
 @functools.cache  # the check of every batch needs it
@@ -53,8 +41,7 @@ class CatchPoint(particle.ParticleDomain):
         self.action_space = catch_point_action_space()
 
     def parse(self, actions, n):
-        """``a`` (n,) int64 and ``theta`` (n,) float64, structure, shapes and dtypes checked; the compiled step
-        checks the values."""
+        """``a`` (n,) int64 and ``theta`` (n,) float64 (the compiled step checks the values)."""
         expected = expected_actions(n)
         a, params = split_actions(actions, self.name, n, expected, n_params=2)
         theta, catch = column(params[0], n, "angles", expected), np.shape(params[1])
@@ -76,12 +63,8 @@ class CatchPoint(particle.ParticleDomain):
         return obs, rewards, terminated, np.zeros(n, dtype=bool), self.infos(env, ~resetting, caught)
 
     def infos(self, env, stepped=None, success=None) -> dict:
-        """Every copy reports its failed catches, the copies that stepped (rather than reset) whether they
-        caught the point."""
-        fails = env._states[:, particle.FAILS].astype(np.int64)
-        return {"failed_catches": fails, "_failed_catches": np.ones(env.num_envs, dtype=bool)} | super().infos(
-            env, stepped, success
-        )
+        fails = every_copy(env.num_envs, failed_catches=env._states[:, particle.FAILS].astype(np.int64))
+        return fails | super().infos(env, stepped, success)
 
     def frame(self, env, i):
         a = int(self.last_actions[i])

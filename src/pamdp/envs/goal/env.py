@@ -1,15 +1,6 @@
-"""Goal and Hard Goal as one pamdp domain: its contract and its envs (the task: ``pamdp.envs.goal``).
-
-Action ``(a, (p_0, p_1, ...))``, batched ``a`` of shape ``(N,)``, ``p_0`` ``(N, 2)`` and the others
-``(N, 1)`` or ``(N,)``, all finite; only ``p_a`` is read, clipped into its box. Observation: 17 float64
-features, nominally in [-1, 1] (``dynamics.observe``); the orientation is never wrapped and a ball that left
-the field lies outside, hence the unbounded box. ``state``: ``player`` and ``keeper`` = [x, y, vx, vy,
-orientation], ``ball`` = [x, y, vx, vy], ``time`` = the agent steps taken, one entry per copy.
-
-Noise: every number is a ``random()`` draw of the copy's generator, used in the original's order, so
-assigning ``numpy.random.RandomState(S)`` to the scalar env's ``np_random`` after ``reset()`` replays the
-original driven by the same generator.
-"""
+"""Goal and Hard Goal as one pamdp domain: its contract and its envs (the task: ``pamdp.envs.goal``). Actions,
+observations, ``state``, ``info`` and the noise's exact replay: ``docs/environments.md``, "Robot Soccer Goal and
+Hard Goal" and "Each domain's batched actions, ``state`` and ``info``"."""
 
 from __future__ import annotations
 
@@ -19,7 +10,7 @@ from gymnasium import spaces
 import pamdp.envs.goal.dynamics as dyn
 from pamdp.envs.goal.render import RENDER_FPS, draw_goal
 from pamdp.envs.scalar import env_classes
-from pamdp.envs.vector import Domain, split_actions
+from pamdp.envs.vector import Domain, every_copy, hybrid_space, shown, split_actions
 
 __all__ = ["Goal", "GoalEnv", "HardGoalEnv", "GoalVectorEnv", "HardGoalVectorEnv", "hard_goal_shot"]
 
@@ -49,16 +40,13 @@ class Goal(Domain):
     render_fps = RENDER_FPS
     state_size = dyn.STATE_SIZE
     reset_draws = dyn.RESET_DRAWS
-    step_draws = dyn.SUBSTEP_DRAWS
-    """A copy's step needs at least one sub-step's numbers; it is resumed after a top-up if it needs more."""
+    step_draws = dyn.SUBSTEP_DRAWS  # at least one sub-step's numbers; a step is resumed after a top-up
     buffer_size = scalar_buffer_size = 4096
 
     def __init__(self, hard: bool = False):
         self.hard = bool(hard)
-        kick = spaces.Box(KICK_LOW.astype(np.float32), KICK_HIGH.astype(np.float32), dtype=np.float32)
         lo, hi, k = (-1.0, 1.0, 10) if self.hard else (-dyn.HALF_GOAL, dyn.HALF_GOAL, 2)
-        shoot = spaces.Box(np.float32(lo), np.float32(hi), shape=(1,), dtype=np.float32)
-        self.action_space = spaces.Tuple((spaces.Discrete(k + 1), spaces.Tuple((kick,) + (shoot,) * k)))
+        self.action_space = hybrid_space((KICK_LOW, KICK_HIGH, 2), *[(lo, hi, 1)] * k)
         self.observation_space = spaces.Box(-np.inf, np.inf, shape=(dyn.OBS_SIZE,), dtype=np.float64)
         self.trace = np.empty((256, dyn.TRACE_SIZE))  # the scalar env's sub-steps, grown for a long step
         self.substeps = 0
@@ -85,7 +73,7 @@ class Goal(Domain):
         for i, (p, box) in enumerate(zip(params, self.action_space[1])):
             p, size = np.asarray(p), box.shape[0]
             if p.shape not in ((n, size), (n,) if size == 1 else (n, size)) or p.dtype.kind not in "iuf":
-                raise ValueError(f"invalid parameter {i} of shape {p.shape}: {p!r}; expected {expected}")
+                raise ValueError(f"invalid parameter {i} of shape {p.shape}: {shown(p)}; expected {expected}")
             p = p.reshape(n, size).astype(np.float64)
             if not np.isfinite(p).all():
                 raise ValueError(f"parameter {i} contains {p[~np.isfinite(p)]}; expected {expected}")
@@ -102,7 +90,7 @@ class Goal(Domain):
     def reset(self, env, mask, options, seeded):
         dyn.reset_copies(env._states, mask, env.streams.buffers, env.streams.cursors)
         self.substeps = 0
-        return self._observe(env), _info(np.zeros(env.num_envs, dtype=np.int64))
+        return self._observe(env), every_copy(env.num_envs, substeps=np.zeros(env.num_envs, dtype=np.int64))
 
     def step(self, env, parsed, resetting):
         """A copy whose numbers run out mid-step stops; its numbers are topped up and the copies still pending
@@ -121,9 +109,8 @@ class Goal(Domain):
             if 0 < trace.shape[0] == substeps[0]:  # a long step: room for more frames
                 self.trace = trace = np.concatenate([trace, np.empty_like(trace)])
         self.substeps = int(substeps[0])
-        infos = _info(substeps)
-        infos["is_success"] = terminated & (rewards == dyn.GOAL_REWARD)
-        infos["_is_success"] = terminated | truncated
+        infos = every_copy(n, substeps=substeps)
+        infos["is_success"], infos["_is_success"] = terminated & (rewards == dyn.GOAL_REWARD), terminated | truncated
         return self._observe(env), rewards, terminated, truncated, infos
 
     def _observe(self, env):
@@ -136,11 +123,6 @@ class Goal(Domain):
 
     def substep_frames(self, env):
         return [draw_goal(*row) for row in self.trace[: self.substeps]]
-
-
-def _info(substeps: np.ndarray) -> dict:
-    # Every copy reports its sub-steps (0 after a reset), hence an all-true "_substeps" mask.
-    return {"substeps": substeps, "_substeps": np.ones(substeps.shape, dtype=bool)}
 
 
 GoalEnv, GoalVectorEnv = env_classes(Goal, __name__, "GoalEnv", "GoalVectorEnv")

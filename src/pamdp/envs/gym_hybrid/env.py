@@ -1,21 +1,7 @@
 """gym-hybrid's Moving and Sliding as one pamdp domain: its contract and its envs (the task:
-``pamdp.envs.gym_hybrid``).
-
-Action ``(a, (p_accelerate, p_turn, p_break))``, batched ``a`` of shape ``(N,)``, ``p_accelerate`` and
-``p_turn`` ``(N, 1)`` or ``(N,)`` (finite; the chosen one is clipped into its box) and ``p_break`` ``(N, 0)``.
-Observation (float64): agent x, y, speed, cos and sin of its heading, target x, y, the distance to the
-target, 1 within the target (``d <= 0.1``) else 0, and the elapsed fraction ``t / max_step``. ``state``:
-copies of the state rows (indices in ``dynamics``, with the heading ``THETA`` and Sliding's velocity
-direction ``PHI``, which the observation does not show).
-
-Random numbers: a reset draws six uniforms in the original's order (the target, then the agent); nothing
-in a step is random, and the scalar env draws no number ahead, so assigning ``numpy.random.RandomState(S)``
-to its ``np_random`` after a first ``reset()`` replays the original driven by that generator.
-
-The original constructor's settings (``max_turn``, ``max_acceleration``, ``delta_t``, ``max_step``,
-``penalty``, ``break_value``) are constructor arguments too; the defaults are the original's and every
-published result's.
-"""
+``pamdp.envs.gym_hybrid``). Actions, observations, ``state``, the resets' draws and the original constructor's
+settings (defaults: the original's): ``docs/environments.md``, "Moving and Sliding (gym-hybrid)" and "Each
+domain's batched actions, ``state`` and ``info``"."""
 
 from __future__ import annotations
 
@@ -28,7 +14,7 @@ from gymnasium import spaces
 import pamdp.envs.gym_hybrid.dynamics as dyn
 from pamdp.envs.gym_hybrid.render import RENDER_FPS, draw_gym_hybrid
 from pamdp.envs.scalar import env_classes
-from pamdp.envs.vector import Domain, column, split_actions
+from pamdp.envs.vector import Domain, column, hybrid_space, split_actions
 
 __all__ = ["GymHybrid", "MovingEnv", "SlidingEnv", "MovingVectorEnv", "SlidingVectorEnv", "check_settings"]
 
@@ -36,14 +22,8 @@ ACTION_FORM = "(a, (p_accelerate, p_turn, p_break)) with a in {0, 1, 2}, p_accel
 
 
 def gym_hybrid_action_space() -> spaces.Tuple:
-    """``Tuple(Discrete(3), Tuple(Box(0, 1, (1,)), Box(-1, 1, (1,)), Box(0,)))``, float32: break has no
-    parameter, hence its zero-size box."""
-    boxes = (
-        spaces.Box(np.float32(0.0), np.float32(1.0), shape=(1,), dtype=np.float32),
-        spaces.Box(np.float32(-1.0), np.float32(1.0), shape=(1,), dtype=np.float32),
-        spaces.Box(np.float32(0.0), np.float32(0.0), shape=(0,), dtype=np.float32),
-    )
-    return spaces.Tuple((spaces.Discrete(3), spaces.Tuple(boxes)))
+    """``Tuple(Discrete(3), Tuple(Box(0, 1, (1,)), Box(-1, 1, (1,)), Box(0,)))``, float32 (break: no parameter)."""
+    return hybrid_space((0.0, 1.0, 1), (-1.0, 1.0, 1), (0.0, 0.0, 0))
 
 
 def check_settings(**settings) -> np.ndarray:
@@ -67,10 +47,9 @@ def check_settings(**settings) -> np.ndarray:
 class GymHybrid(Domain):
     name = "gym-hybrid"
     render_fps = RENDER_FPS
-    state_size = dyn.STATE_SIZE
+    state_size, initial_state = dyn.STATE_SIZE, dyn.INITIAL_STATE
     reset_draws = scalar_buffer_size = dyn.DRAWS_PER_RESET
-    buffer_size = 64 * dyn.DRAWS_PER_RESET
-    """The numbers of 64 resets per copy: a copy's buffer is topped up once every 64 episodes."""
+    buffer_size = 64 * dyn.DRAWS_PER_RESET  # 64 resets' numbers: a copy is topped up once every 64 episodes
 
     def __init__(
         self,
@@ -90,12 +69,8 @@ class GymHybrid(Domain):
         self.action_space = gym_hybrid_action_space()
         self.observation_space = spaces.Box(-np.inf, np.inf, shape=(dyn.OBS_SIZE,), dtype=np.float64)
 
-    def initial_states(self, n):
-        return np.tile(dyn.INITIAL_STATE, (n, 1))
-
     def parse(self, actions, n):
-        """``a`` (n,) and the accelerate and turn parameters (n,), float32 or float64 as given (the compiled
-        step widens them to float64), not yet clipped."""
+        """``a`` (n,) and the accelerate and turn parameters (n,), float32 or float64 as given, not yet clipped."""
         expected = f"{ACTION_FORM} arrays of shape ({n}, 1) or ({n},), p_break of shape ({n}, 0); a of shape ({n},)"
         a, params = split_actions(actions, self.name, n, expected, n_params=3)
         columns = []

@@ -1,38 +1,6 @@
-"""Half Field Offense 1v0 and 1v1 as a pamdp domain: its contract and its two envs (the task: ``pamdp.envs.hfo``).
-
-``info`` holds ``status`` ("IN_GAME", "GOAL", "OUT_OF_BOUNDS", "OUT_OF_TIME" or, with the goalie,
-"CAPTURED_BY_DEFENSE"), ``step``, the number of
-actions taken this episode, and ``action_mask``, bool ``(3,)``: which of DASH, TURN and KICK have an effect
-in the returned state (KICK only when the agent's kickable test passes, as HFO's agent sends it); when an
-episode ends also ``is_success`` (True on a goal). The observation returned with a terminal status is the
-true terminal state. ``reset(options=...)`` accepts ``ball`` (x, y), ``player`` (x, y) and ``body``
-(degrees), in the server's metres (goal centre at (52.5, 0)), each once or one per copy (a leading axis of
-size N); missing ones are drawn as usual. With the goalie also ``goalie_body`` (degrees), its body at its
-placement; any option given starts the goalie's memory neutral (``defense``).
-
-Random numbers: each copy draws placements and actuator noise from a stream of its own (four 64-bit words,
-``copy_streams[i]``, ``dynamics.seed_stream``) seeded from its generator whenever that is a new one (a seeded
-reset, an assignment to ``np_random`` or ``np_randoms``); a seed also turns the player to face the goal, as
-a new server run does. ``state`` is the live state rows (indices in ``dynamics``), through which the
-recorded traces set the simulator's state.
-
-The settings (constructor arguments of the domain, the scalar and the batched env):
-    defense_npcs: 0 (default) for 1v0 on an empty goal; 1 for HFO's goalie (``defense``; 68 features, 66 with
-        ``hfo2016``), the task registered as ``pamdp/HalfFieldOffenseGoalie-v0``.
-    profile: feature set of an HFO release: ``"hfo2016"`` (58 features, Hausknecht & Stone), ``"hfo2017"``
-        (59, the seed paper's; default) or ``"hfo2019"`` (59, current HFO normalisers). The reward reads the
-        features, so it scales with the profile's Dmax.
-    deterministic: zero the actuator noise (HFO's ``--deterministic``); placements stay random.
-    timeout_terminal: report OUT_OF_TIME as ``terminated`` (as dqn-hfo and MP-DQN treated it) instead of
-        ``truncated``. The untouched and trial clocks are not in the observation, so by default they count as
-        truncation.
-    body_reset: ``"carry"`` keeps the body angle from the end of the previous episode, as the real server does
-        (the first episode faces the goal); ``"uniform"`` draws it in (-180, 180].
-    first_step_reward: difference the first transition against the reset state. H&S's and gym-soccer's code
-        start differencing after the first action, so by default the first transition pays only the goal bonus.
-    terminal_deltas: pay the distance and kick terms on the terminal transition too. dqn-hfo zeroes them
-        (only +5 for a goal survives), which is the default.
-"""
+"""Half Field Offense 1v0 and 1v1 as a pamdp domain: its contract and its two envs. Actions, observations,
+``info``, reset options, random streams and the constructor's settings: ``docs/environments.md``, "Half Field
+Offense" and "Each domain's batched actions, ``state`` and ``info``"."""
 
 from __future__ import annotations
 
@@ -50,7 +18,7 @@ from pamdp.envs.hfo.interface import (
     reset_options,
 )
 from pamdp.envs.scalar import env_classes
-from pamdp.envs.vector import Domain
+from pamdp.envs.vector import Domain, every_copy
 
 __all__ = ["HalfFieldOffense", "HalfFieldOffenseEnv", "HalfFieldOffenseVectorEnv", "kick_mask"]
 
@@ -110,8 +78,7 @@ class HalfFieldOffense(Domain):
     def state(self, states):
         return states
 
-    def parse(self, actions, n):
-        return parse_actions(actions, n)
+    parse = staticmethod(parse_actions)
 
     def _follow(self, env) -> None:
         """Seed the stream of every copy whose generator is a new one."""
@@ -151,16 +118,9 @@ class HalfFieldOffense(Domain):
         return obs, reward, terminated, truncated, infos
 
     def _infos(self, env, status=None) -> dict:
-        every = np.ones(env.num_envs, dtype=bool)
         names = _STATUS_NAMES[status] if status is not None else np.full(env.num_envs, "IN_GAME")
-        return {
-            "status": names,
-            "_status": every,
-            "step": env._states[:, dyn.STEPS].astype(np.int64),
-            "_step": every,
-            "action_mask": kick_mask(env._states),
-            "_action_mask": every,
-        }
+        step = env._states[:, dyn.STEPS].astype(np.int64)
+        return every_copy(env.num_envs, status=names, step=step, action_mask=kick_mask(env._states))
 
     def frame(self, env, i):
         return draw_half_field(env._states[i], goalie=self.goalie)

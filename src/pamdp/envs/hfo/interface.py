@@ -12,6 +12,7 @@ from gymnasium import spaces
 import pamdp.envs.hfo.dynamics as dyn
 from pamdp.envs.hfo import defense
 from pamdp.envs.rendering import Canvas
+from pamdp.envs.vector import shown
 
 ACTION_NAMES = ("DASH", "TURN", "KICK")
 PARAM_SIZES = (2, 1, 2)
@@ -131,8 +132,8 @@ def _option(key: str, value, n: int) -> np.ndarray:
     shapes = ((2,), (n, 2)) if point else ((), (n,))
     if arr is None or arr.shape not in shapes or not np.all(np.isfinite(arr)):
         if point:
-            raise ValueError(f"reset option {key}={value!r}; expected a pair of finite numbers (x, y) in metres")
-        raise ValueError(f"reset option {key}={value!r}; expected one finite angle in degrees")
+            raise ValueError(f"reset option {key}={shown(value)}; expected a pair of finite numbers (x, y) in metres")
+        raise ValueError(f"reset option {key}={shown(value)}; expected one finite angle in degrees")
     if point:
         x_lo = 0.0 if key == "ball" else -dyn.PITCH_HALF_LENGTH
         for x, y in arr.reshape(-1, 2):

@@ -1,15 +1,6 @@
-"""Platform as a pamdp domain: its contract and its two envs (the task: ``pamdp.envs.platform``).
-
-Action ``(a, (p_run, p_hop, p_leap))``, batched ``a`` of shape ``(N,)`` and each ``p`` ``(N, 1)`` or
-``(N,)``; only ``p_a`` is read, after clipping into its box, and every ``p`` must be finite. Observation:
-the 9 features of ``physics.observe``, float64 in ``[0, 1]`` (the reference's sub-step count is
-``info["substeps"]``, 0 after a reset). ``state``: ``player`` = ``[x, y, vx, vy]`` and ``enemies`` =
-``[[x1, dx1], [x2, dx2]]``, one entry per copy.
-
-Noise: a step draws standard normals in the order of the reference implementation, so assigning
-``numpy.random.RandomState(S)`` to the scalar env's ``np_random`` after ``reset()`` replays the reference
-driven by the same generator, bit for bit, and :class:`ZeroNoise` gives the noise-free dynamics.
-"""
+"""Platform as a pamdp domain: its contract and its two envs (the task: ``pamdp.envs.platform``). Actions,
+observations, ``state``, ``info`` and the noise's exact replay: ``docs/environments.md``, "Platform" and "Each
+domain's batched actions, ``state`` and ``info``"."""
 
 from __future__ import annotations
 
@@ -19,7 +10,7 @@ from gymnasium import spaces
 import pamdp.envs.platform.physics as physics
 from pamdp.envs.platform.render import RENDER_FPS, draw_platform
 from pamdp.envs.scalar import env_classes
-from pamdp.envs.vector import Domain, column, split_actions
+from pamdp.envs.vector import Domain, column, every_copy, hybrid_space, split_actions
 
 __all__ = ["Platform", "PlatformEnv", "PlatformVectorEnv", "ZeroNoise", "platform_action_space"]
 
@@ -27,12 +18,8 @@ NO_TRACE = np.empty((0, physics.TRACE_SIZE))
 
 
 class ZeroNoise:
-    """A stand-in for a generator whose standard normals are all zero: the noise-free dynamics.
-
-    Assign it after ``reset()``: ``env.unwrapped.np_random = ZeroNoise()`` for the scalar env,
-    ``venv.np_randoms = [ZeroNoise()] * venv.num_envs`` for the batched one. A seeded ``reset(seed=...)``
-    installs fresh generators again.
-    """
+    """A stand-in for a generator whose standard normals are all zero: the noise-free dynamics (assigned after
+    ``reset()`` to ``np_random`` or ``np_randoms``, until a seeded reset)."""
 
     def standard_normal(self, size=None):
         return 0.0 if size is None else np.zeros(size)
@@ -40,18 +27,16 @@ class ZeroNoise:
 
 def platform_action_space() -> spaces.Tuple:
     """``Tuple(Discrete(3), Tuple(Box(1), Box(1), Box(1)))`` with boxes [0, 30], [0, 720], [0, 430]."""
-    boxes = tuple(spaces.Box(np.float32(0.0), np.float32(hi), shape=(1,), dtype=np.float32) for hi in physics.PARAM_MAX)
-    return spaces.Tuple((spaces.Discrete(3), spaces.Tuple(boxes)))
+    return hybrid_space(*((0.0, hi, 1) for hi in physics.PARAM_MAX))
 
 
 class Platform(Domain):
     name = "Platform"
     render_fps = RENDER_FPS
-    state_size = physics.STATE_SIZE
+    state_size, initial_state = physics.STATE_SIZE, physics.INITIAL_STATE
     draw = "standard_normal"
     step_draws = physics.MAX_DRAWS
-    buffer_size = scalar_buffer_size = 2048
-    """A step takes ~150 normals, at most ``physics.MAX_DRAWS``."""
+    buffer_size = scalar_buffer_size = 2048  # a step takes ~150 normals, at most physics.MAX_DRAWS
     max_episode_steps = 200
 
     def __init__(self):
@@ -59,9 +44,6 @@ class Platform(Domain):
         self.observation_space = spaces.Box(0.0, 1.0, shape=(physics.OBS_SIZE,), dtype=np.float64)
         self.trace = np.empty((physics.MAX_SUBSTEPS, physics.TRACE_SIZE))  # the scalar env's sub-steps
         self.substeps = 0
-
-    def initial_states(self, n):
-        return np.tile(physics.INITIAL_STATE, (n, 1))
 
     def state(self, states):
         return {
@@ -89,7 +71,7 @@ class Platform(Domain):
     def reset(self, env, mask, options, seeded):
         env._states[mask] = physics.INITIAL_STATE
         self.substeps = 0
-        return self._observe(env), _info(np.zeros(env.num_envs, dtype=np.int64))
+        return self._observe(env), every_copy(env.num_envs, substeps=np.zeros(env.num_envs, dtype=np.int64))
 
     def step(self, env, parsed, resetting):
         (a, p), n, streams = parsed, env.num_envs, env.streams
@@ -100,7 +82,7 @@ class Platform(Domain):
             env._states, a, p, ~resetting, streams.buffers, streams.cursors, rewards, terminated, substeps, trace
         )
         self.substeps = int(substeps[0])
-        return self._observe(env), rewards, terminated, np.zeros(n, dtype=bool), _info(substeps)
+        return self._observe(env), rewards, terminated, np.zeros(n, dtype=bool), every_copy(n, substeps=substeps)
 
     def _observe(self, env):
         out = np.empty((env.num_envs, physics.OBS_SIZE))
@@ -113,11 +95,6 @@ class Platform(Domain):
 
     def substep_frames(self, env):
         return [draw_platform(*row) for row in self.trace[: self.substeps]]
-
-
-def _info(substeps: np.ndarray) -> dict:
-    # Every copy reports its sub-steps (0 after a reset), hence an all-true "_substeps" mask.
-    return {"substeps": substeps, "_substeps": np.ones(substeps.shape, dtype=bool)}
 
 
 PlatformEnv, PlatformVectorEnv = env_classes(Platform, __name__, "PlatformEnv", "PlatformVectorEnv")
