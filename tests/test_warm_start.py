@@ -131,3 +131,6 @@ settings = { num_envs = 2, batch_size = 200 }
     log = (second / "stdout.log").read_text()
     assert f"networks started from {first}" in log
     assert (first / "final_model.pt").stat().st_mtime < (second / "run.json").stat().st_mtime
+    (first / "final_model.pt").rename(first / "checkpoint.pt")  # as a run still training leaves it
+    with pytest.raises(ValueError, match="holds no final_model.pt"):
+        _warm_start(algorithm_class("patrpo")("pamdp/Platform-v0"), str(first), log=lambda msg: None)

@@ -308,9 +308,17 @@ def _prepare(
 
 def _warm_start(model, source: str, log) -> None:
     """Start ``model``'s networks from the model in ``source``, its observation's features matched by name where
-    the two envs' observations differ (``feature_names`` of their domains, e.g. Half Field Offense 1v0 and 1v1)."""
-    from pamdp.algos.checkpoints import read_checkpoint, transfer_weights
+    the two envs' observations differ (``feature_names`` of their domains, e.g. Half Field Offense 1v0 and 1v1). A
+    run directory gives its final model: a run still training (only a checkpoint) is refused."""
+    from pamdp.algos.checkpoints import FINAL_MODEL, read_checkpoint, transfer_weights
 
+    if Path(source).is_dir():
+        if not (Path(source) / FINAL_MODEL).is_file():
+            raise ValueError(
+                f"cannot start from {source}: it holds no {FINAL_MODEL} (a run not finished yet, or no run); "
+                "expected a finished run directory or a model file"
+            )
+        source = str(Path(source) / FINAL_MODEL)
     payload = read_checkpoint(source)
     new = model.observation_space.shape[0]
     old = int((payload.get("shapes") or {}).get("observation", [new])[0])
