@@ -102,9 +102,10 @@ algo = "patrpo"
     assert [spec.init_from for spec, _ in second] == sources
 
 
-def test_a_curriculum_runs_its_stages_in_order_whatever_the_jobs_order(tmp_path):
-    """Given the second stage first (as two workers could start it before the first ends), it waits for the first
-    and starts from that stage's final model."""
+@pytest.mark.parametrize("workers", [1, 2])
+def test_a_curriculum_runs_its_stages_in_order_whatever_the_jobs_order(tmp_path, workers):
+    """Given the second stage first, and with two workers, which could start it before the first ends, it waits
+    for the first and starts from that stage's final model."""
     from pamdp.experiments.runner import run_all
 
     (tmp_path / "c.toml").write_text("""
@@ -125,7 +126,7 @@ settings = { num_envs = 2, batch_size = 200 }
 """)
     exp = load_experiment(tmp_path / "c.toml")
     jobs = exp.jobs(tmp_path / "out", exp.specs())
-    outcomes = run_all(list(reversed(jobs)), workers=1, log=lambda msg: None)
+    outcomes = run_all(list(reversed(jobs)), workers=workers, log=lambda msg: None)
     assert [o.error for o in outcomes] == [None, None]
     first, second = (tmp_path / "out" / "c" / label / "seed0" for label in ("first", "second"))
     log = (second / "stdout.log").read_text()

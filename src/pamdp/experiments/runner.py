@@ -21,6 +21,7 @@ import multiprocessing
 import os
 import socket
 import sys
+import threading
 import time
 import traceback
 import warnings
@@ -424,25 +425,23 @@ class RunOutcome:
     seconds: float
 
 
-def _waves(jobs: list[tuple[RunSpec, str]]) -> list[list[tuple[RunSpec, str]]]:
-    """``jobs`` in waves that run one after another: a run started from another job's model (``init_from``) comes
-    in a wave after the one that trains it."""
-    waves, left = [], list(jobs)
+def _in_order(jobs: list[tuple[RunSpec, str]]) -> list[tuple[RunSpec, str]]:
+    """``jobs`` with every run started from another job's model (``init_from``) after the job that trains it,
+    the order otherwise kept."""
+    ordered, left = [], list(jobs)
     while left:
         pending = {os.path.normpath(out) for _, out in left}
-        wave = [(spec, out) for spec, out in left if os.path.normpath(spec.init_from or ".") not in pending]
-        if not wave:  # a circle of init_from: run them as given, and each fails on its missing source
-            wave = left
-        waves.append(wave)
-        left = [job for job in left if job not in wave]
-    return waves
+        ready = [(spec, out) for spec, out in left if os.path.normpath(spec.init_from or ".") not in pending]
+        ready = ready or left  # a circle of init_from: as given, each then fails on its unfinished source
+        ordered += ready
+        left = [job for job in left if job not in ready]
+    return ordered
 
 
 def run_all(jobs: list[tuple[RunSpec, str]], workers: int = 1, log=print) -> list[RunOutcome]:
     """Run ``(spec, out_dir)`` jobs, ``workers`` at a time in separate processes (1: in this process); a run
-    started from another job's model waits for it (:func:`_waves`)."""
-    if len(waves := _waves(jobs)) > 1:
-        return [outcome for wave in waves for outcome in run_all(wave, workers, log)]
+    started from another job's model (``init_from``) starts once that job has ended."""
+    jobs = _in_order(jobs)
     outcomes: list[RunOutcome] = []
     if workers <= 1:
         for spec, out in jobs:
@@ -455,16 +454,22 @@ def run_all(jobs: list[tuple[RunSpec, str]], workers: int = 1, log=print) -> lis
             log(_describe(o))
         return outcomes
     ctx = multiprocessing.get_context("spawn")
+    ended = {os.path.normpath(out): threading.Event() for _, out in jobs}
 
     def run_job(spec: RunSpec, out: str) -> RunOutcome:
         # A process pool of its own per run: a worker that dies (killed, out of memory) breaks only its own
         # pool, so it fails its own run alone while the runs beside it go on.
+        source = ended.get(os.path.normpath(spec.init_from)) if spec.init_from else None
+        if source is not None:  # submitted before this one (jobs are in order), so it runs or has run: no deadlock
+            source.wait()
         t0 = time.time()
         try:
             with cf.ProcessPoolExecutor(max_workers=1, mp_context=ctx) as pool:
                 return RunOutcome(spec, out, pool.submit(_worker, spec, out).result(), None, time.time() - t0)
         except Exception as exc:
             return RunOutcome(spec, out, None, "".join(traceback.format_exception(exc)), time.time() - t0)
+        finally:
+            ended[os.path.normpath(out)].set()
 
     with cf.ThreadPoolExecutor(max_workers=workers) as threads:
         for fut in cf.as_completed([threads.submit(run_job, spec, out) for spec, out in jobs]):
