@@ -21,7 +21,6 @@ import multiprocessing
 import os
 import socket
 import sys
-import threading
 import time
 import traceback
 import warnings
@@ -425,26 +424,28 @@ class RunOutcome:
     seconds: float
 
 
-def _in_order(jobs: list[tuple[RunSpec, str]]) -> list[tuple[RunSpec, str]]:
-    """``jobs`` with every run started from another job's model (``init_from``) after the job that trains it,
-    the order otherwise kept."""
-    ordered, left = [], list(jobs)
-    while left:
-        pending = {os.path.normpath(out) for _, out in left}
-        ready = [(spec, out) for spec, out in left if os.path.normpath(spec.init_from or ".") not in pending]
-        ready = ready or left  # a circle of init_from: as given, each then fails on its unfinished source
-        ordered += ready
-        left = [job for job in left if job not in ready]
+def _ready(pending: list, running) -> list:
+    """The jobs of ``pending`` whose ``init_from`` names no job still pending or ``running``, in order."""
+    unfinished = {os.path.normpath(out) for _, out in [*pending, *running]}
+    return [job for job in pending if os.path.normpath(job[0].init_from or ".") not in unfinished]
+
+
+def _started_after_their_sources(jobs: list) -> list:
+    """``jobs`` in their order but for a run started from another job's model, which comes after that job."""
+    ordered, pending = [], list(jobs)
+    while pending:
+        job = (_ready(pending, ()) or pending)[0]  # none ready: a circle of init_from, whose runs then fail
+        ordered.append(job)
+        pending.remove(job)
     return ordered
 
 
 def run_all(jobs: list[tuple[RunSpec, str]], workers: int = 1, log=print) -> list[RunOutcome]:
     """Run ``(spec, out_dir)`` jobs, ``workers`` at a time in separate processes (1: in this process); a run
-    started from another job's model (``init_from``) starts once that job has ended."""
-    jobs = _in_order(jobs)
+    started from another job's model (``init_from``) starts once that job has ended, the others in their order."""
     outcomes: list[RunOutcome] = []
     if workers <= 1:
-        for spec, out in jobs:
+        for spec, out in _started_after_their_sources(jobs):
             t0 = time.time()
             try:
                 o = RunOutcome(spec, out, _worker(spec, out), None, time.time() - t0)
@@ -454,27 +455,29 @@ def run_all(jobs: list[tuple[RunSpec, str]], workers: int = 1, log=print) -> lis
             log(_describe(o))
         return outcomes
     ctx = multiprocessing.get_context("spawn")
-    ended = {os.path.normpath(out): threading.Event() for _, out in jobs}
 
     def run_job(spec: RunSpec, out: str) -> RunOutcome:
         # A process pool of its own per run: a worker that dies (killed, out of memory) breaks only its own
         # pool, so it fails its own run alone while the runs beside it go on.
-        source = ended.get(os.path.normpath(spec.init_from)) if spec.init_from else None
-        if source is not None:  # submitted before this one (jobs are in order), so it runs or has run: no deadlock
-            source.wait()
         t0 = time.time()
         try:
             with cf.ProcessPoolExecutor(max_workers=1, mp_context=ctx) as pool:
                 return RunOutcome(spec, out, pool.submit(_worker, spec, out).result(), None, time.time() - t0)
         except Exception as exc:
             return RunOutcome(spec, out, None, "".join(traceback.format_exception(exc)), time.time() - t0)
-        finally:
-            ended[os.path.normpath(out)].set()
 
+    pending, running = list(jobs), {}
     with cf.ThreadPoolExecutor(max_workers=workers) as threads:
-        for fut in cf.as_completed([threads.submit(run_job, spec, out) for spec, out in jobs]):
-            outcomes.append(fut.result())
-            log(_describe(outcomes[-1]))
+        while pending or running:
+            ready = _ready(pending, running.values())
+            for job in (ready or pending[:1] * (not running))[: workers - len(running)]:  # [:1]: a circle fails
+                pending.remove(job)
+                running[threads.submit(run_job, *job)] = job
+            finished, _ = cf.wait(running, return_when=cf.FIRST_COMPLETED)
+            for fut in finished:
+                del running[fut]
+                outcomes.append(fut.result())
+                log(_describe(outcomes[-1]))
     return outcomes
 
 
