@@ -183,11 +183,15 @@ class MultiPassDense:
         w_blocks = n.weights[0][:, d:].t()[self.param_index] * self.param_mask.unsqueeze(-1)  # (K, m, h): W_k^T
         xs = params.t()[self.param_index].transpose(1, 2)  # (K, B, m): x_k
         base = torch.addmm(n.biases[0], obs, n.weights[0][:, :d].t())  # W_s s + b
-        z = torch.baddbmm(base, xs, w_blocks).view(-1, base.shape[-1])  # (K * B, h)
+        if xs.shape[-1] == 1:  # one parameter an action: an outer product, which addcmul makes faster than bmm
+            z = torch.addcmul(base, xs, w_blocks).view(-1, base.shape[-1])  # (K * B, h)
+        else:
+            z = torch.baddbmm(base, xs, w_blocks).view(-1, base.shape[-1])
         h = _apply(*n.acts[0], z) if n.acts[0] is not None else z
         hidden, middle = self.middle.forward_cached(h)
         hidden = hidden.view(k, -1, hidden.shape[-1])  # (K, B, h')
-        q = torch.baddbmm(n.biases[-1][:, None, None], hidden, n.weights[-1].unsqueeze(-1)).view(k, -1)
+        # Q_k = w_k . h of pass k, as (1, h') x (h', B) products: bmm's matrix-vector form is several times slower
+        q = torch.baddbmm(n.biases[-1][:, None, None], n.weights[-1].unsqueeze(1), hidden.transpose(1, 2)).view(k, -1)
         return q.t(), (obs, xs, w_blocks, z, h, middle, hidden)
 
     def backward(
