@@ -9,9 +9,8 @@ figures less than they would a wall clock.
 
 With ``--baseline REF`` every case also runs on the package as it was at git commit ``REF`` (exported to a
 temporary directory), one worker process per version, the repeats alternating between them so that both see the
-same load. ``--split`` adds each update's time split, measured on the current code with ``torch.profiler``:
-matrix products, Adam, gradient clipping, target (Polyak) updates, copies and indexing, other element-wise
-kernels, and the rest (Python, dispatch and the profiler's own overhead: the update's time less its kernels').
+same load. ``--split`` adds each update's time split on the current code (:func:`split`): matrix products, Adam,
+gradient clipping, target (Polyak) updates, and the rest.
 
     python benchmarks/bench_update_speed.py --baseline 30eadb4 --split --out benchmarks/update_speed.md
 """
@@ -41,18 +40,8 @@ CASES = {
     "PADDPG soccer": ("paddpg", "pamdp/HalfFieldOffense-v0", "paper_hfo", {}),
 }
 REPO = Path(__file__).resolve().parents[1]
-# torch.profiler op names -> the split's parts (anything else is "element-wise")
-PARTS = {
-    "products": ("aten::addmm", "aten::mm", "aten::bmm", "aten::baddbmm", "aten::matmul", "aten::linear"),
-    "Adam": ("aten::_fused_adam_", "aten::_foreach_add_"),
-    "clipping": ("aten::_foreach_norm", "aten::linalg_vector_norm", "aten::_foreach_mul_", "aten::stack"),
-    "target updates": ("aten::lerp_", "aten::_foreach_lerp_"),
-    "copies": (
-        "aten::copy_", "aten::_to_copy", "aten::cat", "aten::index", "aten::index_select", "aten::gather",
-        "aten::scatter_", "aten::clone", "aten::empty", "aten::empty_strided", "aten::empty_like", "aten::zeros",
-        "aten::zeros_like", "aten::ones_like", "aten::fill_", "aten::zero_", "aten::contiguous",
-    ),
-}  # fmt: skip
+# the matrix products an update makes, with how many tensor arguments each takes (addmm: bias, a, b)
+PRODUCTS = {"aten::addmm": 3, "aten::mm": 2, "aten::bmm": 2, "aten::baddbmm": 3}
 
 
 def build(label: str):
@@ -82,23 +71,47 @@ def updates(model, n: int) -> None:
             model._update()
 
 
+def cpu_ms(fn, n: int) -> float:
+    """CPU ms a call of ``fn``, over ``n`` calls after a few to warm up."""
+    for _ in range(3):
+        fn()
+    t = time.process_time()
+    for _ in range(n):
+        fn()
+    return (time.process_time() - t) / n * 1e3
+
+
 def split(model, n_updates: int) -> dict[str, float]:
-    """Fractions of an update's time by part, under ``torch.profiler`` (which times kernels by the wall clock, so
-    the fractions are of the wall time)."""
+    """CPU ms of an update and of its parts, each part timed alone on this core: the update's matrix products
+    (their shapes recorded by ``torch.profiler`` in one update, then replayed on random tensors of those shapes),
+    the Adam steps and the gradient clipping on gradients of the networks' shapes, and the Polyak target updates;
+    "other" is the rest (element-wise kernels, copies and indexing, Python and dispatch). Parts timed alone run
+    with warm caches, so they are lower bounds of their share inside an update."""
+    import torch
     from torch.profiler import profile
 
-    t = time.perf_counter()
-    with profile() as prof:
-        updates(model, n_updates)
-    total = (time.perf_counter() - t) * 1e6  # us, as the profiler's
-    parts = dict.fromkeys([*PARTS, "element-wise"], 0.0)
-    for event in prof.key_averages():
-        if not event.key.startswith("aten::"):
-            continue
-        part = next((p for p, names in PARTS.items() if event.key in names), "element-wise")
-        parts[part] += event.self_cpu_time_total
-    parts["Python, dispatch, profiler"] = total - sum(parts.values())
-    return {p: v / total for p, v in parts.items()}
+    from pamdp.algos.optim import clip_grads, optimizer_step
+
+    total = cpu_ms(lambda: updates(model, 1), n_updates)
+    with profile(record_shapes=True) as prof:
+        updates(model, 1)
+    calls = [(e.name, e.input_shapes[: PRODUCTS[e.name]]) for e in prof.events() if e.name in PRODUCTS]
+    args = [(getattr(torch.ops.aten, name[6:]), [torch.randn(shape) for shape in shapes]) for name, shapes in calls]
+    products = cpu_ms(lambda: [op(*tensors) for op, tensors in args], n_updates)
+    optimizers = list(model._optimizers().values())
+    grads = [[torch.randn_like(p) * 1e-3 for p in opt.param_groups[0]["params"]] for opt in optimizers]
+    clip = getattr(model.config, "grad_clip", 0.0)
+    clipping = cpu_ms(lambda: [clip_grads(g, clip) for g in grads], n_updates) if clip > 0 else 0.0
+    adam = cpu_ms(lambda: [optimizer_step(opt, g) for opt, g in zip(optimizers, grads)], n_updates)
+    modules = model._modules()
+    sources = {name.removesuffix("_net"): module for name, module in modules.items()}  # PDQN's q_net: q_target
+    pairs = [(module, sources[name.removesuffix("_target")]) for name, module in modules.items() if "_target" in name]
+    targets = [p for target, _ in pairs for p in target.parameters()]
+    sources = [p for _, source in pairs for p in source.parameters()]
+    with torch.no_grad():
+        polyak = cpu_ms(lambda: torch._foreach_lerp_(targets, sources, 1e-3), n_updates)
+    parts = {"products": products, "Adam": adam, "clipping": clipping, "target updates": polyak}
+    return {"update": total, **parts, "other": total - sum(parts.values())}
 
 
 def worker(label: str, n_updates: int, n_samples: int, with_split: bool) -> int:
@@ -230,16 +243,18 @@ def main(argv=None) -> int:
             lines.append("| " + " | ".join(map(str, cells)) + " |")
             print(lines[-1], flush=True)
     if args.split:
-        parts = list(next(iter(splits.values())))
+        parts = list(next(iter(splits.values())))[1:]
         lines += [
             "",
-            f"Each update's time split, now (fractions of its CPU time under torch.profiler, {args.updates} updates):",
+            "Each update's time split, now: CPU ms of the update, then of each part timed alone (see "
+            "`split` in the script), with its share of the update:",
             "",
-            "| case | " + " | ".join(parts) + " |",
-            "|---|" + "---|" * len(parts),
+            "| case | update | " + " | ".join(parts) + " |",
+            "|---|---|" + "---|" * len(parts),
         ]
-        for label, fractions in splits.items():
-            lines.append(f"| {label} | " + " | ".join(f"{100 * fractions[p]:.0f} %" for p in parts) + " |")
+        for label, ms in splits.items():
+            cells = [f"{ms[p]:.2f} ({100 * ms[p] / ms['update']:.0f} %)" for p in parts]
+            lines.append(f"| {label} | {ms['update']:.2f} | " + " | ".join(cells) + " |")
     os.makedirs(os.path.dirname(args.out) or ".", exist_ok=True)
     from _record import write_record  # here, not at the top: the workers may import an older pamdp
 

@@ -190,7 +190,7 @@ class PADDPG(EpsilonSchedule, Algorithm):
         """``Q'(s, mu'(s))``, the bootstrap of a truncated episode's Monte-Carlo return."""
         return self.critic_target(obs, self._masked(self.actor_target(obs).clamp(-1.0, 1.0), mask))
 
-    def _update(self) -> dict[str, float]:
+    def _update(self) -> dict[str, torch.Tensor]:
         """One critic step on the mixed target and one actor step along the bounded ``dQ/dmu``, back-propagated
         by hand through the :mod:`~pamdp.algos.dense` views of the networks."""
         cfg = self.config
@@ -212,16 +212,16 @@ class PADDPG(EpsilonSchedule, Algorithm):
             # actor: ascend on Q(s, mu(s)) with the critic just updated, dQ/dmu edited at the bounds
             out, actor_cache = actor.forward_cached(obs)
             q_mu, q_cache = critic.forward_cached(torch.cat([obs, self._masked(out, b.get("mask"))], dim=-1))
-            _, dq_dx = critic.backward(q_cache, torch.ones_like(q_mu), weights=False, inputs=True)
-            dq_dp = bounded(dq_dx[:, self.obs_dim :], out, cfg.bound)
+            _, dq_dp = critic.backward(q_cache, torch.ones_like(q_mu), weights=False, inputs=slice(self.obs_dim, None))
+            dq_dp = bounded(dq_dp, out, cfg.bound)
             if "mask" in b:  # a forbidden action's score is held at -1: no gradient reaches it
                 k = self.hybrid.n_actions
                 dq_dp = torch.cat([dq_dp[:, :k] * b["mask"], dq_dp[:, k:]], dim=-1)
             apply_gradients(self.actor_optimizer, actor.backward(actor_cache, -dq_dp / batch)[0], cfg.grad_clip)
             self._soft_update(cfg.tau)
-        return {
-            "losses/critic_loss": float(error.square().mean()),
-            "losses/actor_loss": float(-q_mu.mean()),
-            "train/q_mean": float(q.mean()),
-            "train/outputs_out_of_bounds": float((out.abs() > 1.0).float().mean()),
+        return {  # tensors, read once an epoch by the loop
+            "losses/critic_loss": error.square().mean(),
+            "losses/actor_loss": -q_mu.mean(),
+            "train/q_mean": q.mean(),
+            "train/outputs_out_of_bounds": (out.abs() > 1.0).float().mean(),
         }

@@ -251,10 +251,11 @@ class QNetwork(nn.Module):
         """From :meth:`forward_cached`'s cache and d loss / d Q ``(B, K)``: the gradients in the order of
         ``parameters()`` if ``weights``, else d loss / d params ``(B, sum_a m_a)``."""
         net, cache = cached
-        grads, d_in = net.backward(cache, grad, weights=weights, inputs=not weights)
         if weights:
-            return grads
-        return d_in if self.multi_pass else d_in[:, self.obs_dim :]
+            return net.backward(cache, grad)[0]
+        return net.backward(cache, grad, weights=False, inputs=True if self.multi_pass else slice(self.obs_dim, None))[
+            1
+        ]
 
     def _load_from_state_dict(self, state_dict, prefix, *args, **kwargs):
         state_dict.pop(prefix + "blocks", None)  # models saved before the block table was dropped hold it
