@@ -134,11 +134,10 @@ def worker(label: str, n_updates: int, n_samples: int, with_split: bool) -> int:
 
 
 def start_worker(label: str, args, src: str | None) -> subprocess.Popen:
-    env = dict(os.environ)
-    if src is not None:
-        env["PYTHONPATH"] = src + os.pathsep + env.get("PYTHONPATH", "")
+    path = os.pathsep.join(p for p in (src, os.environ.get("PYTHONPATH")) if p)  # src first: the version measured
     cmd = [sys.executable, __file__, "--worker", label, "--updates", str(args.updates), "--samples", str(args.samples)]
     cmd += ["--split"] * (args.split and src is None)
+    env = {**os.environ, "PYTHONPATH": path}
     proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True, env=env)
     if json.loads(proc.stdout.readline()) != {"ready": True}:
         raise RuntimeError(f"worker for {label} did not start")
@@ -174,13 +173,13 @@ def git_short(ref: str) -> str:
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--updates", type=int, default=300, help="updates per repeat")
-    parser.add_argument("--samples", type=int, default=1_000, help="env samples per repeat (one epoch)")
-    parser.add_argument("--repeats", type=int, default=5)
-    parser.add_argument("--baseline", metavar="REF", help="git commit to compare with (same settings)")
-    parser.add_argument("--split", action="store_true", help="also profile each update's time split")
     parser.add_argument("--cases", default=",".join(CASES), help=f"comma-separated, some of {list(CASES)}")
-    parser.add_argument("--out", default="benchmarks/update_speed.md")
+    parser.add_argument("--baseline", metavar="REF", help="also measure the package at this git commit")
+    parser.add_argument("--split", action="store_true", help="add each update's time split (current code)")
+    parser.add_argument("--repeats", type=int, default=5, help="measurements a case and version (median)")
+    parser.add_argument("--updates", type=int, default=300, help="_update() calls timed in a repeat")
+    parser.add_argument("--samples", type=int, default=1_000, help="samples of the training epoch timed in a repeat")
+    parser.add_argument("--out", default="benchmarks/update_speed.md", help="the markdown record")
     parser.add_argument("--worker", metavar="LABEL", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.worker:
@@ -255,11 +254,9 @@ def main(argv=None) -> int:
         for label, ms in splits.items():
             cells = [f"{ms[p]:.2f} ({100 * ms[p] / ms['update']:.0f} %)" for p in parts]
             lines.append(f"| {label} | {ms['update']:.2f} | " + " | ".join(cells) + " |")
-    os.makedirs(os.path.dirname(args.out) or ".", exist_ok=True)
-    from _record import write_record  # here, not at the top: the workers may import an older pamdp
+    from _record import write_record  # the workers may import an older pamdp: not at the top
 
-    write_record(lines, args.out)  # keeps the record's hand-written notes
-    print(f"wrote {args.out}")
+    write_record(lines, args.out)  # with the record's hand-written notes kept
     return 0
 
 
