@@ -40,8 +40,6 @@ def test_backward_matches_autograd(activation, output):
     for p, mine in zip(net.parameters(), grads, strict=True):
         torch.testing.assert_close(mine, p.grad)
     torch.testing.assert_close(dx, x.grad)
-    _, dx_part = dense.backward(cache, g, weights=False, inputs=slice(4, None))  # some input columns only
-    torch.testing.assert_close(dx_part, x.grad[:, 4:])
     _, none = dense.backward(cache, g)  # the input gradient only when asked for
     assert none is None
 

@@ -113,13 +113,12 @@ class Dense:
         return h.reshape(*x.shape[:-1], h.shape[-1]), cache
 
     def backward(
-        self, cache: list[torch.Tensor], grad: torch.Tensor, weights: bool = True, inputs: bool | slice = False
+        self, cache: list[torch.Tensor], grad: torch.Tensor, weights: bool = True, inputs: bool = False
     ) -> tuple[list[torch.Tensor] | None, torch.Tensor | None]:
         """Back-propagate ``grad`` (d loss / d outputs, the outputs' shape) through the cached pass.
 
         Returns the parameter gradients in the order of ``net.parameters()`` (weight then bias per layer; ``None``
-        unless ``weights``) and d loss / d inputs (``None`` unless ``inputs``), shaped as the flattened inputs; with
-        ``inputs`` a slice, of those input columns only (a critic's action part, without the product for the state).
+        unless ``weights``) and d loss / d inputs (``None`` unless ``inputs``), shaped as the flattened inputs.
         """
         g = grad.reshape(cache[-1].shape)
         pairs: list[tuple[torch.Tensor, torch.Tensor]] = []  # (weight, bias) gradients, last layer first
@@ -134,12 +133,10 @@ class Dense:
             h = cache[pos]  # the layer's input
             if weights:
                 pairs.append((torch.mm(g.t(), h), g.sum(0)))
-            if i > 0:
+            if i > 0 or inputs:
                 g = torch.mm(g, self.weights[i])
-            elif inputs is not False:
-                g = torch.mm(g, self.weights[0] if inputs is True else self.weights[0][:, inputs])
         grads = [t for pair in reversed(pairs) for t in pair] if weights else None
-        return grads, (g if inputs is not False else None)
+        return grads, (g if inputs else None)
 
 
 @dataclass(frozen=True)

@@ -212,8 +212,8 @@ class PADDPG(EpsilonSchedule, Algorithm):
             # actor: ascend on Q(s, mu(s)) with the critic just updated, dQ/dmu edited at the bounds
             out, actor_cache = actor.forward_cached(obs)
             q_mu, q_cache = critic.forward_cached(torch.cat([obs, self._masked(out, b.get("mask"))], dim=-1))
-            _, dq_dp = critic.backward(q_cache, torch.ones_like(q_mu), weights=False, inputs=slice(self.obs_dim, None))
-            dq_dp = bounded(dq_dp, out, cfg.bound)
+            _, dq_dx = critic.backward(q_cache, torch.ones_like(q_mu), weights=False, inputs=True)
+            dq_dp = bounded(dq_dx[:, self.obs_dim :], out, cfg.bound)
             if "mask" in b:  # a forbidden action's score is held at -1: no gradient reaches it
                 k = self.hybrid.n_actions
                 dq_dp = torch.cat([dq_dp[:, :k] * b["mask"], dq_dp[:, k:]], dim=-1)

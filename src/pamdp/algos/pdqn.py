@@ -253,9 +253,8 @@ class QNetwork(nn.Module):
         net, cache = cached
         if weights:
             return net.backward(cache, grad)[0]
-        return net.backward(cache, grad, weights=False, inputs=True if self.multi_pass else slice(self.obs_dim, None))[
-            1
-        ]
+        d_in = net.backward(cache, grad, weights=False, inputs=True)[1]
+        return d_in if self.multi_pass else d_in[:, self.obs_dim :]
 
     def _load_from_state_dict(self, state_dict, prefix, *args, **kwargs):
         state_dict.pop(prefix + "blocks", None)  # models saved before the block table was dropped hold it
