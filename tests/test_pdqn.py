@@ -17,6 +17,7 @@ from torch import nn
 from pamdp import PDQN
 from pamdp.algos.offpolicy import OUNoise, backprop_actor, invert_gradients, mixed_target
 from pamdp.algos.pdqn import ParamActor, PDQNConfig, QNetwork, param_blocks
+from pamdp.spaces import HybridActionSpace
 
 SMALL = PDQNConfig(hidden_sizes=(16,), epsilon_steps=300, **OFF_POLICY_SMALL)
 # HYBRID's three actions have 1, 2 and 1 parameters: the flat vector is [x_0 | x_1, x_1' | x_2], 4 values.
@@ -31,15 +32,21 @@ def test_parameter_blocks_and_selection_by_hand():
     torch.testing.assert_close(x, torch.tensor([[0.1, 0.0], [0.2, 0.3], [0.4, 0.0]]))
 
 
-def _separate_passes(q_net, obs, params):
+def _separate_passes(q_net, obs, params, blocks=BLOCKS):
     """Bester et al.'s multi-pass by definition: K forward passes of the whole network, pass k on the parameters
     with every block but action k's zeroed, Q_k read from pass k."""
     columns = []
-    for k, block in enumerate(BLOCKS):
+    for k, block in enumerate(blocks):
         only_k = torch.zeros_like(params)
         only_k[:, block] = params[:, block]
         columns.append(q_net.net(torch.cat([obs, only_k], dim=1))[:, k])
     return torch.stack(columns, dim=1)
+
+
+# One parameter an action, as Platform's: the first layer's per-pass product takes another form (an outer product).
+ONE_EACH = HybridActionSpace(
+    (np.array([-1.0]), np.array([0.0]), np.array([-2.0])), (np.ones(1), np.ones(1), np.ones(1))
+)
 
 
 def test_multi_pass_q_equals_k_single_action_passes():
@@ -55,14 +62,16 @@ def test_multi_pass_q_equals_k_single_action_passes():
 
 @pytest.mark.parametrize("multi_pass", [False, True])
 @pytest.mark.parametrize("hidden, activation", [((8,), "relu"), ((8, 6), "tanh"), ((7, 6, 5), "leaky_relu")])
-def test_hand_written_q_passes_match_autograd_through_the_definition(multi_pass, hidden, activation):
+@pytest.mark.parametrize("space, blocks", [(HYBRID, BLOCKS), (ONE_EACH, [slice(0, 1), slice(1, 2), slice(2, 3)])])
+def test_hand_written_q_passes_match_autograd_through_the_definition(multi_pass, hidden, activation, space, blocks):
     torch.manual_seed(4)
-    q_net = QNetwork(5, HYBRID, hidden, activation, multi_pass=multi_pass).double()
+    q_net = QNetwork(5, space, hidden, activation, multi_pass=multi_pass).double()
+    n = space.total_param_size
     obs = torch.randn(6, 5, dtype=torch.float64)
-    params = torch.randn(6, 4, dtype=torch.float64, requires_grad=True)
+    params = torch.randn(6, n, dtype=torch.float64, requires_grad=True)
     g = torch.randn(6, 3, dtype=torch.float64)
     if multi_pass:
-        expected = _separate_passes(q_net, obs, params)
+        expected = _separate_passes(q_net, obs, params, blocks)
     else:
         expected = q_net.net(torch.cat([obs, params], dim=1))
     expected.backward(g)
@@ -76,11 +85,13 @@ def test_hand_written_q_passes_match_autograd_through_the_definition(multi_pass,
     torch.testing.assert_close(d_params, params.grad)
 
 
-def test_float32_multi_pass_equals_the_definition_to_rounding():
+@pytest.mark.parametrize("space, blocks", [(HYBRID, BLOCKS), (ONE_EACH, [slice(0, 1), slice(1, 2), slice(2, 3)])])
+def test_float32_multi_pass_equals_the_definition_to_rounding(space, blocks):
     torch.manual_seed(5)
-    q_net = QNetwork(5, HYBRID, (64, 32), "relu", multi_pass=True)
-    obs, params = torch.randn(128, 5), torch.rand(128, 4) * 2 - 1
-    torch.testing.assert_close(q_net(obs, params), _separate_passes(q_net, obs, params), rtol=1e-5, atol=1e-6)
+    q_net = QNetwork(5, space, (64, 32), "relu", multi_pass=True)
+    obs, params = torch.randn(128, 5), torch.rand(128, space.total_param_size) * 2 - 1
+    expected = _separate_passes(q_net, obs, params, blocks)
+    torch.testing.assert_close(q_net(obs, params), expected, rtol=1e-5, atol=1e-6)
 
 
 def test_only_p_dqn_q_depends_on_other_actions_parameters():
