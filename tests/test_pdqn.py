@@ -2,14 +2,13 @@
 differences, the hand-written update against autograd's, acting and exploration, replay, a tiny learning run
 (save/load, resuming and the CLI: test_algorithms)."""
 
-import copy
 import dataclasses
 
 import gymnasium
 import numpy as np
 import pytest
 import torch
-from conftest import HYBRID, OFF_POLICY_SMALL, progress_rows
+from conftest import HYBRID, OFF_POLICY_SMALL, assert_update_matches, progress_rows
 from numeric import finite_difference
 from test_hybrid_plumbing import MaskedLine
 from torch import nn
@@ -295,10 +294,4 @@ def test_pdqn_update_matches_the_autograd_update(settings):
     cfg = dataclasses.replace(SMALL, grad_clip=0.5, **settings)
     mine = PDQN(MaskedLine() if cfg.action_mask else "pamdp/Platform-v0", cfg)
     mine.learn(200, progress_bar=False)  # fills the replay and takes updates, so Adam's state exists
-    ref = copy.deepcopy(mine)
-    for _ in range(30):  # both draw the same batch from their (equal) random streams
-        _autograd_update(ref)
-        mine._update()
-    for name, module in mine._modules().items():
-        for (pname, p), q in zip(module.named_parameters(), ref._modules()[name].parameters()):
-            torch.testing.assert_close(p, q, atol=2e-6, rtol=1e-4, msg=f"{name}.{pname}")
+    assert_update_matches(mine, _autograd_update)
