@@ -8,6 +8,13 @@ on fixed observations. Run it on the commit before a restructuring and after it;
     python benchmarks/check_same_weights.py --compare before.json    # on the new one: exit 1 on a difference
 
 The fingerprints depend on the PyTorch build and the machine (float rounding of BLAS), so compare on one machine.
+
+Where a change reassociates sums (a different but equivalent order of float32 operations), the fingerprints differ;
+``--save DIR`` keeps each case's weights and ``--diff DIR`` prints how far the new ones are from them (the largest
+absolute difference, and relative to the largest weight), which says whether the difference is rounding:
+
+    python benchmarks/check_same_weights.py --cases mpdqn-platform --save old_weights   # on the old commit
+    python benchmarks/check_same_weights.py --cases mpdqn-platform --diff old_weights   # on the new one
 """
 
 from __future__ import annotations
@@ -16,6 +23,7 @@ import argparse
 import hashlib
 import json
 import sys
+from pathlib import Path
 
 import numpy as np
 import torch
@@ -41,7 +49,10 @@ CASES: dict[str, tuple[str, str, str | None, dict, int]] = {
 }
 
 
-def fingerprint(algo: str, env_id: str, preset: str | None, settings: dict, samples: int) -> dict:
+def fingerprint(
+    algo: str, env_id: str, preset: str | None, settings: dict, samples: int, weights: dict | None = None
+) -> dict:
+    """The case's fingerprint; with ``weights`` (a dict), its weights are put there too, by module and key."""
     cls = algorithm_class(algo)
     try:  # the route of issue 48: Config.preset answers for the env's presets too
         base = cls.config_class.preset(preset, env_id)
@@ -57,6 +68,8 @@ def fingerprint(algo: str, env_id: str, preset: str | None, settings: dict, samp
         for key, tensor in module.state_dict().items():
             digest.update(f"{name}.{key}".encode())
             digest.update(tensor.detach().cpu().contiguous().numpy().tobytes())
+            if weights is not None and tensor.is_floating_point():
+                weights[f"{name}.{key}"] = tensor.detach().cpu().clone()
     obs_size = model.observation_space.shape[0]
     obs = np.random.default_rng(0).uniform(-1, 1, size=(16, obs_size)).astype(np.float32)
     torch.manual_seed(0)
@@ -75,12 +88,23 @@ def main(argv=None) -> int:
     parser.add_argument("--out", help="write the fingerprints to this JSON file")
     parser.add_argument("--compare", help="compare with the fingerprints in this JSON file")
     parser.add_argument("--cases", help="comma-separated case names (default: all)")
+    parser.add_argument("--save", metavar="DIR", help="save each case's weights in this directory")
+    parser.add_argument("--diff", metavar="DIR", help="print how far each case's weights are from those saved here")
     args = parser.parse_args(argv)
     names = args.cases.split(",") if args.cases else list(CASES)
     result = {}
     for name in names:
-        result[name] = fingerprint(*CASES[name])
+        weights: dict[str, torch.Tensor] = {}
+        result[name] = fingerprint(*CASES[name], weights=weights)
         print(name, result[name], flush=True)
+        if args.save:
+            Path(args.save).mkdir(parents=True, exist_ok=True)
+            torch.save(weights, Path(args.save) / f"{name}.pt")
+        if args.diff:
+            saved = torch.load(Path(args.diff) / f"{name}.pt")
+            diff = max((weights[k] - saved[k]).abs().max().item() for k in saved)
+            scale = max(t.abs().max().item() for t in saved.values())
+            print(f"  {name}: largest weight difference {diff:.3g} ({diff / scale:.3g} of the largest weight)")
     if args.out:
         with open(args.out, "w") as f:
             json.dump(result, f, indent=1)

@@ -4,11 +4,13 @@ leaves. Helpers are imported by name (``from conftest import small_config``: pyt
 
 from __future__ import annotations
 
+import copy
 import csv
 import dataclasses
 from pathlib import Path
 
 import numpy as np
+import torch
 
 from pamdp.algos import algorithm_class
 from pamdp.spaces import HybridActionSpace
@@ -76,3 +78,15 @@ def progress_rows(run_dir: str | Path) -> list[dict[str, str]]:
     """The rows of a run directory's ``progress.csv``, one an epoch."""
     with open(Path(run_dir) / "progress.csv", newline="") as f:
         return list(csv.DictReader(f))
+
+
+def assert_update_matches(model, reference_update, updates: int = 30) -> None:
+    """``model._update()`` against ``reference_update`` on a copy of the model, ``updates`` times: both draw the
+    same batches from their (equal) random streams, so their weights must stay equal to float32 rounding."""
+    ref = copy.deepcopy(model)
+    for _ in range(updates):
+        reference_update(ref)
+        model._update()
+    for name, module in model._modules().items():
+        for (pname, p), q in zip(module.named_parameters(), ref._modules()[name].parameters()):
+            torch.testing.assert_close(p, q, atol=2e-6, rtol=1e-4, msg=f"{name}.{pname}")

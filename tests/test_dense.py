@@ -6,6 +6,7 @@ import dataclasses
 
 import pytest
 import torch
+from conftest import assert_update_matches
 from test_hybrid_plumbing import MaskedLine
 from torch import nn
 
@@ -127,13 +128,7 @@ def test_paddpg_update_matches_the_autograd_update(bound, masked):
     cfg = dataclasses.replace(SMALL, bound=bound, grad_clip=0.5, activation="leaky_relu", action_mask=masked)
     mine = PADDPG(MaskedLine() if masked else "pamdp/Platform-v0", cfg)
     mine.learn(200, progress_bar=False)  # fills the replay and takes ~140 updates, so Adam's state exists
-    ref = copy.deepcopy(mine)
-    for _ in range(30):  # both draw the same batch from their (equal) random streams
-        _autograd_update(ref)
-        mine._update()
-    for name, module in mine._modules().items():
-        for (pname, p), q in zip(module.named_parameters(), ref._modules()[name].parameters()):
-            torch.testing.assert_close(p, q, atol=2e-6, rtol=1e-4, msg=f"{name}.{pname}")
+    assert_update_matches(mine, _autograd_update)
 
 
 SVG_SMALL = PASVG0Config(hidden_sizes=(32, 24), learning_starts=64, batch_size=16, epoch_steps=200, grad_clip=0.5)

@@ -1,5 +1,6 @@
 """P-DQN and MP-DQN: the multi-pass Q by hand, which parameters Q_k depends on, the actor's gradient by finite
-differences, acting and exploration, replay, a tiny learning run (save/load, resuming and the CLI: test_algorithms)."""
+differences, the hand-written update against autograd's, acting and exploration, replay, a tiny learning run
+(save/load, resuming and the CLI: test_algorithms)."""
 
 import dataclasses
 
@@ -7,12 +8,15 @@ import gymnasium
 import numpy as np
 import pytest
 import torch
-from conftest import HYBRID, OFF_POLICY_SMALL, progress_rows
+from conftest import HYBRID, OFF_POLICY_SMALL, assert_update_matches, progress_rows
 from numeric import finite_difference
+from test_hybrid_plumbing import MaskedLine
+from torch import nn
 
 from pamdp import PDQN
-from pamdp.algos.offpolicy import OUNoise, backprop_actor, invert_gradients
+from pamdp.algos.offpolicy import OUNoise, backprop_actor, invert_gradients, mixed_target
 from pamdp.algos.pdqn import ParamActor, PDQNConfig, QNetwork, param_blocks
+from pamdp.spaces import HybridActionSpace
 
 SMALL = PDQNConfig(hidden_sizes=(16,), epsilon_steps=300, **OFF_POLICY_SMALL)
 # HYBRID's three actions have 1, 2 and 1 parameters: the flat vector is [x_0 | x_1, x_1' | x_2], 4 values.
@@ -27,20 +31,66 @@ def test_parameter_blocks_and_selection_by_hand():
     torch.testing.assert_close(x, torch.tensor([[0.1, 0.0], [0.2, 0.3], [0.4, 0.0]]))
 
 
+def _separate_passes(q_net, obs, params, blocks=BLOCKS):
+    """Bester et al.'s multi-pass by definition: K forward passes of the whole network, pass k on the parameters
+    with every block but action k's zeroed, Q_k read from pass k."""
+    columns = []
+    for k, block in enumerate(blocks):
+        only_k = torch.zeros_like(params)
+        only_k[:, block] = params[:, block]
+        columns.append(q_net.net(torch.cat([obs, only_k], dim=1))[:, k])
+    return torch.stack(columns, dim=1)
+
+
+# One parameter an action, as Platform's: the first layer's per-pass product takes another form (an outer product).
+ONE_EACH = HybridActionSpace(
+    (np.array([-1.0]), np.array([0.0]), np.array([-2.0])), (np.ones(1), np.ones(1), np.ones(1))
+)
+
+
 def test_multi_pass_q_equals_k_single_action_passes():
     torch.manual_seed(0)
     q_net = QNetwork(5, HYBRID, (8, 8), "relu", multi_pass=True)
     obs, params = torch.randn(6, 5), torch.randn(6, 4)
-    expected = torch.empty(6, 3)
-    for k, block in enumerate(BLOCKS):  # pass k: only action k's parameters, every other one zero
-        only_k = torch.zeros_like(params)
-        only_k[:, block] = params[:, block]
-        expected[:, k] = q_net.net(torch.cat([obs, only_k], dim=1))[:, k]
-    torch.testing.assert_close(q_net(obs, params), expected)
+    torch.testing.assert_close(q_net(obs, params), _separate_passes(q_net, obs, params))
     # Without multi_pass the same weights see the whole vector at once.
     joint = QNetwork(5, HYBRID, (8, 8), "relu", multi_pass=False)
     joint.load_state_dict(q_net.state_dict())
     torch.testing.assert_close(joint(obs, params), q_net.net(torch.cat([obs, params], dim=1)))
+
+
+@pytest.mark.parametrize("multi_pass", [False, True])
+@pytest.mark.parametrize("hidden, activation", [((8,), "relu"), ((8, 6), "tanh"), ((7, 6, 5), "leaky_relu")])
+@pytest.mark.parametrize("space, blocks", [(HYBRID, BLOCKS), (ONE_EACH, [slice(0, 1), slice(1, 2), slice(2, 3)])])
+def test_hand_written_q_passes_match_autograd_through_the_definition(multi_pass, hidden, activation, space, blocks):
+    torch.manual_seed(4)
+    q_net = QNetwork(5, space, hidden, activation, multi_pass=multi_pass).double()
+    n = space.total_param_size
+    obs = torch.randn(6, 5, dtype=torch.float64)
+    params = torch.randn(6, n, dtype=torch.float64, requires_grad=True)
+    g = torch.randn(6, 3, dtype=torch.float64)
+    if multi_pass:
+        expected = _separate_passes(q_net, obs, params, blocks)
+    else:
+        expected = q_net.net(torch.cat([obs, params], dim=1))
+    expected.backward(g)
+    with torch.no_grad():
+        q, cache = q_net.forward_cached(obs, params)
+        grads = q_net.backward(cache, g)
+        d_params = q_net.backward(cache, g, weights=False)
+    torch.testing.assert_close(q, expected.detach())
+    for mine, p in zip(grads, q_net.parameters(), strict=True):
+        torch.testing.assert_close(mine, p.grad)
+    torch.testing.assert_close(d_params, params.grad)
+
+
+@pytest.mark.parametrize("space, blocks", [(HYBRID, BLOCKS), (ONE_EACH, [slice(0, 1), slice(1, 2), slice(2, 3)])])
+def test_float32_multi_pass_equals_the_definition_to_rounding(space, blocks):
+    torch.manual_seed(5)
+    q_net = QNetwork(5, space, (64, 32), "relu", multi_pass=True)
+    obs, params = torch.randn(128, 5), torch.rand(128, space.total_param_size) * 2 - 1
+    expected = _separate_passes(q_net, obs, params, blocks)
+    torch.testing.assert_close(q_net(obs, params), expected, rtol=1e-5, atol=1e-6)
 
 
 def test_only_p_dqn_q_depends_on_other_actions_parameters():
@@ -199,3 +249,49 @@ def test_tiny_learning_run_logs(tmp_path, multi_pass):
         assert np.isfinite(float(last[key])), key
     assert float(last["train/epsilon"]) == pytest.approx(cfg.epsilon_end)
     assert 0.0 <= float(last["charts/episodic_return"]) <= 1.0
+
+
+def _autograd_update(model):
+    """P-DQN's update on autograd and the modules' own forward: the form its hand-written update must equal."""
+    cfg = model.config
+    b = model.replay.sample(cfg.batch_size, model.np_rng)
+    obs = b["obs"]
+    with torch.no_grad():
+        y = b["reward"] + cfg.gamma * (~b["terminated"]).float() * model._next_value(b["next_obs"], b.get("next_mask"))
+        if cfg.beta > 0:
+            y = mixed_target(y, b["mc"], cfg.beta)
+    q = model.q_net(obs, b["params"]).gather(1, b["a"][:, None]).squeeze(1)
+    model.q_optimizer.zero_grad(set_to_none=True)
+    nn.functional.mse_loss(q, y).backward()
+    nn.utils.clip_grad_norm_(model.q_net.parameters(), cfg.grad_clip)
+    model.q_optimizer.step()
+    params = list(model.actor.parameters())
+    _, _, grads = backprop_actor(model.actor, model.q_net, obs, cfg.bound, params)
+    for p, g in zip(params, grads):
+        p.grad = g
+    nn.utils.clip_grad_norm_(params, cfg.grad_clip)
+    model.actor_optimizer.step()
+    with torch.no_grad():
+        for target, source, tau in (
+            (model.q_target, model.q_net, cfg.tau_q),
+            (model.actor_target, model.actor, cfg.tau_actor),
+        ):
+            for t, s in zip(target.parameters(), source.parameters()):
+                t.lerp_(s, tau)
+
+
+@pytest.mark.parametrize(
+    "settings",
+    [
+        {"multi_pass": True},
+        {"multi_pass": False},
+        {"multi_pass": True, "bound": "squash", "hidden_sizes": (16, 12), "activation": "tanh", "beta": 0.3},
+        {"multi_pass": True, "bound": "zero", "action_mask": True},
+        {"multi_pass": False, "hidden_sizes": (16, 12), "activation": "leaky_relu", "action_mask": True},
+    ],
+)
+def test_pdqn_update_matches_the_autograd_update(settings):
+    cfg = dataclasses.replace(SMALL, grad_clip=0.5, **settings)
+    mine = PDQN(MaskedLine() if cfg.action_mask else "pamdp/Platform-v0", cfg)
+    mine.learn(200, progress_bar=False)  # fills the replay and takes updates, so Adam's state exists
+    assert_update_matches(mine, _autograd_update)

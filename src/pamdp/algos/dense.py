@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import torch
 from torch import nn
 
-__all__ = ["Dense"]
+__all__ = ["Dense", "MultiPassDense"]
 
 _aten = torch.ops.aten
 
@@ -137,3 +137,85 @@ class Dense:
                 g = torch.mm(g, self.weights[i])
         grads = [t for pair in reversed(pairs) for t in pair] if weights else None
         return grads, (g if inputs else None)
+
+
+@dataclass(frozen=True)
+class MultiPassDense:
+    """MP-DQN's multi-pass Q-network (:class:`~pamdp.algos.pdqn.QNetwork` with ``multi_pass``) applied and
+    differentiated by hand, the same function as the module's own passes.
+
+    Pass ``k`` sees the state and action ``k``'s parameters only and gives ``Q_k`` alone, so its first layer is
+    ``W_s s + b + W_k x_k`` (``W_k``: the columns of ``x_k``) and its last layer the row ``k`` of the output
+    weights; the layers between are :class:`Dense` over the ``K * B`` rows of all passes, pass ``k``'s ``B`` rows
+    a contiguous block.
+    """
+
+    net: Dense
+    """The whole network; its first and last layers are applied per pass."""
+    middle: Dense
+    """The layers between, applied as they are to the ``K * B`` rows."""
+    obs_dim: int
+    param_index: torch.Tensor
+    """``(K, m)``: where action ``k``'s padded parameter ``j`` sits in the all-actions vector (0 where unused)."""
+    param_mask: torch.Tensor
+    """``(K, m)`` float: 1 where action ``k`` uses padded parameter ``j``."""
+    order: torch.Tensor
+    """``(n,)``: for parameter ``i`` of the all-actions vector, its position ``k * m + j`` among the padded blocks."""
+
+    @staticmethod
+    def block_order(param_index: torch.Tensor, param_mask: torch.Tensor) -> torch.Tensor:
+        """:attr:`order` for the blocks ``param_index`` and ``param_mask``."""
+        used = torch.nonzero(param_mask.flatten() > 0).squeeze(1)
+        return torch.empty_like(used).index_copy_(0, param_index.flatten()[used], used)
+
+    @classmethod
+    def of(
+        cls, net: nn.Sequential, obs_dim: int, param_index: torch.Tensor, param_mask: torch.Tensor, order: torch.Tensor
+    ) -> MultiPassDense:
+        """The network's own parameter tensors (updates to them show through), with its blocks' tables."""
+        whole = Dense.of(net)
+        middle = Dense(whole.weights[1:-1], whole.biases[1:-1], whole.acts[1:-1])
+        return cls(whole, middle, obs_dim, param_index, param_mask, order)
+
+    def forward_cached(self, obs: torch.Tensor, params: torch.Tensor) -> tuple[torch.Tensor, tuple]:
+        """``(B, K)`` values, ``Q_k`` from pass ``k``, with what :meth:`backward` needs."""
+        n, d, k = self.net, self.obs_dim, len(self.param_index)
+        w_blocks = n.weights[0][:, d:].t()[self.param_index] * self.param_mask.unsqueeze(-1)  # (K, m, h): W_k^T
+        xs = params.t()[self.param_index].transpose(1, 2)  # (K, B, m): x_k
+        base = torch.addmm(n.biases[0], obs, n.weights[0][:, :d].t())  # W_s s + b
+        if xs.shape[-1] == 1:  # one parameter an action: an outer product, which addcmul makes faster than bmm
+            z = torch.addcmul(base, xs, w_blocks).view(-1, base.shape[-1])  # (K * B, h)
+        else:
+            z = torch.baddbmm(base, xs, w_blocks).view(-1, base.shape[-1])
+        h = _apply(*n.acts[0], z) if n.acts[0] is not None else z
+        hidden, middle = self.middle.forward_cached(h)
+        hidden = hidden.view(k, -1, hidden.shape[-1])  # (K, B, h')
+        # Q_k = w_k . h of pass k, as (1, h') x (h', B) products: bmm's matrix-vector form is several times slower
+        q = torch.baddbmm(n.biases[-1][:, None, None], n.weights[-1].unsqueeze(1), hidden.transpose(1, 2)).view(k, -1)
+        return q.t(), (obs, xs, w_blocks, z, h, middle, hidden)
+
+    def backward(
+        self, cache: tuple, grad: torch.Tensor, weights: bool = True, inputs: bool = False
+    ) -> tuple[list[torch.Tensor] | None, torch.Tensor | None]:
+        """Back-propagate ``grad`` (d loss / d Q, ``(B, K)``) through the cached passes: the parameter gradients in
+        the order of ``net.parameters()`` (``None`` unless ``weights``) and d loss / d params, ``(B, sum_a m_a)``
+        (``None`` unless ``inputs``)."""
+        obs, xs, w_blocks, z, h, middle, hidden = cache
+        n, k, batch = self.net, len(self.param_index), len(obs)
+        g_q = grad.t().contiguous().unsqueeze(-1)  # (K, B, 1)
+        g = (g_q * n.weights[-1].unsqueeze(1)).view(-1, hidden.shape[-1])  # d/d hidden, (K * B, h')
+        mid_grads, g = self.middle.backward(middle, g, weights=weights, inputs=True)
+        if n.acts[0] is not None:
+            g = _slope_times(*n.acts[0], g, z, h)
+        g = g.view(k, batch, -1)  # d/d z of pass k, (K, B, h)
+        grads = None
+        if weights:
+            g_s = g.sum(0)
+            w_k = torch.bmm(xs.transpose(1, 2), g).view(-1, g.shape[-1])[self.order]  # (n, h): rows of W_x^T
+            first = torch.cat([torch.mm(g_s.t(), obs), w_k.t()], dim=1)
+            last = torch.bmm(g_q.transpose(1, 2), hidden).squeeze(1)  # (K, h'): row k from pass k
+            grads = [first, g_s.sum(0), *mid_grads, last, grad.sum(0)]
+        dparams = None
+        if inputs:  # pass k's d/d x_k, (K, B, m), to the all-actions vector
+            dparams = torch.bmm(g, w_blocks.transpose(1, 2)).transpose(0, 1).reshape(batch, -1)[:, self.order]
+        return grads, dparams

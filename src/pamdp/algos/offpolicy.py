@@ -175,8 +175,9 @@ ActFn = Callable[
     [torch.Tensor, int, np.ndarray, torch.Tensor | None], tuple[torch.Tensor, torch.Tensor, dict[str, np.ndarray]]
 ]
 # update() -> the figures it computed; an epoch's stats average each one over the updates that returned it, so a
-# figure computed every few updates (a delayed actor step, a representation round) is the mean of those steps.
-UpdateFn = Callable[[], dict[str, float]]
+# figure computed every few updates (a delayed actor step, a representation round) is the mean of those steps. A
+# figure may be a one-element tensor: the loop sums it on the tensor and reads it once an epoch.
+UpdateFn = Callable[[], dict[str, float | torch.Tensor]]
 
 
 def soft_updater(pairs: Sequence[tuple[nn.Module, nn.Module]]) -> Callable[[float], None]:
@@ -462,7 +463,7 @@ class OffPolicyLoop:
                             sums[k] = sums.get(k, 0.0) + v
                             reported[k] = reported.get(k, 0) + 1
                         n_updates += 1
-        stats = {k: v / reported[k] for k, v in sums.items()}
+        stats = {k: float(v) / reported[k] for k, v in sums.items()}  # tensors read once an epoch, not per update
         stats["train/updates"] = float(n_updates)
         stats["train/buffer_size"] = float(len(self.buffer))
         stats.update({f"train/action_freq_{k}": float(c) / n_valid for k, c in enumerate(counts)})

@@ -190,7 +190,7 @@ class PADDPG(EpsilonSchedule, Algorithm):
         """``Q'(s, mu'(s))``, the bootstrap of a truncated episode's Monte-Carlo return."""
         return self.critic_target(obs, self._masked(self.actor_target(obs).clamp(-1.0, 1.0), mask))
 
-    def _update(self) -> dict[str, float]:
+    def _update(self) -> dict[str, torch.Tensor]:
         """One critic step on the mixed target and one actor step along the bounded ``dQ/dmu``, back-propagated
         by hand through the :mod:`~pamdp.algos.dense` views of the networks."""
         cfg = self.config
@@ -219,9 +219,9 @@ class PADDPG(EpsilonSchedule, Algorithm):
                 dq_dp = torch.cat([dq_dp[:, :k] * b["mask"], dq_dp[:, k:]], dim=-1)
             apply_gradients(self.actor_optimizer, actor.backward(actor_cache, -dq_dp / batch)[0], cfg.grad_clip)
             self._soft_update(cfg.tau)
-        return {
-            "losses/critic_loss": float(error.square().mean()),
-            "losses/actor_loss": float(-q_mu.mean()),
-            "train/q_mean": float(q.mean()),
-            "train/outputs_out_of_bounds": float((out.abs() > 1.0).float().mean()),
+        return {  # tensors, read once an epoch by the loop
+            "losses/critic_loss": error.square().mean(),
+            "losses/actor_loss": -q_mu.mean(),
+            "train/q_mean": q.mean(),
+            "train/outputs_out_of_bounds": (out.abs() > 1.0).float().mean(),
         }

@@ -22,6 +22,9 @@ passes, pass ``k`` seeing ``x`` with every block but ``x_k`` zeroed, and reads `
 passes are one forward over a batch of ``B * K`` inputs. ``multi_pass = True`` selects it; everything else is
 shared.
 
+The update is back-propagated by hand (:mod:`pamdp.algos.dense`), which pays here
+(``benchmarks/update_speed.md``); ``tests/test_pdqn.py`` holds the autograd form it must equal.
+
 Exploration: epsilon-greedy over the discrete action, epsilon annealed linearly as in PADDPG (with
 ``explore_params``, the random action's parameters are drawn uniformly too, Xiong et al.'s random
 exploration), and Ornstein-Uhlenbeck noise on the parameters (``ou_theta = 1`` makes it i.i.d. Gaussian).
@@ -39,13 +42,14 @@ import torch.nn.functional as F
 from torch import nn
 
 from pamdp.algos.base import Algorithm
+from pamdp.algos.dense import Dense, MultiPassDense
 from pamdp.algos.offpolicy import (
     DeterministicActorConfig,
     EpsilonSchedule,
     OffPolicyConfig,
     OffPolicyLoop,
     OUNoise,
-    backprop_actor,
+    bounded,
     learning_starts_setting,
     mixed_target,
     shared_setting,
@@ -53,7 +57,7 @@ from pamdp.algos.offpolicy import (
     tau_setting,
     uniform_actions,
 )
-from pamdp.algos.optim import apply_gradients, descend
+from pamdp.algos.optim import apply_gradients
 from pamdp.algos.settings import (
     POSITIVE,
     AlgoConfig,
@@ -206,7 +210,10 @@ class QNetwork(nn.Module):
     blocks, so their input rows (``B * K`` of width ``d + sum_a m_a``) are never built: the first layer's
     pre-activation of pass ``k`` is ``W_s s + W_k x_k + b``, one ``(B, h)`` product for the state plus each
     action's own block, and the output layer computes only ``Q_k`` of pass ``k``. That is the same function at
-    ``K`` times fewer operations in the first and last layers (it was quadratic in ``K``).
+    ``K`` times fewer operations in the first and last layers (it was quadratic in ``K``). The passes are one flat
+    batch of ``K * B`` rows, pass ``k``'s a contiguous block (:class:`~pamdp.algos.dense.MultiPassDense`, which
+    also differentiates them by hand for the update; a strided ``(B, K, h)`` layout made every element-wise op and
+    its backward walk memory slowly).
     """
 
     def __init__(self, obs_dim: int, hybrid: HybridActionSpace, hidden_sizes, activation: str, multi_pass: bool):
@@ -214,8 +221,12 @@ class QNetwork(nn.Module):
         self.n_actions = hybrid.n_actions
         self.multi_pass = multi_pass
         self.net = mlp(obs_dim + hybrid.total_param_size, hidden_sizes, hybrid.n_actions, activation)
-        self.register_buffer("param_index", torch.tensor(hybrid.param_index, dtype=torch.long), persistent=False)
-        self.register_buffer("param_mask", torch.tensor(hybrid.param_mask, dtype=torch.float32), persistent=False)
+        index = torch.tensor(hybrid.param_index, dtype=torch.long)
+        mask = torch.tensor(hybrid.param_mask, dtype=torch.float32)
+        self.obs_dim = obs_dim
+        self.register_buffer("param_index", index, persistent=False)
+        self.register_buffer("param_mask", mask, persistent=False)
+        self.register_buffer("param_order", MultiPassDense.block_order(index, mask), persistent=False)
 
     def forward(self, obs: torch.Tensor, params: torch.Tensor) -> torch.Tensor:
         if not self.multi_pass:
@@ -223,12 +234,27 @@ class QNetwork(nn.Module):
         return in_chunks(self._passes, self.n_actions, obs, params)
 
     def _passes(self, obs: torch.Tensor, params: torch.Tensor) -> torch.Tensor:
-        first, last, d = self.net[0], self.net[-1], obs.shape[-1]
-        w_blocks = first.weight[:, d:][:, self.param_index] * self.param_mask  # (h, K, m): W_k
-        pre = F.linear(obs, first.weight[:, :d], first.bias).unsqueeze(1)  # (B, 1, h): W_s s + b
-        pre = pre + torch.einsum("bkm,hkm->bkh", params[:, self.param_index], w_blocks)
-        hidden = self.net[1:-1](pre)  # (B, K, h') of pass k
-        return (hidden * last.weight).sum(-1) + last.bias  # Q_k of pass k
+        return self.forward_cached(obs, params)[0]
+
+    def forward_cached(self, obs: torch.Tensor, params: torch.Tensor) -> tuple[torch.Tensor, tuple]:
+        """The ``(B, K)`` values by the hand-written passes of :mod:`pamdp.algos.dense` (differentiable by autograd
+        too), with what :meth:`backward` needs."""
+        if not self.multi_pass:
+            net = Dense.of(self.net)
+            q, cache = net.forward_cached(torch.cat([obs, params], dim=-1))
+        else:
+            net = MultiPassDense.of(self.net, self.obs_dim, self.param_index, self.param_mask, self.param_order)
+            q, cache = net.forward_cached(obs, params)
+        return q, (net, cache)
+
+    def backward(self, cached: tuple, grad: torch.Tensor, weights: bool = True) -> list[torch.Tensor] | torch.Tensor:
+        """From :meth:`forward_cached`'s cache and d loss / d Q ``(B, K)``: the gradients in the order of
+        ``parameters()`` if ``weights``, else d loss / d params ``(B, sum_a m_a)``."""
+        net, cache = cached
+        if weights:
+            return net.backward(cache, grad)[0]
+        d_in = net.backward(cache, grad, weights=False, inputs=True)[1]
+        return d_in if self.multi_pass else d_in[:, self.obs_dim :]
 
     def _load_from_state_dict(self, state_dict, prefix, *args, **kwargs):
         state_dict.pop(prefix + "blocks", None)  # models saved before the block table was dropped hold it
@@ -251,11 +277,9 @@ class PDQN(EpsilonSchedule, Algorithm):
         self.q_net = QNetwork(self.obs_dim, h, cfg.hidden_sizes, cfg.activation, cfg.multi_pass)
         self.actor_target = copy.deepcopy(self.actor).requires_grad_(False)
         self.q_target = copy.deepcopy(self.q_net).requires_grad_(False)
-        self._actor_params, self._q_params = list(self.actor.parameters()), list(self.q_net.parameters())
-        self.actor_optimizer = torch.optim.Adam(self._actor_params, lr=cfg.actor_lr, fused=True)
-        self.q_optimizer = torch.optim.Adam(self._q_params, lr=cfg.q_lr, fused=True)
-        self._soft_update_q = soft_updater([(self.q_target, self.q_net)])
-        self._soft_update_actor = soft_updater([(self.actor_target, self.actor)])
+        self.actor_optimizer = torch.optim.Adam(self.actor.parameters(), lr=cfg.actor_lr, fused=True)
+        self.q_optimizer = torch.optim.Adam(self.q_net.parameters(), lr=cfg.q_lr, fused=True)
+        self._bind_networks()
         self.blocks = torch.as_tensor(param_blocks(h), device=self.device)
         self.loop = OffPolicyLoop(
             self,
@@ -300,27 +324,44 @@ class PDQN(EpsilonSchedule, Algorithm):
         return masked_logits(self.q_target(obs, self.actor_target(obs).clamp(-1.0, 1.0)), mask).max(-1).values
 
     # -- learning --------------------------------------------------------------------------------
-    def _update(self) -> dict[str, float]:
-        """One TD step of the Q-network, one actor step along the bounded ``d sum_k Q_k / dx``, soft target updates."""
+    def _bind_networks(self) -> None:
+        """The actor's hand-written passes (:mod:`pamdp.algos.dense`) over its own tensors, and the soft updates;
+        called again by whoever replaces a module."""
+        self._dense_actor = Dense.of(self.actor.net)
+        self._soft_update_q = soft_updater([(self.q_target, self.q_net)])
+        self._soft_update_actor = soft_updater([(self.actor_target, self.actor)])
+
+    def _update(self) -> dict[str, torch.Tensor]:
+        """One TD step of the Q-network, one actor step along the bounded ``d sum_k Q_k / dx``, soft target updates;
+        back-propagated by hand through the :mod:`~pamdp.algos.dense` views of the networks. The figures stay
+        tensors, read once an epoch."""
         cfg = self.config
         b = self.replay.sample(cfg.batch_size, self.np_rng)
-        obs, next_obs = b["obs"], b["next_obs"]
+        obs, next_obs, batch = b["obs"], b["next_obs"], len(b["obs"])
         with torch.no_grad():
             q_next = self._next_value(next_obs, b.get("next_mask"))
             y = b["reward"] + cfg.gamma * (~b["terminated"]).float() * q_next
             if cfg.beta > 0:
                 y = mixed_target(y, b["mc"], cfg.beta)
-        q = self.q_net(obs, b["params"]).gather(1, b["a"][:, None]).squeeze(1)
-        q_loss = F.mse_loss(q, y)
-        descend(self.q_optimizer, q_loss, self._q_params, cfg.grad_clip)
-        x, q_x, grads = backprop_actor(self.actor, self.q_net, obs, cfg.bound, self._actor_params)
-        apply_gradients(self.actor_optimizer, grads, cfg.grad_clip)
-
-        self._soft_update_q(cfg.tau_q)
-        self._soft_update_actor(cfg.tau_actor)
+            # Q: descend on mean (Q_a - y)^2, the gradient reaching Q_a of the replayed action only
+            q_all, cache = self.q_net.forward_cached(obs, b["params"])
+            a = b["a"][:, None]
+            error = q_all.gather(1, a).squeeze(1) - y
+            grad = torch.zeros_like(q_all).scatter_(1, a, (error * (2.0 / batch)).unsqueeze(1))
+            apply_gradients(self.q_optimizer, self.q_net.backward(cache, grad), cfg.grad_clip)
+            # actor: ascend on sum_k Q_k(s, x(s)) with Q just updated, dQ/dx edited at the bounds
+            x, actor_cache = self._dense_actor.forward_cached(obs)
+            if self.actor.passthrough_weight is not None:
+                x = x + F.linear(obs, self.actor.passthrough_weight, self.actor.passthrough_bias)
+            q_x, cache = self.q_net.forward_cached(obs, x)
+            dq_dx = bounded(self.q_net.backward(cache, torch.ones_like(q_x), weights=False), x, cfg.bound)
+            grads = self._dense_actor.backward(actor_cache, -dq_dx / batch)[0]
+            apply_gradients(self.actor_optimizer, grads, cfg.grad_clip)
+            self._soft_update_q(cfg.tau_q)
+            self._soft_update_actor(cfg.tau_actor)
         return {
-            "losses/critic_loss": float(q_loss.detach()),
-            "losses/actor_loss": float(-q_x.sum(-1).mean()),
-            "train/q_mean": float(q.detach().mean()),
-            "train/outputs_out_of_bounds": float((x.abs() > 1.0).float().mean()),
+            "losses/critic_loss": error.square().mean(),
+            "losses/actor_loss": -q_x.sum(-1).mean(),
+            "train/q_mean": q_all.gather(1, a).mean(),
+            "train/outputs_out_of_bounds": (x.abs() > 1.0).float().mean(),
         }
