@@ -18,7 +18,7 @@
 #   suite:  Hybrid SAC tuned 0.4-2 ms (7-33 min per 1M), P-DQN hard_move_large 3.5-6 ms (1-1.7 h per 1M),
 #           MP-DQN hard_move 10.6 ms (n = 4) and 33 ms (n = 6): 3 and 9 h per 1M          ~45 core-hours
 #   HFO:    PAPPO 0.46 ms (~40 min a run)
-#   goalie: PATRPO on HFO 1v1, 0.12 ms a sample alone on a core (20M samples a seed: ~40 min; 3 arms x 3 seeds)
+#   goalie: PATRPO, 1v0 stage 5M (0.25 ms a sample, ~21 min) then HFO 1v1 (0.12 ms a sample, 15M: ~30 min) a seed
 set -euo pipefail
 cd "$(dirname "$0")"
 RUNS=${PAMDP_RUNS:-$HOME/pamdp-runs}
