@@ -71,7 +71,7 @@ class Dim:
 
     def describe(self) -> str:
         if self.kind == "choice":
-            return ", ".join(_label(c) for c in self.choices)
+            return ", ".join(str(_label(c)) for c in self.choices)
         scale = "log-uniform" if self.kind == "log" or self.log else "uniform"
         kind = "integers" if self.kind == "int" else scale
         return f"{self.low:g} to {self.high:g} ({kind}{', log-spaced' if self.kind == 'int' and self.log else ''})"
@@ -255,7 +255,7 @@ class Search:
             raise ValueError(f"pruner = {self.pruner!r}; expected one of {', '.join(PRUNERS)}")
         base = self.base().config
         check_space(self.algo, base)
-        least = max(_largest_epoch(self.algo, base), getattr(base, "learning_starts", 0) + _epoch_size(base))
+        least = getattr(base, "learning_starts", 0) + _largest_epoch(self.algo, base)
         if self.steps_per_trial < least:
             raise ValueError(
                 f"steps per trial = {self.steps_per_trial:,} is too few to train and evaluate; expected at least "
