@@ -20,7 +20,7 @@ STEPS = 2048
 
 
 @pytest.fixture
-def tiny(monkeypatch, tmp_path):
+def tiny(tmp_path):
     """A PAPPO search on Catch Point whose trials train a few epochs of 512 or 1024 samples."""
     space = {
         "lr": log_uniform(1e-4, 1e-3, "step"),
@@ -28,9 +28,8 @@ def tiny(monkeypatch, tmp_path):
         "minibatch_size": choice((128, 256), "samples per step"),
         "hidden_sizes": choice(((16,), (32, 32)), "layers"),
     }
-    monkeypatch.setitem(SEARCH_SPACES, "pappo", space)
     search = Search("pappo", ENV, 2, STEPS, f"sqlite:///{tmp_path / 'study.db'}", "tiny", pruner="none")
-    return tuning.dataclasses.replace(search, eval_episodes=5)
+    return tuning.dataclasses.replace(search, eval_episodes=5, space=space)
 
 
 class _AlwaysPrune(optuna.pruners.BasePruner):
@@ -64,6 +63,13 @@ def test_a_stopped_search_resumes_to_its_total_keeping_the_finished_trials(tiny)
     assert trials[2].state == TrialState.FAIL and trials[2].user_attrs["killed"]
     assert [t.state for t in trials[3:]] == [TrialState.COMPLETE]
     assert trials[3].params != trials[0].params and trials[3].params != trials[1].params  # new draws, not the first's
+
+
+def test_workers_share_the_storage_and_start_exactly_the_trials_asked(tiny):
+    study = tuning.tune(tuning.dataclasses.replace(tiny, n_trials=3), workers=2, log=lambda m: None)
+    trials = study.get_trials()
+    assert [t.state for t in trials] == [TrialState.COMPLETE] * 3
+    assert tuning.os.getpid() not in {t.user_attrs["pid"] for t in trials}  # each in a worker process
 
 
 def test_a_study_is_resumed_only_with_its_own_terms(tiny):
@@ -117,10 +123,9 @@ def test_without_optuna_tune_fails_at_once_naming_the_extra(monkeypatch, capsys)
 def test_every_search_space_is_valid_over_every_preset_of_its_algorithm(algo):
     config_class = algorithm_class(algo).config_class
     for config in config_class.presets().values():
-        check_space(algo, config)
+        check_space(SEARCH_SPACES[algo], config)
 
 
-def test_a_range_the_config_refuses_is_named(monkeypatch):
-    monkeypatch.setitem(SEARCH_SPACES, "pappo", {"gamma": tuning.uniform(0.9, 1.5, "too far")})
+def test_a_range_the_config_refuses_is_named():
     with pytest.raises(ValueError, match=r"gamma = 1.5; expected a number in \[0, 1\]"):
-        check_space("pappo", algorithm_class("pappo").config_class())
+        check_space({"gamma": tuning.uniform(0.9, 1.5, "too far")}, algorithm_class("pappo").config_class())

@@ -105,6 +105,10 @@ _REPLAY_BATCH = choice((32, 64, 128, 256), "transitions per gradient update")
 _TAU = log_uniform(1e-3, 5e-2, "target networks' step towards the learned ones")
 _CRITIC_LR = log_uniform(1e-4, 3e-3, "the critic's Adam step")
 _ACTOR_LR = log_uniform(1e-6, 1e-3, "the actor's Adam step; the papers' are small, 1e-5")
+# TD3's and SAC's usual ranges (HyAR and Hybrid SAC)
+_TD3_SAC_ACTOR_LR = log_uniform(1e-4, 1e-3, "the actor's Adam step")
+_TD3_SAC_CRITIC_LR = log_uniform(1e-4, 1e-3, "the critics' Adam step")
+_TD3_SAC_TAU = log_uniform(1e-3, 2e-2, "target networks' step towards the learned ones")
 _Q_NETS = choice(((64,), (128,), (128, 128), (256, 256)), "the Q-network's and actor's hidden layers")
 
 SEARCH_SPACES: dict[str, dict[str, Dim]] = {
@@ -171,24 +175,24 @@ SEARCH_SPACES: dict[str, dict[str, Dim]] = {
         "multi_pass": choice((False, True), "MP-DQN's one pass per action (Bester et al.)"),
     },
     "hyar": {
-        "actor_lr": log_uniform(1e-4, 1e-3, "the actor's Adam step"),
-        "critic_lr": log_uniform(1e-4, 1e-3, "the critics' Adam step"),
+        "actor_lr": _TD3_SAC_ACTOR_LR,
+        "critic_lr": _TD3_SAC_CRITIC_LR,
         "vae_lr": log_uniform(3e-5, 1e-3, "the action representation's Adam step"),
         "batch_size": _REPLAY_BATCH,
         "gamma": _GAMMA,
-        "tau": log_uniform(1e-3, 2e-2, "target networks' step towards the learned ones"),
+        "tau": _TD3_SAC_TAU,
         "hidden_sizes": choice(((128, 128), (256, 256)), "the actor's and critics' hidden layers"),
         "latent_dim": integers(2, 12, "size of the parameters' latent code"),
         "exploration_noise": uniform(0.05, 0.3, "Gaussian noise on the latent action when acting"),
         "policy_delay": integers(1, 3, "critic updates per actor update (TD3)"),
     },
     "hsac": {
-        "actor_lr": log_uniform(1e-4, 1e-3, "the actor's Adam step"),
-        "critic_lr": log_uniform(1e-4, 1e-3, "the critics' Adam step"),
+        "actor_lr": _TD3_SAC_ACTOR_LR,
+        "critic_lr": _TD3_SAC_CRITIC_LR,
         "alpha_lr": log_uniform(1e-4, 1e-3, "the temperatures' Adam step"),
         "batch_size": _REPLAY_BATCH,
         "gamma": _GAMMA,
-        "tau": log_uniform(1e-3, 2e-2, "target networks' step towards the learned ones"),
+        "tau": _TD3_SAC_TAU,
         "hidden_sizes": choice(((64, 64), (128, 128), (256, 256)), "the networks' hidden layers"),
         "init_alpha_d": log_uniform(0.01, 1.0, "the discrete policy's initial temperature"),
         "init_alpha_c": log_uniform(0.01, 1.0, "the parameters' initial temperature"),
@@ -200,16 +204,15 @@ SEARCH_SPACES: dict[str, dict[str, Dim]] = {
 """Algorithm -> setting -> its range. Each range is one the config accepts at both ends (:func:`check_space`)."""
 
 
-def check_space(algo: str, base) -> None:
+def check_space(space: dict[str, Dim], base) -> None:
     """Refuse a search space with a value ``base`` (a config) does not accept: each end of each range alone, and all
     the low ends and all the high ends together (a check across settings, minibatch against batch size)."""
-    space = SEARCH_SPACES[algo]
     corners = [{name: dim.extremes()[i] for name, dim in space.items()} for i in (0, -1)]
     for values in [*({name: v} for name, dim in space.items() for v in dim.extremes()), *corners]:
         try:
             type(base).from_dict(values, base=base)
         except ValueError as exc:
-            raise ValueError(f"the search space of {algo} holds a value its config refuses: {exc}") from None
+            raise ValueError(f"the search space holds a value {type(base).__name__} refuses: {exc}") from None
 
 
 def _epoch_size(config) -> int:
@@ -217,10 +220,10 @@ def _epoch_size(config) -> int:
     return int(getattr(config, "epoch_steps", None) or config.batch_size)
 
 
-def _largest_epoch(algo: str, base) -> int:
-    """The largest epoch a trial of ``algo`` over ``base`` may have: a trial's budget must hold one to evaluate."""
+def _largest_epoch(space: dict[str, Dim], base) -> int:
+    """The largest epoch a trial over ``base`` may have: a trial's budget must hold one to evaluate."""
     name = "epoch_steps" if hasattr(base, "epoch_steps") else "batch_size"
-    dim = SEARCH_SPACES[algo].get(name)
+    dim = space.get(name)
     return int(max(dim.extremes())) if dim is not None else _epoch_size(base)
 
 
@@ -238,6 +241,12 @@ class Search:
     preset: str | None = None
     pruner: str = "median"
     eval_episodes: int = 100
+    space: dict[str, Dim] | None = None
+    """The settings searched and their ranges (``None``: the algorithm's, :data:`SEARCH_SPACES`)."""
+
+    @property
+    def dims(self) -> dict[str, Dim]:
+        return SEARCH_SPACES[self.algo] if self.space is None else self.space
 
     def base(self):
         """The resolved :class:`~pamdp.experiments.runner.RunConfig` every trial's settings go over."""
@@ -254,8 +263,8 @@ class Search:
         if self.pruner not in PRUNERS:
             raise ValueError(f"pruner = {self.pruner!r}; expected one of {', '.join(PRUNERS)}")
         base = self.base().config
-        check_space(self.algo, base)
-        least = getattr(base, "learning_starts", 0) + _largest_epoch(self.algo, base)
+        check_space(self.dims, base)
+        least = getattr(base, "learning_starts", 0) + _largest_epoch(self.dims, base)
         if self.steps_per_trial < least:
             raise ValueError(
                 f"steps per trial = {self.steps_per_trial:,} is too few to train and evaluate; expected at least "
@@ -373,7 +382,7 @@ def _run_trial(trial, search: Search) -> float:
 
     from pamdp.evaluation import evaluate
 
-    settings = {name: dim.suggest(trial, name) for name, dim in SEARCH_SPACES[search.algo].items()}
+    settings = {name: dim.suggest(trial, name) for name, dim in search.dims.items()}
     trial.set_user_attr("settings", {k: list(v) if isinstance(v, tuple) else v for k, v in settings.items()})
     cls, _, config, _ = search.trial_spec(settings).check()
     model = cls(search.env, config)
