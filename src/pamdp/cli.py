@@ -286,19 +286,18 @@ def build_parser() -> argparse.ArgumentParser:
     tu = sub.add_parser("tune", help="search an algorithm's settings on an env with Optuna; write the best as a preset")
     tu.add_argument("algo", metavar="ALGO", choices=names, help=", ".join(names))
     tu.add_argument("--env", default="pamdp/Platform-v0", help="registered env id (default: %(default)s)")
-    tu.add_argument("--trials", type=_positive_int, default=20, help="trials in all, earlier sessions' included")
-    tu.add_argument(
-        "--steps-per-trial", type=_integer(1, MAX_STEPS, "a number of steps"), default=200_000, help="a trial's budget"
-    )
+    tu.add_argument("--trials", type=_positive_int, default=20, metavar="N", help="in all, a resumed study's included")
+    steps = _integer(1, MAX_STEPS, "a number of steps")
+    tu.add_argument("--steps-per-trial", type=steps, default=200_000, metavar="S", help="a trial's budget (200,000)")
     where = tu.add_mutually_exclusive_group()
-    where.add_argument("--study-dir", default=None, help="directory of the SQLite study (default: tune/ALGO-ENVNAME)")
-    where.add_argument("--storage", default=None, help="an Optuna storage URL instead, e.g. sqlite:///study.db")
-    tu.add_argument("--workers", type=_positive_int, default=1, help="trials side by side in processes")
+    where.add_argument("--study-dir", metavar="DIR", help="directory of the SQLite study (default: tune/ALGO-ENVNAME)")
+    where.add_argument("--storage", metavar="URL", help="an Optuna storage URL instead, e.g. sqlite:///study.db")
+    tu.add_argument("--workers", type=_positive_int, default=1, metavar="W", help="trials side by side in processes")
     tu.add_argument("--seed", type=_seed, default=0, help="the sampler's seed and every trial's (default: 0)")
-    tu.add_argument("--pruner", choices=["median", "hyperband", "none"], default="median")
+    tu.add_argument("--pruner", choices=["median", "hyperband", "none"], default="median", help="(default: median)")
     tu.add_argument("--preset", default=None, help="the settings the search goes over (default: the env's, as train)")
     tu.add_argument("--eval-episodes", type=_positive_int, default=100, help="greedy episodes of each evaluation")
-    tu.add_argument("--out", default=None, help="the best settings as a TOML preset (default: DIR/best.toml)")
+    tu.add_argument("--out", metavar="FILE", help="the best settings as a TOML preset (default: DIR/best.toml)")
     return parser
 
 
