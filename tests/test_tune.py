@@ -60,7 +60,7 @@ def test_a_stopped_search_resumes_to_its_total_keeping_the_finished_trials(tiny)
     study = tuning.tune(tuning.dataclasses.replace(tiny, n_trials=3), log=lambda m: None)
     trials = study.get_trials()
     assert [(t.params, t.value, t.user_attrs) for t in trials[:2]] == [(t.params, t.value, t.user_attrs) for t in first]
-    assert trials[2].state == TrialState.FAIL and trials[2].user_attrs["killed"]
+    assert trials[2].state == TrialState.FAIL and "error" not in trials[2].user_attrs  # killed, not counted
     assert [t.state for t in trials[3:]] == [TrialState.COMPLETE]
     assert trials[3].params != trials[0].params and trials[3].params != trials[1].params  # new draws, not the first's
 

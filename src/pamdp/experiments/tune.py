@@ -360,8 +360,7 @@ def _fail_dead_trials(study) -> None:
 
     for t in study.get_trials(deepcopy=False, states=(TrialState.RUNNING,)):
         if t.user_attrs.get("host") == socket.gethostname() and not _alive(t.user_attrs.get("pid", -1)):
-            study._storage.set_trial_user_attr(t._trial_id, "killed", True)
-            study._storage.set_trial_state_values(t._trial_id, TrialState.FAIL)
+            study.tell(t.number, state=TrialState.FAIL)  # without the "error" a failure of its own records
 
 
 def _counted(study) -> int:
@@ -372,7 +371,7 @@ def _counted(study) -> int:
     return sum(
         1
         for t in study.get_trials(deepcopy=False)
-        if t.state != TrialState.WAITING and not (t.state == TrialState.FAIL and t.user_attrs.get("killed"))
+        if t.state != TrialState.WAITING and (t.state != TrialState.FAIL or "error" in t.user_attrs)
     )
 
 
