@@ -394,7 +394,8 @@ def _run_trial(trial, search: Search) -> float:
         reports[0] += 1
         trial.report(stats.get("eval/success_rate", stats["eval/mean_return"]), reports[0])
         trial.set_user_attr("steps", model.num_timesteps)
-        pruned[0] = trial.should_prune()
+        # a trial past its budget is scored, whatever its last evaluation: its training is done
+        pruned[0] = model.num_timesteps < search.steps_per_trial and trial.should_prune()
         return not pruned[0]
 
     cpu = time.process_time()
