@@ -6,9 +6,10 @@
 Runs the search of ``pamdp tune ALGO --env pamdp/CatchPoint-v0`` (trials of ``--steps`` samples, trained with seed 0,
 the median pruner) in DIR/tune (resumed if it is there), then trains the best settings and the env's hand-found
 preset (PATRPO's ``catch_point``: benchmarks/catch_point.md) for the same ``--steps`` on the held-out ``--seeds``,
-one run at a time, each resuming from its checkpoint, and writes benchmarks/tune_catch_point.md: the search's
-figures, the settings it found and, per arm, each seed's greedy success rate over 1000 episodes and the CPU time.
-``--record-only`` trains nothing and writes the record from what DIR holds. The record keeps its hand-written notes.
+one run at a time, seed by seed across the two arms, each resuming from its checkpoint. After every run it writes
+benchmarks/tune_catch_point.md: the search's figures, the settings it found and, per arm, each seed's greedy success
+rate over 1000 episodes and the CPU time. ``--record-only`` trains nothing and writes the record from what DIR
+holds. The record keeps its hand-written notes.
 """
 
 from __future__ import annotations
@@ -114,9 +115,10 @@ def main() -> None:
         study = tune(search)
         wall = time.time() - start
     info = write_preset(study, f"{args.out}/tune/best.toml")
-    if not args.record_only:
-        for label, settings in arms(info).items():
-            run_all(arm_specs(args, info, label, settings), workers=1)
+    if not args.record_only:  # seed by seed across the arms, so that a cut-short invocation compares like with like
+        per_arm = [arm_specs(args, info, label, settings) for label, settings in arms(info).items()]
+        for job in [job for seed_jobs in zip(*per_arm) for job in seed_jobs]:
+            run_all([job], workers=1)
             write_record(record(args, info, wall), RECORD)
     write_record(record(args, info, wall), RECORD)
 
