@@ -18,7 +18,6 @@ import argparse
 import json
 import statistics
 import sys
-import time
 from pathlib import Path
 
 from _record import HERE, progress_rows, record_head, write_record
@@ -49,20 +48,26 @@ def _cpu_minutes(run: Path) -> float:
     return sum(epoch_seconds(r) for r in progress_rows(run)) / 60
 
 
-def record(args, info: dict, search_wall: float | None) -> list[str]:
+def _span(study) -> str:
+    """When the search's trials ran, first start to last end, over every invocation that ran some."""
+    trials = [t for t in study.get_trials(deepcopy=False) if t.datetime_complete is not None]
+    start, end = min(t.datetime_start for t in trials), max(t.datetime_complete for t in trials)
+    return f"{start:%Y-%m-%d %H:%M} to {end:%H:%M} ({(end - start).total_seconds() / 60:.0f} min of wall time)"
+
+
+def record(args, info: dict, study) -> list[str]:
     command = " ".join(["python benchmarks/bench_tune.py", *sys.argv[1:]])
     lines = record_head(f"pamdp tune {args.algo} on Catch Point against the hand-found preset", command)
     lines += [
         f"- search: `pamdp tune {args.algo} --env {ENV} --trials {args.trials} --steps-per-trial {args.steps} "
         f"--study-dir {args.out}/tune` (seed 0, median pruner, 100 greedy episodes per evaluation, "
         f"{info['trials']} trials: {info['complete']} complete, {info['pruned']} pruned, {info['failed']} failed); "
-        f"CPU time of its trials {info['cpu_seconds'] / 60:.1f} min"
-        + (f", wall time {search_wall / 60:.1f} min this invocation" if search_wall else ""),
+        f"CPU time of its trials {info['cpu_seconds'] / 60:.1f} min" + f", its trials from {_span(study)}",
         f"- best trial {info['best_trial']}: {info['objective']} {info['best_value']:.3f} (100 greedy episodes, "
         "training seed 0); the arms below train on held-out seeds and evaluate 1000 greedy episodes each",
         f"- comparison: `pamdp train {args.algo} --env {ENV} --preset {info['preset']} --seed N --total-steps "
-        f"{args.steps} [--config {args.out}/tune/best.toml]`, one run at a time at `nice -n 15` beside another long "
-        "run on a 2-core machine",
+        f"{args.steps} [--config {args.out}/tune/best.toml]`, one run at a time at `nice -n 15` beside other long "
+        "runs on a 2-core machine (the search's trials too)",
         "",
         f"| setting | {info['preset']} (hand-found) | found by the search |",
         "|---|---|---|",
@@ -107,20 +112,14 @@ def main() -> None:
     args = parser.parse_args()
     name = f"{args.algo}-CatchPoint-v0"
     search = Search(args.algo, ENV, args.trials, args.steps, f"sqlite:///{args.out}/tune/study.db", name)
-    wall = None
-    if args.record_only:
-        study = load_study(search)
-    else:
-        start = time.time()
-        study = tune(search)
-        wall = time.time() - start
+    study = load_study(search) if args.record_only else tune(search)
     info = write_preset(study, f"{args.out}/tune/best.toml")
     if not args.record_only:  # seed by seed across the arms, so that a cut-short invocation compares like with like
         per_arm = [arm_specs(args, info, label, settings) for label, settings in arms(info).items()]
         for job in [job for seed_jobs in zip(*per_arm) for job in seed_jobs]:
             run_all([job], workers=1)
-            write_record(record(args, info, wall), RECORD)
-    write_record(record(args, info, wall), RECORD)
+            write_record(record(args, info, study), RECORD)
+    write_record(record(args, info, study), RECORD)
 
 
 if __name__ == "__main__":
