@@ -104,7 +104,7 @@ _INIT_LOG_STD = uniform(-2.0, 0.0, "initial parameter noise: Catch Point wants i
 _REPLAY_BATCH = choice((32, 64, 128, 256), "transitions per gradient update")
 _TAU = log_uniform(1e-3, 5e-2, "target networks' step towards the learned ones")
 _CRITIC_LR = log_uniform(1e-4, 3e-3, "the critic's Adam step")
-_ACTOR_LR = log_uniform(1e-6, 1e-3, "the actor's Adam step; the papers' are small, 1e-5")
+_ACTOR_LR = log_uniform(1e-6, 1e-3, "the actor's Adam step; the papers' are small")
 # TD3's and SAC's usual ranges (HyAR and Hybrid SAC)
 _TD3_SAC_ACTOR_LR = log_uniform(1e-4, 1e-3, "the actor's Adam step")
 _TD3_SAC_CRITIC_LR = log_uniform(1e-4, 1e-3, "the critics' Adam step")
@@ -132,7 +132,7 @@ SEARCH_SPACES: dict[str, dict[str, Dim]] = {
         "minibatch_size": choice((64, 128, 256, 512), "samples per gradient step (at most the smallest batch)"),
         "n_epochs": integers(3, 15, "passes over each batch"),
         "clip_range": uniform(0.1, 0.3, "PPO's clip of the probability ratio"),
-        "ent_coef_d": log_uniform(1e-3, 0.5, "the discrete policy's entropy bonus (the tuned preset's: 0.3)"),
+        "ent_coef_d": log_uniform(1e-3, 0.5, "the discrete policy's entropy bonus, against early collapse"),
         "ent_coef_c": uniform(0.0, 0.01, "the parameters' entropy bonus"),
         "hidden_sizes": _POLICY_NETS,
         "init_log_std": _INIT_LOG_STD,
@@ -167,7 +167,7 @@ SEARCH_SPACES: dict[str, dict[str, Dim]] = {
         "actor_lr": log_uniform(1e-5, 1e-3, "the parameter network's Adam step"),
         "batch_size": _REPLAY_BATCH,
         "gamma": _GAMMA,
-        "tau_q": log_uniform(1e-2, 0.5, "the Q-network's target step (the paper's: 0.1)"),
+        "tau_q": log_uniform(1e-2, 0.5, "the Q-network's target step (P-DQN's is large)"),
         "tau_actor": log_uniform(1e-4, 1e-2, "the parameter network's target step"),
         "hidden_sizes": _Q_NETS,
         "epsilon_end": uniform(0.0, 0.1, "final chance of a random discrete action"),
