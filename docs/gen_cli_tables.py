@@ -1,7 +1,8 @@
 """Regenerate the tables of the docs that restate code: the commands (from the parser of ``pamdp``), each
 algorithm's command-line name, default budget and presets (from :data:`pamdp.algos.ALGORITHMS` and
 :mod:`pamdp.presets`: the configs' own, then the envs'), the experiments of ``pamdp reproduce`` (from their files)
-in ``docs/cli.md``, and the registered env ids in ``docs/environments.md``.
+in ``docs/cli.md``, the registered env ids in ``docs/environments.md``, and the search space of each algorithm
+(from :data:`pamdp.experiments.tune.SEARCH_SPACES`) in ``docs/tune.md``.
 
 Each table sits between ``<!-- cli:NAME start -->`` and ``<!-- cli:NAME end -->``; everything between the
 markers is replaced.
@@ -21,7 +22,7 @@ from pathlib import Path
 from pamdp.algos import ALGORITHMS, algorithm_class
 from pamdp.presets import default_preset, preset_names
 
-DOCS = [Path(__file__).with_name("cli.md"), Path(__file__).with_name("environments.md")]
+DOCS = [Path(__file__).with_name(name) for name in ("cli.md", "environments.md", "tune.md")]
 BLOCK = re.compile(r"(<!-- cli:([\w-]+) start -->\n)(.*?)(<!-- cli:\2 end -->)", re.DOTALL)
 
 
@@ -110,11 +111,22 @@ def envs_table() -> str:
     return "\n".join(rows) + "\n"
 
 
+def search_spaces_table() -> str:
+    """What ``pamdp tune ALGO`` searches: each algorithm's settings, their ranges and why."""
+    from pamdp.experiments.tune import SEARCH_SPACES
+
+    rows = ["| `ALGO` | setting | range | why |", "|---|---|---|---|"]
+    for algo, space in SEARCH_SPACES.items():
+        rows += [f"| `{algo}` | `{name}` | {dim.describe()} | {dim.note} |" for name, dim in space.items()]
+    return "\n".join(rows) + "\n"
+
+
 TABLES = {
     "commands": commands_block,
     "algorithms": algorithms_table,
     "experiments": experiments_table,
     "envs": envs_table,
+    "search-spaces": search_spaces_table,
 }
 
 

@@ -310,6 +310,22 @@ def build_parser() -> argparse.ArgumentParser:
     rd.add_argument("source", help="run directory, model file, or a registered env id (random actions)")
     rd.add_argument("--out", default="episode.gif", help="GIF path (default: %(default)s)")
     rd.add_argument("--seed", type=_seed, default=0, help="env seed (default: %(default)s)")
+
+    tu = sub.add_parser("tune", help="search an algorithm's settings on an env with Optuna; write the best as a preset")
+    tu.add_argument("algo", metavar="ALGO", choices=names, help=", ".join(names))
+    tu.add_argument("--env", default="pamdp/Platform-v0", help="registered env id (default: %(default)s)")
+    tu.add_argument("--trials", type=_positive_int, default=20, metavar="N", help="in all, a resumed study's included")
+    steps = _integer(1, MAX_STEPS, "a number of steps")
+    tu.add_argument("--steps-per-trial", type=steps, default=200_000, metavar="S", help="a trial's budget (200,000)")
+    where = tu.add_mutually_exclusive_group()
+    where.add_argument("--study-dir", metavar="DIR", help="directory of the SQLite study (default: tune/ALGO-ENVNAME)")
+    where.add_argument("--storage", metavar="URL", help="an Optuna storage URL instead, e.g. sqlite:///study.db")
+    tu.add_argument("--workers", type=_positive_int, default=1, metavar="W", help="trials side by side in processes")
+    tu.add_argument("--seed", type=_seed, default=0, help="the sampler's seed and every trial's (default: 0)")
+    tu.add_argument("--pruner", choices=["median", "hyperband", "none"], default="median", help="(default: median)")
+    tu.add_argument("--preset", default=None, help="the settings the search goes over (default: the env's, as train)")
+    tu.add_argument("--eval-episodes", type=_positive_int, default=100, help="greedy episodes of each evaluation")
+    tu.add_argument("--out", metavar="FILE", help="the best settings as a TOML preset (default: DIR/best.toml)")
     return parser
 
 
@@ -544,6 +560,31 @@ def cmd_render(args) -> int:
     return 0
 
 
+def cmd_tune(args) -> int:
+    from pamdp.experiments.tune import Search, require_optuna, tune, write_preset
+
+    require_optuna()
+    name = f"{args.algo}-{args.env.split('/')[-1]}"
+    root = Path(args.study_dir or f"tune/{name}")
+    storage = args.storage or f"sqlite:///{root / 'study.db'}"
+    out = Path(args.out or (root if args.storage is None else Path()) / "best.toml")
+    search = Search(args.algo, args.env, args.trials, args.steps_per_trial, storage, name, seed=args.seed)
+    search = dataclasses.replace(search, preset=args.preset, pruner=args.pruner, eval_episodes=args.eval_episodes)
+    search.check()
+    existing = next(p for p in (out.parent.absolute(), *out.parent.absolute().parents) if p.exists())
+    if out.is_dir() or not existing.is_dir() or not os.access(existing, os.W_OK):
+        raise ValueError(f"--out {args.out or out}: cannot be written ({existing} is not a writable directory)")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    study = tune(search, workers=args.workers, log=lambda m: print(m, file=sys.stderr))
+    info = write_preset(study, out)
+    print(
+        f"best {info['objective']} {info['best_value']:.4f} (trial {info['best_trial']}); {info['trials']} trials: "
+        f"{info['complete']} complete, {info['pruned']} pruned, {info['failed']} failed; {info['cpu_seconds']:.0f} "
+        f"CPU s\nwrote {out} and {out.with_suffix('.json')}: pamdp train {args.algo} --env {args.env} --config {out}"
+    )
+    return 0
+
+
 def _warning_line(message, category, filename, lineno, line=None) -> str:
     return f"pamdp: warning: {str(message).replace(chr(10), ' ')}\n"
 
@@ -561,6 +602,7 @@ def main(argv: list[str] | None = None) -> int:
         "reproduce": cmd_reproduce,
         "plot": cmd_plot,
         "summarize": cmd_summarize,
+        "tune": cmd_tune,
     }
     try:
         return handlers[args.command](args)
