@@ -227,6 +227,14 @@ def build_parser() -> argparse.ArgumentParser:
             "this env or one whose features this env's observation extends (Half Field Offense 1v0 for 1v1)",
         )
         p.add_argument(
+            "--init-keep",
+            type=_names,
+            default=(),
+            metavar="TENSORS",
+            help="with --init-from: comma-separated tensors that keep this run's own initialisation, e.g. "
+            "policy.log_std (PATRPO's exploration, then set by --init-log-std)",
+        )
+        p.add_argument(
             "--eval-episodes", type=_count, default=1000, help="greedy evaluation episodes at the end (0: none)"
         )
         p.add_argument(
@@ -332,7 +340,17 @@ def build_parser() -> argparse.ArgumentParser:
 # -- train -------------------------------------------------------------------------------------------
 
 
+def _names(text: str) -> tuple[str, ...]:
+    """A comma-separated list of names, none empty."""
+    names = tuple(name.strip() for name in text.split(","))
+    if not all(names):
+        raise argparse.ArgumentTypeError(f"{text!r}; expected comma-separated names such as policy.log_std")
+    return names
+
+
 def _train_spec(args, cls) -> RunSpec:
+    if args.init_keep and not args.init_from:
+        raise ValueError(f"--init-keep {','.join(args.init_keep)} without --init-from; expected both or neither")
     file_values = _read_config_file(args.config) if args.config else {}
     file_preset = file_values.pop("preset", None)
     preset = args.preset or file_preset
@@ -354,6 +372,7 @@ def _train_spec(args, cls) -> RunSpec:
         env_kwargs,
         args.eval_every,
         args.init_from or "",
+        tuple(args.init_keep),
     )
 
 

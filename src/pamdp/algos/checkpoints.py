@@ -105,7 +105,9 @@ def read_checkpoint(path: str | os.PathLike) -> dict:
     return payload
 
 
-def transfer_weights(model, source: str | os.PathLike, input_columns: list[int | None] | None = None) -> dict[str, str]:
+def transfer_weights(
+    model, source: str | os.PathLike, input_columns: list[int | None] | None = None, keep: tuple[str, ...] = ()
+) -> dict[str, str]:
     """Start ``model``'s networks from those of ``source`` (a model file or run directory of the same algorithm and
     action space), trained on an env whose observation may differ: a warm start, not a resumption (optimisers,
     counters and random states stay ``model``'s own).
@@ -135,6 +137,10 @@ def transfer_weights(model, source: str | os.PathLike, input_columns: list[int |
         )
     if old == new and columns != list(range(new)):  # the input layers would not be told from the hidden ones
         raise ValueError(f"input_columns = {input_columns!r:.80}; expected None: both observations have {new} features")
+    own_names = {f"{name}.{key}" for name, module in model._modules().items() for key in module.state_dict()}
+    unknown = sorted(set(keep) - own_names)
+    if unknown:
+        raise ValueError(f"keep names {', '.join(unknown)}; expected tensors of the model, such as {min(own_names)}")
     states, report = {}, {}
     for name, module in model._modules().items():
         saved = payload["modules"].get(name)
@@ -142,6 +148,9 @@ def transfer_weights(model, source: str | os.PathLike, input_columns: list[int |
             raise ValueError(f"{source} has no network {name!r}; expected a model made with the same settings")
         states[name] = {}
         for key, target in module.state_dict().items():
+            if f"{name}.{key}" in keep:
+                states[name][key], report[f"{name}.{key}"] = target, "kept"
+                continue
             weight = saved.get(key)
             fits = weight is not None and weight.ndim == target.ndim
             mapped = _map_observation(weight, target, columns, old) if fits else None

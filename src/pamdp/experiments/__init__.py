@@ -4,7 +4,8 @@ Each experiment is a TOML file in ``configs/`` (one per figure of the paper, and
 the budget, the seeds, optional ``env_kwargs`` for the env's constructor, and a list of runs (a label, an
 algorithm, a preset, setting overrides, and optionally their own ``env``, ``env_kwargs``, ``total_steps`` and
 ``eval_every``: a suite of domains gives each its own budget; ``init_from``, the label of an earlier run whose
-final model of the same seed starts this one's networks: a curriculum). The experiment's ``env`` and ``total_steps``
+final model of the same seed starts this one's networks: a curriculum; ``init_keep``, the tensors such a run keeps
+of its own initialisation, e.g. ``["policy.log_std"]``). The experiment's ``env`` and ``total_steps``
 may be left out where every run gives its own.
 """
 
@@ -72,6 +73,7 @@ class Experiment:
                         env_kwargs,
                         run.get("eval_every", self.eval_every),
                         run.get("init_from", ""),
+                        tuple(run.get("init_keep", ())),
                     )
                 )
         return out
@@ -129,7 +131,18 @@ def load_experiment(name_or_path: str | os.PathLike) -> Experiment:
 
 MAX_STEPS = 10**12  # as ``pamdp train --total-steps``: a budget beyond this is a typing slip
 _KEYS = {"description", "env", "total_steps", "seeds", "eval_episodes", "eval_every", "env_kwargs", "runs"}
-_RUN_KEYS = {"label", "algo", "preset", "settings", "env", "env_kwargs", "total_steps", "eval_every", "init_from"}
+_RUN_KEYS = {
+    "label",
+    "algo",
+    "preset",
+    "settings",
+    "env",
+    "env_kwargs",
+    "total_steps",
+    "eval_every",
+    "init_from",
+    "init_keep",
+}
 
 
 def _whole(value, low: int, high: int | None = None) -> bool:
@@ -189,6 +202,9 @@ def _check_experiment(path: Path, data: dict) -> None:
             refuse(f"runs[{i}].eval_every", run["eval_every"], "an integer >= 0")
         if "init_from" in run and run["init_from"] not in [r.get("label") for r in runs[:i]]:
             refuse(f"runs[{i}].init_from", run["init_from"], "the label of a run listed before it")
+        keep = run.get("init_keep", [])
+        if not (isinstance(keep, list) and all(isinstance(k, str) for k in keep)) or keep and "init_from" not in run:
+            refuse(f"runs[{i}].init_keep", keep, "a list of tensor names such as 'policy.log_std', with init_from")
         slug = _slug(str(run["label"]))
         if slug in dirs:
             refuse(f"runs[{i}].label", run["label"], f"a label whose directory differs from {dirs[slug]!r}'s ({slug})")
