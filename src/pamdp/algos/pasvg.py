@@ -1,26 +1,9 @@
 """PASVG(0): stochastic value gradients through a Gumbel-Softmax hierarchical policy (Wei, Wicke & Luke 2018).
 
-Section "Parameterized Actions SVG(0)" of the paper, in the reparameterised form
-
-    a = f(s, eta_a)     = onehot(argmax(log pi_d(.|s) + eta_a)), eta_a ~ Gumbel(0, 1)^K
-    x = g(s, a, eta_x)  = tanh(mu(s, a) + sigma_a * eta_x),       eta_x ~ N(0, 1)^m
-
-where the argmax is relaxed to ``softmax((log pi_d + eta_a) / temperature)`` for the backward pass (the
-straight-through estimator; with ``straight_through=False`` the critic sees the soft sample itself), and
-``pi_c``'s mean ``mu`` is conditioned on that sample. The objective
-``J = E_s E_eta [Q(s, f(s, eta_a), g(s, f(s, eta_a), eta_x))]`` is differentiable in both policies, so one
-loss ``-Q`` trains ``pi_d`` and ``pi_c`` together. The noise ``eta = (eta_a, eta_x)`` drawn while acting is
-recorded with the transition: as the paper notes, the policy gradient at a replayed state reuses it, with no
-inference of ``p(eta | s, a, x)``.
-
-With ``discrete_gradient="expected"`` (not in the paper) the Gumbel-Softmax estimate of ``pi_d``'s gradient
-is replaced by the exact expectation over the K actions, ``J = E_s E_eta_x [sum_k pi_d(k|s) Q(s, k, g(s, k,
-eta_x))]``, and the TD target likewise averages the target policy's actions: with few actions (K = 3 on
-Platform) the K critic evaluations cost little and remove the straight-through estimator's bias.
-
-The critic ``Q(s, a, x)`` (the action as a one-hot, or the soft sample) is trained by TD from replay against
-target networks updated softly, as in DDPG; the next action in the target is drawn from the target policy
-with fresh noise, so ``Q`` estimates the value of the stochastic policy being optimised.
+Section "Parameterized Actions SVG(0)" of the paper: acting draws Gumbel noise for ``pi_d`` and Gaussian noise
+for ``pi_c``, records it with the transition, and one loss ``-Q(s, f(s, eta_a), g(s, f(s, eta_a), eta_x))``
+trains both policies through the relaxed sample (or, with ``discrete_gradient="expected"``, through the exact
+expectation over the K actions). The maths: docs/algorithms.md, "PASVG(0)".
 """
 
 from __future__ import annotations
@@ -290,7 +273,7 @@ class Critic(nn.Module):
 
 
 class PASVG0(Algorithm):
-    """Parameterized Actions SVG(0). See the module docstring for the update and :class:`PASVG0Config`."""
+    """Parameterized Actions SVG(0). See docs/algorithms.md, "PASVG(0)", for the update and :class:`PASVG0Config`."""
 
     config_class = PASVG0Config
     config: PASVG0Config

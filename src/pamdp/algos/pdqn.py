@@ -1,33 +1,9 @@
 """P-DQN and MP-DQN: Q-learning over parameterized actions with a deterministic parameter actor.
 
-P-DQN (Xiong et al. 2018, "Parametrized Deep Q-Networks Learning", arXiv 1810.06394) keeps DQN's
-argmax over the K discrete actions and learns the continuous parameters with a deterministic actor:
-
-- the actor ``x(s)`` outputs the parameters of *every* action, ``x = (x_0, ..., x_{K-1})`` with
-  ``sum_a m_a`` values, each in ``[-1, 1]`` (the units of :class:`~pamdp.spaces.HybridActionSpace`);
-- the Q-network ``Q(s, x)`` outputs K values, ``Q_k`` the value of action ``k`` with parameters ``x_k``;
-- acting: ``k* = argmax_k Q_k(s, x(s))``, executed with its own parameters ``x_{k*}(s)``;
-- ``Q`` is trained by one-step TD on replayed transitions against target networks,
-  ``y = r + gamma max_k Q'_k(s', x'(s'))`` (no bootstrap after a termination), optionally mixed with the
-  Monte-Carlo return as PADDPG does, ``y = beta * MC + (1 - beta) * y`` (``beta``; Bester et al. used such
-  mixed targets on Half Field Offense);
-- the actor ascends ``sum_k Q_k(s, x(s))`` with Q's weights held fixed. Its outputs are kept in ``[-1, 1]``
-  by Hausknecht & Stone's inverting gradients (``bound``; :func:`~pamdp.algos.offpolicy.backprop_actor`).
-
-MP-DQN (Bester, James & Konidaris 2019, "Multi-Pass Q-Networks for Deep Reinforcement Learning with
-Parameterised Action Spaces", arXiv 1905.04388) points out that with the joint input ``Q_k`` depends on the
-parameters of the *other* actions: the greedy choice is swayed by parameters that are never executed, and
-the actor's update of ``x_j`` is pushed by every ``Q_k``, ``k != j``. The multi-pass Q-network evaluates K
-passes, pass ``k`` seeing ``x`` with every block but ``x_k`` zeroed, and reads ``Q_k`` from pass ``k``; the K
-passes are one forward over a batch of ``B * K`` inputs. ``multi_pass = True`` selects it; everything else is
-shared.
-
-The update is back-propagated by hand (:mod:`pamdp.algos.dense`), which pays here
-(``benchmarks/update_speed.md``); ``tests/test_pdqn.py`` holds the autograd form it must equal.
-
-Exploration: epsilon-greedy over the discrete action, epsilon annealed linearly as in PADDPG (with
-``explore_params``, the random action's parameters are drawn uniformly too, Xiong et al.'s random
-exploration), and Ornstein-Uhlenbeck noise on the parameters (``ou_theta = 1`` makes it i.i.d. Gaussian).
+P-DQN (Xiong et al. 2018, arXiv 1810.06394) acts by ``argmax_k Q_k(s, x(s))`` with an actor ``x(s)`` of every
+action's parameters; MP-DQN (Bester, James & Konidaris 2019, arXiv 1905.04388; ``multi_pass = True``) reads
+``Q_k`` from a pass that sees only ``x_k``. The update is back-propagated by hand (:mod:`pamdp.algos.dense`;
+``tests/test_pdqn.py`` holds the autograd form it must equal). The maths: docs/algorithms.md, "P-DQN and MP-DQN".
 """
 
 from __future__ import annotations
