@@ -158,9 +158,7 @@ class HyARConfig(OffPolicyConfig, AlgoConfig):
         """The samples before the first update (:class:`~pamdp.algos.offpolicy.OffPolicyLoop`): the warm-up's."""
         return self.warmup_steps
 
-    # "cpu" (the command line's default): smaller networks, 64 batched env copies and a quarter of a TD3 update
-    # per sample, for a laptop CPU, with a small KL weight and small latents (a 1-D parameter in 6 latent
-    # dimensions left 5 for the critic to learn to ignore). It is sized, not tuned: see docs/algorithms.md.
+    # "cpu" (the command line's default), sized for a laptop CPU, not tuned: docs/algorithms.md, "HyAR-TD3".
     PRESETS = {
         "cpu": dict(
             num_envs=64,

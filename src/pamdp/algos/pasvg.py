@@ -78,17 +78,14 @@ class PASVG0Config(OffPolicyConfig, AlgoConfig):
     )
     explore_epsilon: float = setting(
         0.0,
-        "While collecting, the fraction of steps whose discrete action is drawn uniformly instead of from pi_d "
-        "(with pi_c's parameters for it), so that every action keeps appearing in replay; 0 in the paper. "
-        "The policy update does not see it: it replays the recorded noise through the current policy.",
+        "Fraction of collected discrete actions drawn uniformly instead of from pi_d, so that every action keeps "
+        "appearing in replay (the policy update never sees them; 0 in the paper).",
         interval(0, 1),
     )
     discrete_gradient: str = setting(
         "gumbel",
-        "How pi_d's gradient is estimated: gumbel (the paper) differentiates Q through the Gumbel-Softmax "
-        "sample; expected takes the exact expectation over the K actions, sum_k pi_d(k|s) Q(s, k, x_k), in the "
-        "policy loss and in the TD target (pi_c's parameters for every action from the same recorded eta_x): "
-        "no estimator bias and lower variance, at K critic evaluations per state. Not in the paper.",
+        "pi_d's gradient: gumbel (the paper's, through the Gumbel-Softmax sample) or expected (the exact "
+        "expectation over the K actions, in the policy loss and the TD target; not in the paper).",
         one_of(("gumbel", "expected")),
     )
     twin_critics: bool = setting(
@@ -120,11 +117,7 @@ class PASVG0Config(OffPolicyConfig, AlgoConfig):
 
     PRESETS = {
         "paper": {},
-        # Small networks, 64 batched env copies and a quarter of an update per sample; pi_d's gradient from
-        # the exact expectation over the K actions instead of the Gumbel-Softmax estimate; pi_d's entropy
-        # held at 0.3 nats (of ln 3 = 1.10) by a tuned weight; 5 % of the collected discrete actions
-        # uniform; a fixed parameter noise (std 0.2 before the Tanh). How each choice was reached, and what
-        # it fixed: benchmarks/pasvg_tuning.md.
+        # What each choice is: docs/algorithms.md, "PASVG(0)"; how it was reached: benchmarks/pasvg_tuning.md.
         "tuned": dict(
             num_envs=64,
             hidden_sizes=(128, 128),

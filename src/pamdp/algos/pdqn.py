@@ -104,10 +104,7 @@ class PDQNConfig(DeterministicActorConfig, OffPolicyConfig, AlgoConfig):
                 "or no passthrough"
             )
 
-    # "paper": Bester et al.'s text as recalled here (not re-read; never their code); grad_clip, learning_starts,
-    # explore_params and the conversion of 1000 episodes to 5 000 samples are assumptions (see the help).
-    # "tuned": the same learning rates and targets with a smaller Q-network and batch, 64 batched env copies
-    # and a quarter of an update per sample (how it learns: benchmarks/later_platform.md).
+    # Both presets: docs/algorithms.md, "P-DQN and MP-DQN"; how "tuned" learns: benchmarks/later_platform.md.
     PRESETS = {
         "paper": {},
         "tuned": dict(
@@ -181,15 +178,11 @@ class ParamActor(nn.Module):
 class QNetwork(nn.Module):
     """``Q(s, x)``: K action values from the state and every action's parameters.
 
-    With ``multi_pass`` (MP-DQN), pass ``k`` sees ``x`` with all blocks but action ``k``'s zeroed and ``Q_k`` is
-    read from it, so ``Q_k`` depends on ``x_k`` alone. The ``K`` passes share all but their inputs' parameter
-    blocks, so their input rows (``B * K`` of width ``d + sum_a m_a``) are never built: the first layer's
-    pre-activation of pass ``k`` is ``W_s s + W_k x_k + b``, one ``(B, h)`` product for the state plus each
-    action's own block, and the output layer computes only ``Q_k`` of pass ``k``. That is the same function at
-    ``K`` times fewer operations in the first and last layers (it was quadratic in ``K``). The passes are one flat
-    batch of ``K * B`` rows, pass ``k``'s a contiguous block (:class:`~pamdp.algos.dense.MultiPassDense`, which
-    also differentiates them by hand for the update; a strided ``(B, K, h)`` layout made every element-wise op and
-    its backward walk memory slowly).
+    With ``multi_pass`` (MP-DQN), ``Q_k`` is read from a pass that sees only ``x_k``. The passes' input rows are
+    never built: pass ``k``'s first layer is ``W_s s + W_k x_k + b`` and its output layer computes ``Q_k`` alone,
+    the same function at ``K`` times fewer operations; the passes are one flat batch of ``K * B`` rows, pass
+    ``k``'s a contiguous block (a strided layout walked memory slowly; :class:`~pamdp.algos.dense.MultiPassDense`
+    differentiates it by hand).
     """
 
     def __init__(self, obs_dim: int, hybrid: HybridActionSpace, hidden_sizes, activation: str, multi_pass: bool):
