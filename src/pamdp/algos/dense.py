@@ -1,10 +1,6 @@
-"""Hand-written forward and backward passes of :func:`~pamdp.policies.mlp` networks, for the off-policy updates.
-
-An off-policy update with the paper's {400, 300} networks and a batch of 32 is a few dozen small matrix
-products, where the calls through ``nn.Module`` and the autograd engine cost more than the arithmetic.
-:class:`Dense` applies a network's layers as plain products (``addmm``) and back-propagates by hand with ATen's
-own activation derivatives, so the gradients are autograd's (``tests/test_dense.py``) in a fraction of the
-calls (the times: ``benchmarks/offpolicy_speed.md``).
+"""Hand-written forward and backward passes of :func:`~pamdp.policies.mlp` networks, for the off-policy updates:
+plain ``addmm`` products and ATen's own activation derivatives, autograd's gradients (``tests/test_dense.py``) in
+a fraction of the calls (why it pays: docs/performance.md; the times: ``benchmarks/offpolicy_speed.md``).
 
     net = Dense.of(critic.net)                      # the module's own parameter tensors, no copies
     q, cache = net.forward_cached(x)

@@ -1,36 +1,6 @@
-"""Hybrid SAC: soft actor-critic over parameterized actions (Delalleau, Peter, Alonso & Logut 2019, "Discrete
-and Continuous Action Representation for Practical RL in Video Games", arXiv 1912.11077).
-
-The policy ``pi(a, x | s) = pi_d(a | s) * pi_c(x | s, a)`` has a categorical ``pi_d`` over the K discrete actions
-and a tanh-squashed Gaussian ``pi_c``: ``x = tanh(u)``, ``u ~ N(mu, sigma)``, so ``x`` stays in ``[-1, 1]`` and
-
-    log pi_c(x | s, a) = sum_i [ log N(u_i; mu_i, sigma_i) - log(1 - tanh(u_i)^2) ]
-
-over the ``m_a`` parameters of action ``a`` (none for a parameterless action, which adds no continuous entropy).
-``pi_c`` comes in two forms (``form``):
-
-- ``flat`` (Delalleau et al.): one network on the state outputs the K logits and the means and log-stds of the
-  parameters of *every* action (``sum_a m_a`` of each);
-- ``hierarchical`` (the seed paper, Wei, Wicke & Luke 2018): ``pi_d`` is a network on the state and ``pi_c`` one
-  on ``[s, onehot(a)]`` with ``2 m`` outputs (``m = max_a m_a``), evaluated for every action in one batched pass.
-
-Either way every action's parameters are drawn at each step, ``x_all = (x_0, ..., x_{K-1})``; the env gets the
-chosen action's. Twin critics ``Q_i(s, ., x_all)`` have one output per discrete action, as P-DQN's. Soft
-Q-learning with the exact expectation over the next discrete action (a sample of its parameters), twice the
-clipped minimum of the target critics:
-
-    V(s') = sum_a' pi_d(a'|s') [ min_i Q'_i(s', x'_all)_a' - alpha_c log pi_c(x'_a'|s',a') - alpha_d log pi_d(a'|s') ]
-    y = r + gamma (1 - terminated) V(s')
-
-The policy minimises ``E_s sum_a pi_d(a|s) [alpha_d log pi_d(a|s) + alpha_c log pi_c(x_a|s,a) - min_i Q_i(s,
-x_all)_a]`` (the exact expectation over ``a``, reparameterised ``x``). Each part has its own temperature, tuned
-towards its own target entropy: ``alpha_d`` towards ``target_entropy_d * log(allowed actions)``, ``alpha_c``
-towards ``target_entropy_c`` nats per parameter of the expected action (``sum_a pi_d(a) m_a`` parameters), by
-descent on ``log alpha * (H - target)`` (:func:`temperature_gradient`): a policy more random than its target lowers
-its temperature. Critic targets follow the critics softly (``tau``).
-
-With ``action_mask`` the actions the env's ``info["action_mask"]`` forbids get probability zero, in acting and
-in the target's expectation (the next state's mask is stored with the transition).
+"""Hybrid SAC: soft actor-critic over parameterized actions (Delalleau, Peter, Alonso & Logut 2019, arXiv
+1912.11077), with a flat or a hierarchical ``pi_c``, twin critics with one output per discrete action, and one
+tuned temperature for each part of the policy. The maths: docs/algorithms.md, "Hybrid SAC".
 """
 
 from __future__ import annotations
@@ -104,11 +74,7 @@ class HybridSACConfig(OffPolicyConfig, AlgoConfig):
     batch_size: int = shared_setting("batch_size", 256, "SAC: 256; assumed")
     learning_starts: int = learning_starts_setting(10_000, "SAC: 10 000; assumed")
 
-    # "tuned" (the command line's default): sized for a laptop CPU, with 64 batched env copies, networks of
-    # 64-64, a tenth of an update per sample on batches of 128 (an update costs about the same at 64 or 128 here),
-    # lower initial temperatures (Platform's returns sum to at most 1, so an entropy bonus of 1 nat a step would
-    # dominate them) and a discrete target entropy of half the uniform's; how it learns:
-    # benchmarks/hsac_platform.md.
+    # "tuned" (the command line's default): docs/algorithms.md, "Hybrid SAC"; benchmarks/hsac_platform.md.
     PRESETS = {
         "paper": {},
         "tuned": dict(
@@ -130,12 +96,8 @@ class HybridSACConfig(OffPolicyConfig, AlgoConfig):
 
 
 class HybridSACActor(nn.Module):
-    """The policy in one of two forms (see the module docstring); ``forward(obs, mask)`` is a :class:`SquashedHybrid`.
-
-    ``flat``: ``mlp(s) -> [logits (K) | means (sum_a m_a) | log-stds (sum_a m_a)]``, the parameter blocks laid
-    out in the padded ``(K, m)`` form by index. ``hierarchical``: ``pi_d = mlp(s) -> K`` and
-    ``pi_c = mlp([s, onehot(a)]) -> [means (m) | log-stds (m)]`` for every ``a``.
-    """
+    """The policy, ``flat`` (``mlp(s) -> [logits | means | log-stds]``) or ``hierarchical`` (``pi_d = mlp(s)``,
+    ``pi_c = mlp([s, onehot(a)])`` for every ``a``); ``forward(obs, mask)`` is a :class:`SquashedHybrid`."""
 
     def __init__(self, obs_dim: int, hybrid: HybridActionSpace, form: str, hidden_sizes, activation: str):
         super().__init__()
@@ -174,7 +136,7 @@ class HybridSACActor(nn.Module):
 
 
 class HybridSAC(Algorithm):
-    """Hybrid SAC (Delalleau et al. 2019), flat or hierarchical (``form``). See the module docstring."""
+    """Hybrid SAC (Delalleau et al. 2019), flat or hierarchical (``form``). See docs/algorithms.md, "Hybrid SAC"."""
 
     config_class = HybridSACConfig
     config: HybridSACConfig

@@ -1,41 +1,9 @@
 """HyAR-TD3: TD3 in a learned latent space of hybrid actions (Li et al., ICLR 2022, arXiv 2109.05490).
 
-HyAR ("Hybrid Action Representation") turns the parameterized action space into a continuous box that an
-ordinary continuous-control algorithm can act in, and decodes the box back to a hybrid action:
-
-- an **embedding table** ``E`` (``K x embed_dim``) holds one vector ``e_k`` per discrete action;
-- a **conditional VAE** encodes an action's parameters ``x_k`` into ``z`` (``latent_dim`` values), conditioned on
-  the state and ``e_k``: ``q(z | x_k, s, e_k) = N(mu, sigma)``; its decoder maps ``(z, s, e_k)`` back to
-  ``x_k``, and a sub-network stacked on the decoder predicts the state change ``s' - s``, so that latents with
-  similar effects lie close together. Loss: ``|x_k - x~_k|^2 + kl_weight * KL(q || N(0, I)) +
-  dynamics_weight * |s' - s - d~|^2``; the table is trained with the VAE;
-- **decoding** a latent action ``(e, z)``: ``k`` is the table row nearest to ``e`` (Euclidean distance), then
-  ``x_k = decoder(z, s, e_k)``;
-- **TD3** (clipped double Q, target policy smoothing, delayed actor updates) learns an actor ``s -> (e, z)`` and
-  twin critics ``Q(s, e, z)`` on the latent actions;
-- the **latent space constraint**: the actor's Tanh output ``u`` in ``[-1, 1]`` is mapped affinely onto the
-  central ``lsc_percent`` % range of the latents of replayed data, per dimension, recomputed after every round of
-  representation training; outside that range the decoder has seen no data;
-- **representation shift correction**: the representation keeps training during RL, so a replayed latent action
-  may no longer decode to the hybrid action that was executed. Every sampled batch is checked, and the latents
-  that decode to another action, or to parameters more than ``relabel_tolerance`` away, are replaced by the
-  current encoding ``(e_k, mu(x_k, s, e_k))`` of what was executed (``relabel = "invalid"``; ``"all"`` re-encodes
-  every sample, ``"none"`` never does).
-
-Schedule: ``warmup_steps`` samples of uniformly random hybrid actions (the paper: 5000 random episodes; 11 000
-samples are about that many on Platform, whose random episodes last 2.2 steps), then ``warmup_updates`` steps of
-representation training alone, then TD3 with a round of ``vae_updates`` representation steps every
-``vae_interval`` samples. TD3's exploration noise may start high and fall linearly over ``exploration_noise_steps``
-samples (``exploration_noise_start`` to ``exploration_noise``), as HyAR's own training scripts do.
-
-The paper's appendix (network sizes, learning rates, latent sizes, the percentile, the validity test) was not
-available when this was written: those settings are marked as assumptions in their help. The paper reports
-0.98 +- 0.01 on Platform (5 runs).
-
-Two options beyond the paper, off in the ``paper`` preset and on in ``cpu``: epsilon-greedy over the embeddings
-(``epsilon_start``, ``epsilon_end``) and inverting gradients instead of the actor's Tanh (``bound = "invert"``).
-Probes on Platform found the Tanh actor stuck in a corner of the latent box, on one action's embedding, while
-its critic preferred another (docs/algorithms.md, "HyAR-TD3").
+A table of discrete-action embeddings and a conditional VAE of the parameters (with a dynamics head) turn the
+hybrid action space into a box; TD3 acts in the box, within the latent space constraint, and replayed latents
+are relabelled when the representation has moved. The maths, the schedule, the options beyond the paper and
+how the ``cpu`` preset came about: docs/algorithms.md, "HyAR-TD3".
 """
 
 from __future__ import annotations
@@ -190,9 +158,7 @@ class HyARConfig(OffPolicyConfig, AlgoConfig):
         """The samples before the first update (:class:`~pamdp.algos.offpolicy.OffPolicyLoop`): the warm-up's."""
         return self.warmup_steps
 
-    # "cpu" (the command line's default): smaller networks, 64 batched env copies and a quarter of a TD3 update
-    # per sample, for a laptop CPU, with a small KL weight and small latents (a 1-D parameter in 6 latent
-    # dimensions left 5 for the critic to learn to ignore). It is sized, not tuned: see docs/algorithms.md.
+    # "cpu" (the command line's default), sized for a laptop CPU, not tuned: docs/algorithms.md, "HyAR-TD3".
     PRESETS = {
         "cpu": dict(
             num_envs=64,
@@ -216,7 +182,7 @@ class HyARConfig(OffPolicyConfig, AlgoConfig):
 
 
 class ActionRepresentation(nn.Module):
-    """The embedding table and the conditional VAE with its state-change head (see the module docstring).
+    """The embedding table and the conditional VAE with its state-change head (docs/algorithms.md, "HyAR-TD3").
 
     Parameters ``x`` are padded to ``m = max_a m_a`` in ``[-1, 1]`` units; the unused slots of an action are
     zero on the way in and masked out of the reconstruction loss.

@@ -1,26 +1,7 @@
 """What the off-policy algorithms share: their loop settings, the collect-and-learn loop over a replay buffer,
 target networks, twin critics, the entropy temperature rule, and the bounded-gradient tricks of deterministic
-actors.
-
-:class:`OffPolicyConfig` declares the settings of the loop and the replay once; an algorithm's config inherits
-it beside :class:`~pamdp.algos.settings.AlgoConfig`. :class:`OffPolicyLoop` reads them: it steps the batched
-env with the algorithm's exploration policy, stores every valid transition in the
-:class:`~pamdp.algos.replay.ReplayBuffer`, and interleaves gradient updates: once the buffer holds
-``learning_starts`` transitions, each new sample earns ``updates_per_step`` updates (the update-to-data ratio),
-so ``num_envs`` changes how samples are batched, not how much is learned per sample.
-
-Gymnasium's vector envs reset a finished copy on the *next* step and ignore that step's action: such
-autoreset steps are marked invalid and never stored. A true termination stores ``terminated = True`` (no
-bootstrap); a truncation by the time limit stores ``False``, so the target bootstraps from the final
-observation. Episodes carry across epochs; a resumed run starts new episodes (env states are not saved).
-
-With ``mc_returns`` the loop also writes each transition's discounted Monte-Carlo return-to-go into the
-buffer's ``"mc"`` field when its episode ends (``NaN`` until then), for PADDPG's mixed targets. Both the stored
-rewards and these returns are the env's rewards times ``reward_scale``, the scale the critics learn on.
-
-The actors of PADDPG, P-DQN and HyAR output bounded values trained along ``dQ/d output``; Hausknecht & Stone's
-three ways of keeping them in ``[-1, 1]`` ("Deep Reinforcement Learning in Parameterized Action Space", ICLR 2016,
-section "Bounded parameter space learning") are :data:`BOUNDS`, applied by :func:`backprop_actor`.
+actors. How the loop treats autoreset, truncation and Monte-Carlo returns: docs/algorithms.md, "The off-policy
+family".
 """
 
 from __future__ import annotations
@@ -72,14 +53,9 @@ BOUNDS = ("invert", "squash", "zero")
 class OffPolicyConfig:
     """The settings of the collect-and-learn loop and its replay, declared once for every off-policy algorithm.
 
-    An algorithm's config inherits it beside :class:`~pamdp.algos.settings.AlgoConfig`, which brings the checks
-    and the settings of every algorithm (``class PADDPGConfig(OffPolicyConfig, AlgoConfig)``): each base is one
-    level up, where a chain (``OffPolicyConfig(AlgoConfig)``) would put the algorithm two levels below
-    ``AlgoConfig``, and a nested settings object would change the flat names that config files, the command
-    line and checkpoints use. This base holds fields only. An algorithm whose paper gives another default
-    declares the setting again with :func:`shared_setting`, which keeps the help and the check written here.
-    Each config also declares ``learning_starts``, the samples in the replay before the first update (HyAR's is
-    its warm-up).
+    An algorithm's config inherits it beside :class:`~pamdp.algos.settings.AlgoConfig`
+    (``class PADDPGConfig(OffPolicyConfig, AlgoConfig)``) and declares its own ``learning_starts``; a setting
+    whose paper gives another default is declared again with :func:`shared_setting`.
     """
 
     num_envs: int = setting(
@@ -221,12 +197,7 @@ class Temperatures(nn.Module):
 
 def temperature_gradient(entropy: torch.Tensor, target: torch.Tensor | float) -> torch.Tensor:
     """The gradient in ``log alpha`` of SAC's temperature loss ``mean(log alpha * (H - target))``, the entropy
-    estimates ``H`` held fixed: ``mean(H - target)``.
-
-    Descent lowers the temperature of a policy more random than its target, raises it for one less random, and
-    leaves it where the entropy meets the target, so the policy keeps exploring about as much as asked however
-    the critic's values scale.
-    """
+    estimates ``H`` held fixed: ``mean(H - target)`` (why: docs/algorithms.md, "The off-policy family")."""
     return (entropy - target).mean()
 
 
@@ -357,7 +328,8 @@ def backprop_actor(
 
 
 class OffPolicyLoop:
-    """Collect-and-learn epochs of an off-policy algorithm over its replay buffer (see the module docstring).
+    """Collect-and-learn epochs of an off-policy algorithm over its replay buffer (docs/algorithms.md, "The off-policy
+    family").
 
     The loop receives the algorithm and reads from it what it needs: the settings (an :class:`OffPolicyConfig`
     with ``learning_starts`` and ``flush_denormal``; the updates, not the env steps, flush subnormal floats to

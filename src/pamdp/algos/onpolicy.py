@@ -1,9 +1,6 @@
-"""What the on-policy algorithms (PATRPO, PAPPO) share: sampling the hierarchical policy, GAE, the baselines.
-
-An epoch of either algorithm starts the same way: :meth:`Rollout.collect` steps the vector env with
-``(a, x) ~ pi_d(a|s) pi_c(x|s,a)`` until ``batch_size`` valid samples, then :func:`advantage_batch` computes
-the advantages by GAE from a baseline ``V(s)`` (a value network, or rllab's :class:`LinearFeatureBaseline`)
-and flattens the batch to its valid samples. What differs, the policy update, lives in each algorithm's file.
+"""What the on-policy algorithms (PATRPO, PAPPO) share: sampling the hierarchical policy
+(:meth:`Rollout.collect`), GAE from a baseline (:func:`advantage_batch`), the baselines. What differs, the policy
+update, lives in each algorithm's file.
 """
 
 from __future__ import annotations

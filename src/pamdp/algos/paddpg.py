@@ -1,29 +1,9 @@
 """PADDPG: DDPG over a parameterized action space (Hausknecht & Stone, ICLR 2016), the seed paper's baseline.
 
-The actor ``mu(s)`` outputs one vector: K action scores and the parameters of *every* action
-(``sum_a m_a`` values), all kept in ``[-1, 1]``. The executed action is the argmax of the scores with its
-own parameters; the critic ``Q(s, mu(s))`` sees the whole vector, so the actor is trained by DDPG's
-deterministic policy gradient ``dQ/dmu * dmu/dtheta`` through all of it.
-
-Bounded outputs (``bound``, the three options Hausknecht & Stone compare in their section on bounded parameter
-space learning):
-
-- ``invert`` (the default, theirs): with ``g = dQ/dp`` at the actor's output, scale ``g`` by
-  ``(p_max - p) / (p_max - p_min)`` where it would increase ``p`` and by ``(p - p_min) / (p_max - p_min)``
-  where it would decrease it, so an output slows down as it nears a bound and is pushed back (the factor
-  turns negative) once it has crossed one. See :func:`~pamdp.algos.offpolicy.invert_gradients`.
-- ``squash``: a Tanh output layer and the plain gradient.
-- ``zero``: the plain gradient, except that components pushing an output at or past a bound further out
-  are set to 0 (:func:`~pamdp.algos.offpolicy.zero_gradients`).
-
-The bound handling edits ``dQ/dp`` for the whole batch before it is back-propagated into the actor.
-Exploration is epsilon-greedy over the whole output vector (uniform in ``[-1, 1]`` with probability
-epsilon, annealed linearly), optionally with Ornstein-Uhlenbeck noise on the actor's parameters. Targets
-may mix in on-policy Monte-Carlo returns, ``y = beta * MC + (1 - beta) * (r + gamma Q'(s', mu'(s')))``; a
-transition whose episode has not ended yet uses the TD target alone.
-
-The update is back-propagated by hand (:mod:`pamdp.algos.dense`), which pays here
-(``benchmarks/offpolicy_speed.md``); ``tests/test_dense.py`` holds the autograd form it must equal.
+The actor outputs K action scores and every action's parameters in one vector, kept in ``[-1, 1]`` by ``bound``
+(:func:`~pamdp.algos.offpolicy.invert_gradients` by default); the critic sees the whole vector. The update is
+back-propagated by hand (:mod:`pamdp.algos.dense`; ``tests/test_dense.py`` holds the autograd form it must
+equal). The maths: docs/algorithms.md, "PADDPG".
 """
 
 from __future__ import annotations

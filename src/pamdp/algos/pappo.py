@@ -1,27 +1,9 @@
 """PAPPO: Proximal Policy Optimization of the hierarchical policy, H-PPO style (Fan et al., IJCAI 2019).
 
-The policy, the sampling and the advantages are PATRPO's (``pi(a,x|s) = pi_d(a|s) pi_c(x|s,a)``, and the
-on-policy family's :class:`~pamdp.algos.onpolicy.Rollout` and :func:`~pamdp.algos.onpolicy.advantage_batch`);
-PPO's clipped surrogate (Schulman et al. 2017, eq. 7) replaces the trust-region step. One epoch:
-
-1. Sample ``batch_size`` steps with ``(a, x) ~ pi_d(a|s) pi_c(x|s,a)`` from the batched env.
-2. Advantages ``A`` by GAE(``gamma``, ``gae_lambda``) from the value network ``V(s)``; the returns
-   ``R = A + V(s)`` are ``V``'s regression targets.
-3. ``n_epochs`` passes over the batch in shuffled minibatches of about ``minibatch_size``, each one Adam step
-   (gradient norm clipped to ``max_grad_norm``) on
-
-       L = -E[min(r A, clip(r, 1 - eps, 1 + eps) A)] + vf_coef E[(V(s) - R)^2]
-           - ent_coef_d E[H(pi_d(.|s))] - ent_coef_c E[sum_a pi_d(a|s) H(pi_c(.|s,a))]
-
-   with the joint ratio ``r = pi(a,x|s) / pi_old(a,x|s) = exp(log pi_d(a|s) + log pi_c(x|s,a) - log pi_old)``
-   and ``eps = clip_range``. The two entropy terms are the chain rule's split of the joint entropy, weighted
-   apart because the discrete one decides which actions keep being tried and the continuous one only
-   widens the parameter noise. With ``target_kl > 0`` the passes stop at the first minibatch whose
-   chain-rule ``KL(pi_old || pi)`` (the paper's ``chain_analytic`` estimator) exceeds it.
-
-Fan et al. clip the discrete and the parameter policies' ratios separately, with parameter heads that do
-not see the discrete action; here ``pi_c`` is conditioned on ``a`` and the ratio is the joint one, so the
-clip bounds the change of the whole hierarchical policy, as PATRPO's KL does.
+The policy, the sampling and the advantages are PATRPO's (the on-policy family's
+:class:`~pamdp.algos.onpolicy.Rollout` and :func:`~pamdp.algos.onpolicy.advantage_batch`); PPO's clipped
+surrogate of the joint ratio ``pi(a,x|s) / pi_old(a,x|s)`` (Schulman et al. 2017, eq. 7) replaces the
+trust-region step. The loss and how it differs from Fan et al.'s: docs/algorithms.md, "PAPPO".
 """
 
 from __future__ import annotations
@@ -117,7 +99,7 @@ def ppo_loss(
     returns: torch.Tensor,
     cfg: PAPPOConfig,
 ) -> tuple[torch.Tensor, dict[str, torch.Tensor]]:
-    """The joint loss ``L`` of the module docstring on a minibatch, and its parts (detached) for logging."""
+    """The joint loss ``L`` of docs/algorithms.md, "PAPPO", on a minibatch, and its parts (detached) for logging."""
     logp = dist.log_prob(a, x)
     policy_loss = clipped_surrogate(logp, old_logp, adv, cfg.clip_range)
     value_loss = (values - returns).pow(2).mean()
@@ -137,7 +119,7 @@ def ppo_loss(
 
 
 class PAPPO(Algorithm):
-    """PPO of the hierarchical policy. See the module docstring for the update and :class:`PAPPOConfig`."""
+    """PPO of the hierarchical policy. See docs/algorithms.md, "PAPPO", for the update and :class:`PAPPOConfig`."""
 
     config_class = PAPPOConfig
     config: PAPPOConfig

@@ -1,26 +1,9 @@
 """PASVG(0): stochastic value gradients through a Gumbel-Softmax hierarchical policy (Wei, Wicke & Luke 2018).
 
-Section "Parameterized Actions SVG(0)" of the paper, in the reparameterised form
-
-    a = f(s, eta_a)     = onehot(argmax(log pi_d(.|s) + eta_a)), eta_a ~ Gumbel(0, 1)^K
-    x = g(s, a, eta_x)  = tanh(mu(s, a) + sigma_a * eta_x),       eta_x ~ N(0, 1)^m
-
-where the argmax is relaxed to ``softmax((log pi_d + eta_a) / temperature)`` for the backward pass (the
-straight-through estimator; with ``straight_through=False`` the critic sees the soft sample itself), and
-``pi_c``'s mean ``mu`` is conditioned on that sample. The objective
-``J = E_s E_eta [Q(s, f(s, eta_a), g(s, f(s, eta_a), eta_x))]`` is differentiable in both policies, so one
-loss ``-Q`` trains ``pi_d`` and ``pi_c`` together. The noise ``eta = (eta_a, eta_x)`` drawn while acting is
-recorded with the transition: as the paper notes, the policy gradient at a replayed state reuses it, with no
-inference of ``p(eta | s, a, x)``.
-
-With ``discrete_gradient="expected"`` (not in the paper) the Gumbel-Softmax estimate of ``pi_d``'s gradient
-is replaced by the exact expectation over the K actions, ``J = E_s E_eta_x [sum_k pi_d(k|s) Q(s, k, g(s, k,
-eta_x))]``, and the TD target likewise averages the target policy's actions: with few actions (K = 3 on
-Platform) the K critic evaluations cost little and remove the straight-through estimator's bias.
-
-The critic ``Q(s, a, x)`` (the action as a one-hot, or the soft sample) is trained by TD from replay against
-target networks updated softly, as in DDPG; the next action in the target is drawn from the target policy
-with fresh noise, so ``Q`` estimates the value of the stochastic policy being optimised.
+Section "Parameterized Actions SVG(0)" of the paper: acting draws Gumbel noise for ``pi_d`` and Gaussian noise
+for ``pi_c``, records it with the transition, and one loss ``-Q(s, f(s, eta_a), g(s, f(s, eta_a), eta_x))``
+trains both policies through the relaxed sample (or, with ``discrete_gradient="expected"``, through the exact
+expectation over the K actions). The maths: docs/algorithms.md, "PASVG(0)".
 """
 
 from __future__ import annotations
@@ -95,17 +78,14 @@ class PASVG0Config(OffPolicyConfig, AlgoConfig):
     )
     explore_epsilon: float = setting(
         0.0,
-        "While collecting, the fraction of steps whose discrete action is drawn uniformly instead of from pi_d "
-        "(with pi_c's parameters for it), so that every action keeps appearing in replay; 0 in the paper. "
-        "The policy update does not see it: it replays the recorded noise through the current policy.",
+        "Fraction of collected discrete actions drawn uniformly instead of from pi_d, so that every action keeps "
+        "appearing in replay (the policy update never sees them; 0 in the paper).",
         interval(0, 1),
     )
     discrete_gradient: str = setting(
         "gumbel",
-        "How pi_d's gradient is estimated: gumbel (the paper) differentiates Q through the Gumbel-Softmax "
-        "sample; expected takes the exact expectation over the K actions, sum_k pi_d(k|s) Q(s, k, x_k), in the "
-        "policy loss and in the TD target (pi_c's parameters for every action from the same recorded eta_x): "
-        "no estimator bias and lower variance, at K critic evaluations per state. Not in the paper.",
+        "pi_d's gradient: gumbel (the paper's, through the Gumbel-Softmax sample) or expected (the exact "
+        "expectation over the K actions, in the policy loss and the TD target; not in the paper).",
         one_of(("gumbel", "expected")),
     )
     twin_critics: bool = setting(
@@ -137,11 +117,7 @@ class PASVG0Config(OffPolicyConfig, AlgoConfig):
 
     PRESETS = {
         "paper": {},
-        # Small networks, 64 batched env copies and a quarter of an update per sample; pi_d's gradient from
-        # the exact expectation over the K actions instead of the Gumbel-Softmax estimate; pi_d's entropy
-        # held at 0.3 nats (of ln 3 = 1.10) by a tuned weight; 5 % of the collected discrete actions
-        # uniform; a fixed parameter noise (std 0.2 before the Tanh). How each choice was reached, and what
-        # it fixed: benchmarks/pasvg_tuning.md.
+        # What each choice is: docs/algorithms.md, "PASVG(0)"; how it was reached: benchmarks/pasvg_tuning.md.
         "tuned": dict(
             num_envs=64,
             hidden_sizes=(128, 128),
@@ -290,7 +266,7 @@ class Critic(nn.Module):
 
 
 class PASVG0(Algorithm):
-    """Parameterized Actions SVG(0). See the module docstring for the update and :class:`PASVG0Config`."""
+    """Parameterized Actions SVG(0). See docs/algorithms.md, "PASVG(0)", for the update and :class:`PASVG0Config`."""
 
     config_class = PASVG0Config
     config: PASVG0Config

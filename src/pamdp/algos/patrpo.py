@@ -1,22 +1,9 @@
 """PATRPO: Trust Region Policy Optimization of the hierarchical policy (Wei, Wicke & Luke 2018).
 
-One epoch, as section "Parameterized Actions TRPO" of the paper reads:
-
-1. Sample ``batch_size`` steps with ``(a, x) ~ pi_d(a|s) pi_c(x|s,a)`` from the batched env.
-2. Advantages by GAE(``gamma``, ``gae_lambda``) from the baseline; a step cut by the time limit (or by the
-   end of the epoch) bootstraps from the baseline, a true termination does not. Then refit the baseline.
-3. Maximise the surrogate ``E[pi(a,x|s) / pi_old(a,x|s) * A]`` subject to ``mean KL(pi_old || pi) <= delta``,
-   the joint KL estimated by ``kl_estimator`` (the chain rule splits it into the discrete KL plus the
-   parameter policy's KL): natural-gradient direction ``H^-1 g`` by conjugate gradient, where each product
-   ``H v`` with the KL's Hessian is one more back-propagation of ``grad(KL) . v`` (Hessian-free, as TRPO's;
-   :class:`~pamdp.algos.trpo.FisherVectorProduct`); step length ``sqrt(2 delta / (d^T H d))``, backtracking
-   line search.
-
-Steps 1 and 2 are the on-policy family's (:mod:`pamdp.algos.onpolicy`). For the chain estimators the KL's
-Hessian in the distribution's own parameters has a closed form, and ``fvp="gauss_newton"`` (the default
-through ``auto``) computes the same product from it with fewer matrix products
-(:func:`~pamdp.algos.trpo.hybrid_gauss_newton_fvp`; the measured gain: ``benchmarks/fvp_speed.md``; a test
-checks that both take the same step).
+One epoch, as section "Parameterized Actions TRPO" of the paper reads: sample and compute advantages (the
+on-policy family's, :mod:`pamdp.algos.onpolicy`), then maximise the surrogate ``E[pi / pi_old * A]`` subject to
+``mean KL(pi_old || pi) <= delta`` by conjugate gradient and a backtracking line search (:mod:`pamdp.algos.trpo`;
+``fvp`` chooses how the Fisher-vector products are computed). The maths: docs/algorithms.md, "PATRPO".
 """
 
 from __future__ import annotations
@@ -139,7 +126,7 @@ class PATRPOConfig(OnPolicyConfig, AlgoConfig):
 
 
 class PATRPO(Algorithm):
-    """Parameterized Actions TRPO. See the module docstring for the update and :class:`PATRPOConfig`."""
+    """Parameterized Actions TRPO. See docs/algorithms.md, "PATRPO", for the update and :class:`PATRPOConfig`."""
 
     config_class = PATRPOConfig
     config: PATRPOConfig

@@ -1,33 +1,9 @@
 """P-DQN and MP-DQN: Q-learning over parameterized actions with a deterministic parameter actor.
 
-P-DQN (Xiong et al. 2018, "Parametrized Deep Q-Networks Learning", arXiv 1810.06394) keeps DQN's
-argmax over the K discrete actions and learns the continuous parameters with a deterministic actor:
-
-- the actor ``x(s)`` outputs the parameters of *every* action, ``x = (x_0, ..., x_{K-1})`` with
-  ``sum_a m_a`` values, each in ``[-1, 1]`` (the units of :class:`~pamdp.spaces.HybridActionSpace`);
-- the Q-network ``Q(s, x)`` outputs K values, ``Q_k`` the value of action ``k`` with parameters ``x_k``;
-- acting: ``k* = argmax_k Q_k(s, x(s))``, executed with its own parameters ``x_{k*}(s)``;
-- ``Q`` is trained by one-step TD on replayed transitions against target networks,
-  ``y = r + gamma max_k Q'_k(s', x'(s'))`` (no bootstrap after a termination), optionally mixed with the
-  Monte-Carlo return as PADDPG does, ``y = beta * MC + (1 - beta) * y`` (``beta``; Bester et al. used such
-  mixed targets on Half Field Offense);
-- the actor ascends ``sum_k Q_k(s, x(s))`` with Q's weights held fixed. Its outputs are kept in ``[-1, 1]``
-  by Hausknecht & Stone's inverting gradients (``bound``; :func:`~pamdp.algos.offpolicy.backprop_actor`).
-
-MP-DQN (Bester, James & Konidaris 2019, "Multi-Pass Q-Networks for Deep Reinforcement Learning with
-Parameterised Action Spaces", arXiv 1905.04388) points out that with the joint input ``Q_k`` depends on the
-parameters of the *other* actions: the greedy choice is swayed by parameters that are never executed, and
-the actor's update of ``x_j`` is pushed by every ``Q_k``, ``k != j``. The multi-pass Q-network evaluates K
-passes, pass ``k`` seeing ``x`` with every block but ``x_k`` zeroed, and reads ``Q_k`` from pass ``k``; the K
-passes are one forward over a batch of ``B * K`` inputs. ``multi_pass = True`` selects it; everything else is
-shared.
-
-The update is back-propagated by hand (:mod:`pamdp.algos.dense`), which pays here
-(``benchmarks/update_speed.md``); ``tests/test_pdqn.py`` holds the autograd form it must equal.
-
-Exploration: epsilon-greedy over the discrete action, epsilon annealed linearly as in PADDPG (with
-``explore_params``, the random action's parameters are drawn uniformly too, Xiong et al.'s random
-exploration), and Ornstein-Uhlenbeck noise on the parameters (``ou_theta = 1`` makes it i.i.d. Gaussian).
+P-DQN (Xiong et al. 2018, arXiv 1810.06394) acts by ``argmax_k Q_k(s, x(s))`` with an actor ``x(s)`` of every
+action's parameters; MP-DQN (Bester, James & Konidaris 2019, arXiv 1905.04388; ``multi_pass = True``) reads
+``Q_k`` from a pass that sees only ``x_k``. The update is back-propagated by hand (:mod:`pamdp.algos.dense`;
+``tests/test_pdqn.py`` holds the autograd form it must equal). The maths: docs/algorithms.md, "P-DQN and MP-DQN".
 """
 
 from __future__ import annotations
@@ -128,10 +104,7 @@ class PDQNConfig(DeterministicActorConfig, OffPolicyConfig, AlgoConfig):
                 "or no passthrough"
             )
 
-    # "paper": Bester et al.'s text as recalled here (not re-read; never their code); grad_clip, learning_starts,
-    # explore_params and the conversion of 1000 episodes to 5 000 samples are assumptions (see the help).
-    # "tuned": the same learning rates and targets with a smaller Q-network and batch, 64 batched env copies
-    # and a quarter of an update per sample (how it learns: benchmarks/later_platform.md).
+    # Both presets: docs/algorithms.md, "P-DQN and MP-DQN"; how "tuned" learns: benchmarks/later_platform.md.
     PRESETS = {
         "paper": {},
         "tuned": dict(
@@ -205,15 +178,11 @@ class ParamActor(nn.Module):
 class QNetwork(nn.Module):
     """``Q(s, x)``: K action values from the state and every action's parameters.
 
-    With ``multi_pass`` (MP-DQN), pass ``k`` sees ``x`` with all blocks but action ``k``'s zeroed and ``Q_k`` is
-    read from it, so ``Q_k`` depends on ``x_k`` alone. The ``K`` passes share all but their inputs' parameter
-    blocks, so their input rows (``B * K`` of width ``d + sum_a m_a``) are never built: the first layer's
-    pre-activation of pass ``k`` is ``W_s s + W_k x_k + b``, one ``(B, h)`` product for the state plus each
-    action's own block, and the output layer computes only ``Q_k`` of pass ``k``. That is the same function at
-    ``K`` times fewer operations in the first and last layers (it was quadratic in ``K``). The passes are one flat
-    batch of ``K * B`` rows, pass ``k``'s a contiguous block (:class:`~pamdp.algos.dense.MultiPassDense`, which
-    also differentiates them by hand for the update; a strided ``(B, K, h)`` layout made every element-wise op and
-    its backward walk memory slowly).
+    With ``multi_pass`` (MP-DQN), ``Q_k`` is read from a pass that sees only ``x_k``. The passes' input rows are
+    never built: pass ``k``'s first layer is ``W_s s + W_k x_k + b`` and its output layer computes ``Q_k`` alone,
+    the same function at ``K`` times fewer operations; the passes are one flat batch of ``K * B`` rows, pass
+    ``k``'s a contiguous block (a strided layout walked memory slowly; :class:`~pamdp.algos.dense.MultiPassDense`
+    differentiates it by hand).
     """
 
     def __init__(self, obs_dim: int, hybrid: HybridActionSpace, hidden_sizes, activation: str, multi_pass: bool):

@@ -1,21 +1,6 @@
-"""The replay buffer shared by the off-policy algorithms (PASVG(0), PADDPG, P-DQN, HyAR).
-
-One preallocated tensor per field on the algorithm's device, written as a ring: the newest transition
-overwrites the oldest once ``capacity`` is reached. The contents live where the update runs, so sampling a
-minibatch is an index on the device, not a copy from host memory for every update; each environment step
-sends its new transitions there once. On the CPU the tensors are created with ``torch.empty``, which reserves
-address space without touching it, so the paper's capacity of 10^7 costs memory only as it fills (10^7
-Platform transitions hold about 0.9 GB once full) and never allocates a Python object per slot; on a GPU
-the whole capacity is allocated at once.
-
-Fields are declared by the algorithm (``{"obs": ((9,), np.float32), "eta_a": ((3,), np.float32), ...}``),
-so algorithm-specific extras such as PASVG(0)'s recorded noise ``eta`` or PADDPG's Monte-Carlo returns
-live beside the usual ``obs, reward, next_obs, terminated``.
-
-Saving the contents in a checkpoint is optional (``state_dict(include_data=...)``): a full buffer is
-large. When a checkpoint holds no contents, a resumed run starts with an empty buffer and refills it,
-waiting for ``learning_starts`` fresh samples before it updates again, so it is not bit-identical to an
-uninterrupted run.
+"""The replay buffer shared by the off-policy algorithms: one preallocated tensor per field on the algorithm's
+device, written as a ring. Why on the device, and what it costs in memory: docs/algorithms.md, "The off-policy
+family"; what a checkpoint keeps of it (``state_dict(include_data=...)``): "Checkpoints and resuming".
 """
 
 from __future__ import annotations

@@ -90,13 +90,9 @@ class FisherVectorProduct:
 
 class GaussNewtonFVP:
     """``v -> (J^T M J + damping I) v``: the Fisher-vector product as a Gauss-Newton product, for a KL whose
-    Hessian ``M`` in the distribution's own parameters is known in closed form.
-
-    At the current parameters the KL's gradient in the distribution's parameters is zero, so the Hessian in
-    the network's parameters is exactly ``J^T M J`` (``J``: the Jacobian of the distribution's parameters in
-    the network's). Each product is then one Jacobian-vector product (forward mode), ``M`` applied, and one
-    backward pass through the retained forward graph: about half the matrix products of double
-    back-propagation (the measured gain: ``benchmarks/fvp_speed.md``), with the same result up to rounding.
+    Hessian ``M`` in the distribution's own parameters is known in closed form (``J``: the Jacobian of the
+    distribution's parameters in the network's). One forward-mode product, ``M``, one backward pass: why it is
+    exact and what it saves, docs/algorithms.md, "PATRPO".
 
     Args:
         outputs: the distribution's parameters, computed from ``params`` with their autograd graph.
