@@ -68,7 +68,8 @@ def test_no_import_circle_in_the_package():
 
 def test_the_circle_finder_finds_a_circle(monkeypatch):
     monkeypatch.setitem(GRAPH, "pamdp.evaluation", GRAPH["pamdp.evaluation"] | {"pamdp.algos.base"})
-    with pytest.raises(AssertionError, match=r"import circle: pamdp\.algos\.base -> pamdp\.evaluation -> pamdp\.algos"):
+    circle = r"import circle: pamdp\.algos\.base -> (pamdp\.callbacks -> )?pamdp\.evaluation -> pamdp\.algos\.base"
+    with pytest.raises(AssertionError, match=circle):
         test_no_import_circle_in_the_package()
 
 

@@ -88,7 +88,10 @@ def test_python_and_the_command_line_give_one_config(tmp_path):
 
 
 def test_a_preset_made_for_another_env_warns_and_the_run_records_it(tmp_path):
-    message = r"preset 'hfo' of PDQNConfig was made for pamdp/HalfFieldOffense-v0, not pamdp/Platform-v0"
+    message = (  # both ids of Half Field Offense, 1v0 and against the goalie, take it
+        r"preset 'hfo' of PDQNConfig was made for pamdp/HalfFieldOffense-v0, pamdp/HalfFieldOffenseGoalie-v0, "
+        r"not pamdp/Platform-v0"
+    )
     with pytest.warns(UserWarning, match=message):
         config = PDQNConfig.preset("hfo", "pamdp/Platform-v0")
     assert config == PDQNConfig.preset("hfo")  # used as asked

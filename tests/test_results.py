@@ -12,7 +12,8 @@ import pytest
 from pamdp import __version__
 from pamdp.cli import main
 from pamdp.experiments import results
-from pamdp.experiments.summary import from_suite_final, load, save, summarize
+from pamdp.experiments.suite import from_suite_final
+from pamdp.experiments.summary import load, save, summarize
 
 ROOT = Path(__file__).resolve().parents[1]
 TINY = ["--hidden-sizes", "16", "--vf-hidden-sizes", "16", "--batch-size", "500", "--num-envs", "4"]

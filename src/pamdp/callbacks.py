@@ -26,12 +26,14 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from pamdp.algos.base import _count, _eval_figures
 from pamdp.evaluation import evaluate
 
 if TYPE_CHECKING:
-    from pamdp.algos.base import Algorithm
     from pamdp.algos.logger import Logger
+
+Algorithm = Any
+"""A model, any :class:`~pamdp.algos.base.Algorithm` (the learn loop in ``pamdp.algos.base`` imports this module,
+so this one names the class without importing it)."""
 
 __all__ = [
     "BaseCallback",
@@ -43,6 +45,24 @@ __all__ = [
     "WandbCallback",
     "as_callback",
 ]
+
+
+def _count(name: str, value: object, low: int) -> int:
+    """``value`` as an integer >= ``low`` (an integral float such as ``1e6`` too), else a ``ValueError`` naming it."""
+    number = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_))
+    if not (number and math.isfinite(value) and value == int(value) and value >= low):
+        raise ValueError(f"{name} = {value!r}; expected an integer >= {low}")
+    return int(value)
+
+
+def _eval_figures(result: dict[str, float]) -> dict[str, float]:
+    """An evaluation's figures as a run logs them: ``eval/mean_return``, ``eval/mean_length`` and, where the env
+    reports success, ``eval/success_rate``."""
+    figures = {"eval/mean_return": result["mean_return"], "eval/mean_length": result["mean_length"]}
+    if "success_rate" in result:
+        figures["eval/success_rate"] = result["success_rate"]
+    return figures
+
 
 WANDB_MISSING = 'the Weights & Biases tracker needs wandb, which is not installed: pip install "pamdp[wandb]"'
 

@@ -12,7 +12,6 @@ one's :class:`~pamdp.algos.onpolicy.Rollout` (``_values`` and ``_learn``). Its s
 
 from __future__ import annotations
 
-import math
 import os
 import time
 import warnings
@@ -31,13 +30,12 @@ from pamdp.algos.checkpoints import CHECKPOINT, FORMAT, atomic_save, read_checkp
 from pamdp.algos.logger import Logger
 from pamdp.algos.settings import AlgoConfig
 from pamdp.algos.vector_env import describe_env, make_vector_env
+from pamdp.callbacks import BaseCallback, _count, _eval_figures, as_callback
 from pamdp.evaluation import evaluate
 from pamdp.spaces import HybridActionSpace
 
 if TYPE_CHECKING:
     from typing_extensions import Self  # typing.Self from Python 3.11
-
-    from pamdp.callbacks import BaseCallback
 
 __all__ = ["Algorithm", "resolve_device"]
 
@@ -69,23 +67,6 @@ def _available(name: str) -> bool:
     except ValueError:
         return False
     return True
-
-
-def _count(name: str, value: object, low: int) -> int:
-    """``value`` as an integer >= ``low`` (an integral float such as ``1e6`` too), else a ``ValueError`` naming it."""
-    number = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_))
-    if not (number and math.isfinite(value) and value == int(value) and value >= low):
-        raise ValueError(f"{name} = {value!r}; expected an integer >= {low}")
-    return int(value)
-
-
-def _eval_figures(result: dict[str, float]) -> dict[str, float]:
-    """An evaluation's figures as a run logs them: ``eval/mean_return``, ``eval/mean_length`` and, where the env
-    reports success, ``eval/success_rate``."""
-    figures = {"eval/mean_return": result["mean_return"], "eval/mean_length": result["mean_length"]}
-    if "success_rate" in result:
-        figures["eval/success_rate"] = result["success_rate"]
-    return figures
 
 
 def _shown(shapes: dict[str, list[int]]) -> str:
@@ -293,7 +274,6 @@ class Algorithm:
             )
         if eval_every > 0 and self.env_id is None:  # before training, not after its first epoch
             raise ValueError("eval_every needs a registered env (an env id); this model's env has none")
-        from pamdp.callbacks import as_callback
 
         callback = as_callback(callback)  # before training, not after its first epoch
         note = self.loop.budget_note(total_timesteps) if total_timesteps > 0 and self.loop is not None else None

@@ -13,10 +13,10 @@ from __future__ import annotations
 
 import dataclasses
 import os
-import re
 from pathlib import Path
 
 from pamdp.experiments.runner import RunSpec
+from pamdp.experiments.summary import _slug
 
 __all__ = ["Experiment", "load_experiment", "available_experiments"]
 
@@ -90,11 +90,6 @@ class Experiment:
             return dataclasses.replace(spec, init_from=str(source)) if spec.init_from else spec
 
         return [(started(spec), str(self.run_dir(root, spec))) for spec in specs]
-
-
-def _slug(label: str) -> str:
-    """A run label as a directory name."""
-    return re.sub(r"[^A-Za-z0-9_.=-]+", "_", label)
 
 
 def load_experiment(name_or_path: str | os.PathLike) -> Experiment:

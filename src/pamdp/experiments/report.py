@@ -12,8 +12,8 @@ import numpy as np
 
 from pamdp.experiments import results
 from pamdp.experiments.plots import EXTRA_FIGURES, aggregate, find_groups, plot_curves, results_table
-from pamdp.experiments.suite import load_finals, merge_finals, plot_domains, suite_finals, suite_table
-from pamdp.experiments.summary import from_suite_final, summarize
+from pamdp.experiments.suite import from_suite_final, load_finals, merge_finals, plot_domains, suite_finals, suite_table
+from pamdp.experiments.summary import summarize
 
 __all__ = ["write_report"]
 

@@ -28,6 +28,7 @@ from pamdp.experiments.runner import env_defaults
 __all__ = [
     "DOMAINS",
     "HYAR_TABLE",
+    "from_suite_final",
     "domain_of",
     "method_of",
     "suite_finals",
@@ -299,3 +300,40 @@ def plot_domains(groups: dict[str, list[Path]], out: str | os.PathLike) -> list[
         name = "domain-" + domain.lower().replace(" ", "-").replace("=", "")
         written += plot_curves(methods, Path(out) / name, domain, metric, x="samples")
     return written
+
+
+def from_suite_final(entry: dict) -> dict:
+    """The summary of a benchmark-suite run known only by its entry of ``suite-finals.json`` (its tree lost): the
+    final figure (the return on Platform, else the success rate), its seed and what the entry recorded of the
+    setting; the env is the entry's domain's. Nothing the entry does not hold is filled in: ``algo``, ``config``,
+    costs and evaluations during training are ``None`` or empty."""
+    from pamdp.experiments.summary import FORMAT, SOURCES
+
+    if not entry.get("final"):  # a run's last greedy evaluation during training: 100 episodes at unknown samples
+        raise ValueError(f"suite entry {entry}: not a final evaluation; expected the entry of a finished run")
+    _, env, env_kwargs = next(d for d in DOMAINS if d[0] == entry["domain"])
+    figure = "mean_return" if entry["domain"] == "Platform" else "success_rate"
+    return {
+        "format": FORMAT,
+        "source": SOURCES[1],
+        "origin": entry["source"],
+        "label": f"{entry['method']} on {entry['domain']}",
+        "algo": None,
+        "preset": entry.get("preset"),
+        "env": env,
+        "env_kwargs": dict(env_kwargs),
+        "seed": entry["seed"],
+        "total_steps": entry.get("total_steps"),
+        "settings_hash": entry.get("settings"),
+        "config": None,
+        "pamdp_version": None,
+        "git_commit": None,
+        "finished": True,
+        "samples": None,
+        "epochs": None,
+        "gradient_updates": None,
+        "cpu_seconds": None,
+        "wall_seconds": None,
+        "evaluations": {"samples": []},
+        "final": {figure: entry["value"]},
+    }

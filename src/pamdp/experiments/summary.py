@@ -12,7 +12,8 @@ be made of any run tree, old or new; ``pamdp train`` and ``pamdp reproduce`` wri
 The results' summaries are committed under ``docs/results/summaries/EXPERIMENT/ARM/seedN.json`` (:func:`save`),
 from which ``docs/gen_results.py`` regenerates the tables of ``docs/results.md``. For runs whose trees were lost
 before summaries existed, the benchmark suite's ``suite-finals.json`` entries are converted
-(:func:`from_suite_final`): such a summary holds only what the entry recorded, and says so in ``source``.
+(``pamdp.experiments.suite.from_suite_final``): such a summary holds only what the entry recorded, and says so in
+``source``.
 """
 
 from __future__ import annotations
@@ -26,7 +27,7 @@ from pathlib import Path
 
 from pamdp.algos.logger import RENAMED, success_of
 
-__all__ = ["FORMAT", "SUMMARY", "git_commit", "summarize", "write_summary", "load", "save", "from_suite_final"]
+__all__ = ["FORMAT", "SUMMARY", "git_commit", "summarize", "write_summary", "load", "save"]
 
 FORMAT = 1
 """The summary's format version, kept in each file: a reader refuses a newer one rather than misread it."""
@@ -176,7 +177,6 @@ def load(path: str | os.PathLike) -> dict:
 def save(summaries: list[dict], root: str | os.PathLike) -> list[Path]:
     """Each summary as ``root/ARM/seedN.json`` (``ARM``: its label as an experiment names its run's directory),
     refusing two summaries of one arm and seed rather than keep one of them silently."""
-    from pamdp.experiments import _slug
 
     paths: dict[Path, dict] = {}
     for summary in summaries:
@@ -195,38 +195,6 @@ def save(summaries: list[dict], root: str | os.PathLike) -> list[Path]:
     return list(paths)
 
 
-def from_suite_final(entry: dict) -> dict:
-    """The summary of a benchmark-suite run known only by its entry of ``suite-finals.json`` (its tree lost): the
-    final figure (the return on Platform, else the success rate), its seed and what the entry recorded of the
-    setting; the env is the entry's domain's. Nothing the entry does not hold is filled in: ``algo``, ``config``,
-    costs and evaluations during training are ``None`` or empty."""
-    from pamdp.experiments.suite import DOMAINS
-
-    if not entry.get("final"):  # a run's last greedy evaluation during training: 100 episodes at unknown samples
-        raise ValueError(f"suite entry {entry}: not a final evaluation; expected the entry of a finished run")
-    _, env, env_kwargs = next(d for d in DOMAINS if d[0] == entry["domain"])
-    figure = "mean_return" if entry["domain"] == "Platform" else "success_rate"
-    return {
-        "format": FORMAT,
-        "source": SOURCES[1],
-        "origin": entry["source"],
-        "label": f"{entry['method']} on {entry['domain']}",
-        "algo": None,
-        "preset": entry.get("preset"),
-        "env": env,
-        "env_kwargs": dict(env_kwargs),
-        "seed": entry["seed"],
-        "total_steps": entry.get("total_steps"),
-        "settings_hash": entry.get("settings"),
-        "config": None,
-        "pamdp_version": None,
-        "git_commit": None,
-        "finished": True,
-        "samples": None,
-        "epochs": None,
-        "gradient_updates": None,
-        "cpu_seconds": None,
-        "wall_seconds": None,
-        "evaluations": {"samples": []},
-        "final": {figure: entry["value"]},
-    }
+def _slug(label: str) -> str:
+    """A run label as a directory name."""
+    return re.sub(r"[^A-Za-z0-9_.=-]+", "_", label)
