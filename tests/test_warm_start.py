@@ -4,9 +4,12 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import gymnasium as gym
 import numpy as np
 import pytest
+import torch
 
 import pamdp  # noqa: F401  (registers the envs)
 from pamdp.algos import ALGORITHMS, algorithm_class
@@ -135,3 +138,19 @@ settings = { num_envs = 2, batch_size = 200 }
     (first / "final_model.pt").rename(first / "checkpoint.pt")  # as a run still training leaves it
     with pytest.raises(ValueError, match="holds no final_model.pt"):
         _warm_start(algorithm_class("patrpo")("pamdp/Platform-v0"), str(first), log=lambda msg: None)
+
+
+def test_kept_tensors_stay_the_new_models_own(tmp_path):
+    """PATRPO's exploration (``policy.log_std``) kept from the new model's settings while the rest is the source's."""
+    patrpo = algorithm_class("patrpo")
+    source = patrpo(ONE_V_ZERO, patrpo.config_class.preset("tuned"))
+    source.save(tmp_path / "source.pt")
+    model = patrpo(ONE_V_ONE, dataclasses.replace(source.config, init_log_std=-2.0))
+    report = transfer_weights(
+        model, tmp_path / "source.pt", list(range(58)) + [None] * 9 + [58], keep=("policy.log_std",)
+    )
+    assert report["policy.log_std"] == "kept" and report["policy.pi_d.0.weight"] == "inputs mapped"
+    torch.testing.assert_close(model.policy.log_std.detach(), torch.full_like(model.policy.log_std, -2.0))
+    torch.testing.assert_close(model.policy.pi_c[2].weight, source.policy.pi_c[2].weight)
+    with pytest.raises(ValueError, match="keep names policy.bogus; expected tensors of the model"):
+        transfer_weights(model, tmp_path / "source.pt", [None] * 68, keep=("policy.bogus",))
