@@ -182,12 +182,11 @@ class ParticleDomain(Domain):
         self.last_actions, self.last_params = np.full(n, -1, dtype=np.int64), np.zeros(n)  # for the pictures
         return np.zeros((n, STATE_SIZE))
 
-    def reset(self, env, mask, options, seeded):
+    def reset(self, env, mask, options, seeded, obs):
         reset_copies(env._states, mask, env.streams.buffers, env.streams.cursors)
         self.last_actions[mask] = -1
-        obs = np.empty((env.num_envs, OBS_SIZE))
         observe(env._states, obs)
-        return obs, self.infos(env)
+        return self.infos(env)
 
     def infos(self, env, stepped=None, success=None) -> dict:
         """The batched ``info`` of a reset (``stepped`` None) or a step."""

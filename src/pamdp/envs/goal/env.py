@@ -87,19 +87,18 @@ class Goal(Domain):
         kick = a == dyn.KICK_TO
         return kick, np.where(kick, x, dyn.SHOOT_X), np.where(kick, x, y)
 
-    def reset(self, env, mask, options, seeded):
+    def reset(self, env, mask, options, seeded, obs):
         dyn.reset_copies(env._states, mask, env.streams.buffers, env.streams.cursors)
         self.substeps = 0
-        return self._observe(env), every_copy(env.num_envs, substeps=np.zeros(env.num_envs, dtype=np.int64))
+        dyn.observe(env._states, obs)
+        return every_copy(env.num_envs, substeps=np.zeros(env.num_envs, dtype=np.int64))
 
-    def step(self, env, parsed, resetting):
+    def step(self, env, parsed, resetting, obs, rewards, terminated, truncated):
         """A copy whose numbers run out mid-step stops; its numbers are topped up and the copies still pending
         resume (a shot can take more numbers than a copy keeps drawn ahead)."""
         (kick, tx, ty), n, streams = parsed, env.num_envs, env.streams
         dyn.reset_copies(env._states, resetting, streams.buffers, streams.cursors)
-        rewards, substeps = np.zeros(n), np.zeros(n, dtype=np.int64)
-        terminated, truncated = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
-        pending = ~resetting
+        substeps, pending = np.zeros(n, dtype=np.int64), ~resetting
         trace = self.trace if n == 1 and env.render_mode else NO_TRACE
         while dyn.step_copies(
             env._states, kick, tx, ty, pending, streams.buffers, streams.cursors, substeps, rewards, terminated,
@@ -111,12 +110,8 @@ class Goal(Domain):
         self.substeps = int(substeps[0])
         infos = every_copy(n, substeps=substeps)
         infos["is_success"], infos["_is_success"] = terminated & (rewards == dyn.GOAL_REWARD), terminated | truncated
-        return self._observe(env), rewards, terminated, truncated, infos
-
-    def _observe(self, env):
-        out = np.empty((env.num_envs, dyn.OBS_SIZE))
-        dyn.observe(env._states, out)
-        return out
+        dyn.observe(env._states, obs)
+        return infos
 
     def frame(self, env, i):
         return draw_goal(*(env._states[i, k] for k in _DRAWN))

@@ -87,20 +87,17 @@ class GymHybrid(Domain):
             )
         return a, columns[0], columns[1]
 
-    def reset(self, env, mask, options, seeded):
-        obs = np.empty((env.num_envs, dyn.OBS_SIZE))
+    def reset(self, env, mask, options, seeded, obs):
         dyn.reset_copies(env._states, mask, self.settings, env.streams.buffers, env.streams.cursors, obs)
-        return obs, {}
+        return {}
 
-    def step(self, env, parsed, resetting):
-        (a, p_accelerate, p_turn), n, streams = parsed, env.num_envs, env.streams
-        obs, rewards = np.empty((n, dyn.OBS_SIZE)), np.empty(n)
-        terminated, goal = np.empty(n, dtype=bool), np.empty(n, dtype=bool)
+    def step(self, env, parsed, resetting, obs, rewards, terminated, truncated):
+        (a, p_accelerate, p_turn), streams, goal = parsed, env.streams, np.empty(env.num_envs, dtype=bool)
         dyn.step_copies(
             env._states, a, p_accelerate, p_turn, resetting, self.settings, self.sliding,
             streams.buffers, streams.cursors, obs, rewards, terminated, goal,
         )  # fmt: skip
-        return obs, rewards, terminated, np.zeros(n, dtype=bool), {"is_success": goal, "_is_success": terminated.copy()}
+        return {"is_success": goal, "_is_success": terminated.copy()}
 
     def frame(self, env, i):
         return draw_gym_hybrid(env._states[i], self.sliding)

@@ -69,9 +69,8 @@ class HardMove(particle.ParticleDomain):
             raise ValueError(f"parameter {j} contains {params[j][~finite[j]]}; expected {expected}")
         return a, params[a, np.arange(n)].astype(np.float64, copy=False)
 
-    def step(self, env, parsed, resetting):
-        (a, p), n, streams = parsed, env.num_envs, env.streams
-        obs, rewards, terminated = np.empty((n, particle.OBS_SIZE)), np.zeros(n), np.zeros(n, dtype=bool)
+    def step(self, env, parsed, resetting, obs, rewards, terminated, truncated):
+        (a, p), streams = parsed, env.streams
         particle.hard_move_copies(
             env._states, a, p, self.motions, resetting, streams.buffers, streams.cursors, obs, rewards, terminated
         )
@@ -79,7 +78,7 @@ class HardMove(particle.ParticleDomain):
             self.last_actions[:] = np.where(resetting, -1, a)
             self.last_params[:] = p
         # As Gymnasium's vector envs merge the scalar envs' infos: a copy that was reset reports nothing.
-        return obs, rewards, terminated, np.zeros(n, dtype=bool), self.infos(env, ~resetting, terminated.copy())
+        return self.infos(env, ~resetting, terminated.copy())
 
     def frame(self, env, i):
         a = int(self.last_actions[i])

@@ -93,29 +93,25 @@ class HalfFieldOffense(Domain):
     def check_options(self, options, n):
         reset_options(options, n, shell_keys=("reset_mask",), goalie=self.goalie)
 
-    def reset(self, env, mask, options, seeded):
+    def reset(self, env, mask, options, seeded, obs):
         placements = reset_options(options, env.num_envs, shell_keys=("reset_mask",), goalie=self.goalie)
         self._follow(env)
         env._states[mask & seeded, dyn.BODY] = 0.0  # a new server run faces the goal
         for i in np.flatnonzero(mask & seeded) if self.goalie else ():
             defense.new_goalie(env._states[i])  # and starts a new goalie program
-        obs = np.empty((env.num_envs, self.n_features), dtype=np.float32)
         self._reset_batch(env._states, self.copy_streams, mask, self.settings, placements, obs)
-        return obs, self._infos(env)
+        return self._infos(env)
 
-    def step(self, env, parsed, resetting):
-        (a, dash, turn, kick), n = parsed, env.num_envs
+    def step(self, env, parsed, resetting, obs, rewards, terminated, truncated):
+        (a, dash, turn, kick), status = parsed, np.empty(env.num_envs, dtype=np.int64)
         self._follow(env)
-        obs = np.empty((n, self.n_features), dtype=np.float32)
-        reward, status = np.empty(n), np.empty(n, dtype=np.int64)
-        terminated, truncated = np.empty(n, dtype=bool), np.empty(n, dtype=bool)
         self._step_batch(
-            env._states, self.copy_streams, a, dash, turn, kick, resetting, self.settings, obs, reward, status,
+            env._states, self.copy_streams, a, dash, turn, kick, resetting, self.settings, obs, rewards, status,
             terminated, truncated,
         )  # fmt: skip
         infos = self._infos(env, status)
         infos["is_success"], infos["_is_success"] = status == dyn.GOAL, terminated | truncated
-        return obs, reward, terminated, truncated, infos
+        return infos
 
     def _infos(self, env, status=None) -> dict:
         names = _STATUS_NAMES[status] if status is not None else np.full(env.num_envs, "IN_GAME")
