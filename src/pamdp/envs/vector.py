@@ -47,14 +47,16 @@ def split_actions(actions, domain: str, n: int, expected: str, n_actions=None, n
     return a, params
 
 
-def column(p, n: int, name: int | str, expected: str) -> np.ndarray:
-    """One number of ``n`` copies given ``(n,)`` or ``(n, 1)``, numeric, as an ``(n,)`` array (dtype kept); else a
-    ``ValueError`` naming ``name`` (an int ``i``: "parameter i")."""
-    p = np.asarray(p)
-    if p.shape not in ((n,), (n, 1)) or p.dtype.kind not in "iuf":
-        name = f"parameter {name}" if isinstance(name, int) else name
+def column(p, n: int, name: int | str, expected: str, size: int = 1, finite: bool = False) -> np.ndarray:
+    """The first number of ``n`` copies' parameters given ``(n, size)`` (one number: or ``(n,)``), numeric (all finite
+    if ``finite``), as an ``(n,)`` array (dtype kept); else a ``ValueError`` naming ``name`` (an int ``i``: "parameter
+    i") and the bad value."""
+    p, name = np.asarray(p), f"parameter {name}" if isinstance(name, int) else name
+    if p.shape not in ((n, size), (n,) if size == 1 else (n, size)) or p.dtype.kind not in "iuf":
         raise ValueError(f"invalid {name} of shape {p.shape}: {shown(p)}; expected {expected}")
-    return p.reshape(n)
+    if finite and not np.isfinite(p).all():
+        raise ValueError(f"{name} contains {p[~np.isfinite(p)]}; expected {expected}")
+    return p.reshape(n, size)[:, 0]
 
 
 def hybrid_space(*boxes) -> spaces.Tuple:

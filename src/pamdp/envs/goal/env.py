@@ -10,7 +10,7 @@ from gymnasium import spaces
 import pamdp.envs.goal.dynamics as dyn
 from pamdp.envs.goal.render import RENDER_FPS, draw_goal
 from pamdp.envs.scalar import env_classes
-from pamdp.envs.vector import Domain, every_copy, hybrid_space, shown, split_actions
+from pamdp.envs.vector import Domain, column, every_copy, hybrid_space, split_actions
 
 __all__ = ["Goal", "GoalEnv", "HardGoalEnv", "GoalVectorEnv", "HardGoalVectorEnv", "hard_goal_shot"]
 
@@ -69,15 +69,8 @@ class Goal(Domain):
             f"of shape ({n}, 2) and each other p of shape ({n}, 1) or ({n},)"
         )
         a, params = split_actions(actions, self.name, n, expected, k, k)
-        columns = []
-        for i, (p, box) in enumerate(zip(params, self.action_space[1])):
-            p, size = np.asarray(p), box.shape[0]
-            if p.shape not in ((n, size), (n,) if size == 1 else (n, size)) or p.dtype.kind not in "iuf":
-                raise ValueError(f"invalid parameter {i} of shape {p.shape}: {shown(p)}; expected {expected}")
-            p = p.reshape(n, size).astype(np.float64)
-            if not np.isfinite(p).all():
-                raise ValueError(f"parameter {i} contains {p[~np.isfinite(p)]}; expected {expected}")
-            columns.append(p[:, 0])
+        boxes = enumerate(zip(params, self.action_space[1]))
+        columns = [column(p, n, i, expected, box.shape[0], finite=True).astype(np.float64) for i, (p, box) in boxes]
         a = a.astype(np.int64)
         x = np.clip(columns[0], KICK_LOW[0], KICK_HIGH[0])
         y = np.stack(columns[1:])[np.maximum(a - 1, 0), np.arange(n)]

@@ -58,9 +58,7 @@ class Platform(Domain):
             f"array of shape ({n}, 1) or ({n},)"
         )
         a, params = split_actions(actions, self.name, n, expected, 3, 3)
-        columns = np.empty((3, n))
-        for i, p in enumerate(params):
-            columns[i] = column(p, n, i, expected)
+        columns = np.array([column(p, n, i, expected) for i, p in enumerate(params)], dtype=np.float64)
         chosen = np.empty(n)
         bad = physics.choose(a, columns, chosen)
         if bad >= 0:
