@@ -8,31 +8,15 @@ import numpy as np
 from gymnasium import spaces
 
 import pamdp.envs.goal.dynamics as dyn
+from pamdp.envs.goal.dynamics import hard_goal_shot
 from pamdp.envs.goal.render import RENDER_FPS, draw_goal
 from pamdp.envs.scalar import env_classes
 from pamdp.envs.vector import Domain, column, every_copy, hybrid_space, split_actions
 
 __all__ = ["Goal", "GoalEnv", "HardGoalEnv", "GoalVectorEnv", "HardGoalVectorEnv", "hard_goal_shot"]
 
-KICK_LOW, KICK_HIGH = np.array([0.0, -15.0]), np.array([40.0, 15.0])
-"""Kick-to's box, also the float64 bounds its parameters are clipped to."""
-HARD_GOAL_INTERVALS = ((-1.0, -0.6), (-0.6, -0.2), (0.2, 0.2), (0.2, 0.6), (0.6, 1.0))
-"""HyAR's five parts of the goal mouth, as positions in [-1, 1]; the third is HyAR's typo for
-[-0.2, 0.2], so actions 3 and 8 always aim at the same point."""
-_SLOPE = np.array([(lo - hi) / 2 for lo, hi in HARD_GOAL_INTERVALS])
-_OFFSET = np.array([lo - 1 * m for (lo, _), m in zip(HARD_GOAL_INTERVALS, _SLOPE)])
-_SHOT_RANGE, _SHOT_LOW = 14.020000457763672, -7.010000228881836
-"""Goal's float32 shoot box, its width computed in float32, through which MP-DQN scales a position."""
 _DRAWN = (dyn.PX, dyn.PY, dyn.PHI, dyn.KX, dyn.KY, dyn.PSI, dyn.BX, dyn.BY)
 NO_TRACE = np.empty((0, dyn.TRACE_SIZE))
-
-
-def hard_goal_shot(j, p):
-    """The goal-line y that Hard Goal's shot into part ``j`` (0..4) with parameter ``p`` aims at, before
-    Goal's clip: HyAR's ``q = p * m_j + o_j`` (p = +1 gives the part's lower end; ``p`` is not clipped)
-    scaled from [-1, 1] onto Goal's shoot box. Works on arrays."""
-    q = p * _SLOPE[j] + _OFFSET[j]
-    return (_SHOT_RANGE * (q + 1)) / 2.0 + _SHOT_LOW
 
 
 class Goal(Domain):
@@ -46,7 +30,7 @@ class Goal(Domain):
     def __init__(self, hard: bool = False):
         self.hard = bool(hard)
         lo, hi, k = (-1.0, 1.0, 10) if self.hard else (-dyn.HALF_GOAL, dyn.HALF_GOAL, 2)
-        self.action_space = hybrid_space((KICK_LOW, KICK_HIGH, 2), *[(lo, hi, 1)] * k)
+        self.action_space = hybrid_space((dyn.KICK_LOW, dyn.KICK_HIGH, 2), *[(lo, hi, 1)] * k)
         self.observation_space = spaces.Box(-np.inf, np.inf, shape=(dyn.OBS_SIZE,), dtype=np.float64)
         self.trace = np.empty((256, dyn.TRACE_SIZE))  # the scalar env's sub-steps, grown for a long step
         self.substeps = 0
@@ -60,9 +44,7 @@ class Goal(Domain):
         }
 
     def parse(self, actions, n):
-        """Each copy's ``(kick, tx, ty)`` for ``dynamics.step``: kick-to aims at ``(x, x)`` with ``x`` clipped
-        into [0, 40], a shot at ``(20.4, y)`` with ``y`` (Hard Goal: :func:`hard_goal_shot`'s) clipped into
-        [-7.01, 7.01]."""
+        """Each copy's ``(kick, tx, ty)`` for ``dynamics.step_copies`` (see ``dynamics.targets``)."""
         k = self.action_space[0].n
         expected = (
             f"(a, (p_0, ..., p_{k - 1})) with a an int array of shape ({n},) in 0..{k - 1}, p_0 a finite array "
@@ -71,14 +53,7 @@ class Goal(Domain):
         a, params = split_actions(actions, self.name, n, expected, k, k)
         boxes = enumerate(zip(params, self.action_space[1]))
         columns = [column(p, n, i, expected, box.shape[0], finite=True).astype(np.float64) for i, (p, box) in boxes]
-        a = a.astype(np.int64)
-        x = np.clip(columns[0], KICK_LOW[0], KICK_HIGH[0])
-        y = np.stack(columns[1:])[np.maximum(a - 1, 0), np.arange(n)]
-        if self.hard:
-            y = hard_goal_shot((np.maximum(a, 1) - 1) % 5, y)
-        y = np.clip(y, -dyn.HALF_GOAL, dyn.HALF_GOAL)
-        kick = a == dyn.KICK_TO
-        return kick, np.where(kick, x, dyn.SHOOT_X), np.where(kick, x, y)
+        return dyn.targets(a.astype(np.int64), columns, self.hard)
 
     def reset(self, env, mask, options, seeded, obs):
         dyn.reset_copies(env._states, mask, env.streams.buffers, env.streams.cursors)

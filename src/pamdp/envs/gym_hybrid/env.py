@@ -5,13 +5,11 @@ domain's batched actions, ``state`` and ``info``"."""
 
 from __future__ import annotations
 
-import math
-import numbers
-
 import numpy as np
 from gymnasium import spaces
 
 import pamdp.envs.gym_hybrid.dynamics as dyn
+from pamdp.envs.gym_hybrid.dynamics import check_settings
 from pamdp.envs.gym_hybrid.render import RENDER_FPS, draw_gym_hybrid
 from pamdp.envs.scalar import env_classes
 from pamdp.envs.vector import Domain, column, hybrid_space, split_actions
@@ -24,24 +22,6 @@ ACTION_FORM = "(a, (p_accelerate, p_turn, p_break)) with a in {0, 1, 2}, p_accel
 def gym_hybrid_action_space() -> spaces.Tuple:
     """``Tuple(Discrete(3), Tuple(Box(0, 1, (1,)), Box(-1, 1, (1,)), Box(0,)))``, float32 (break: no parameter)."""
     return hybrid_space((0.0, 1.0, 1), (-1.0, 1.0, 1), (0.0, 0.0, 0))
-
-
-def check_settings(**settings) -> np.ndarray:
-    """The original constructor's settings (``dynamics.SETTING_NAMES``; missing ones take
-    ``dynamics.DEFAULTS``) as the settings row of the compiled functions, or ``ValueError`` naming a bad one."""
-    row = dyn.DEFAULTS.copy()
-    for name, v in settings.items():
-        if name not in dyn.SETTING_NAMES:
-            raise ValueError(f"unknown setting {name!r}; expected one of {list(dyn.SETTING_NAMES)}")
-        if name == "max_step":
-            if isinstance(v, bool) or not isinstance(v, numbers.Integral) or v < 1:
-                raise ValueError(f"max_step={v!r}; expected a positive integer")
-        elif isinstance(v, bool) or not isinstance(v, numbers.Real) or not math.isfinite(v):
-            raise ValueError(f"{name}={v!r}; expected a finite number")
-        elif name != "penalty" and v <= 0:
-            raise ValueError(f"{name}={v!r}; expected a positive number")
-        row[dyn.SETTING_NAMES.index(name)] = float(v)
-    return row
 
 
 class GymHybrid(Domain):
