@@ -192,6 +192,17 @@ class ParticleDomain(Domain):
         """The batched ``info`` of a reset (``stepped`` None) or a step."""
         return {} if stepped is None else {"is_success": success, "_is_success": stepped}
 
+    def stepped(self, env, resetting, a, p, success) -> dict:
+        """The end of a step: the actions ``(a, p)`` the pictures show (none where a copy was reset) and the batched
+        ``info`` (as Gymnasium's vector envs merge the scalar envs' infos: a copy that was reset reports nothing)."""
+        if env.render_mode is not None:
+            self.last_actions[:], self.last_params[:] = np.where(resetting, -1, a), p
+        return self.infos(env, ~resetting, success)
+
+    def shown_action(self, i: int) -> int | None:
+        """Copy ``i``'s last action, None after a reset."""
+        return None if self.last_actions[i] < 0 else int(self.last_actions[i])
+
 
 # --- the top view both domains draw ----------------------------------------------------------------
 VIEW = 2.0

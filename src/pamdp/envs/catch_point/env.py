@@ -56,17 +56,14 @@ class CatchPoint(particle.ParticleDomain):
         )
         if bad >= 0:
             raise ValueError(f"copy {bad}: action {a[bad]} with angle {theta[bad]}; expected {expected_actions(n)}")
-        if env.render_mode is not None:
-            self.last_actions[:] = np.where(resetting, -1, a)
-        return self.infos(env, ~resetting, caught)
+        return self.stepped(env, resetting, a, theta, caught)
 
     def infos(self, env, stepped=None, success=None) -> dict:
         fails = every_copy(env.num_envs, failed_catches=env._states[:, particle.FAILS].astype(np.int64))
         return fails | super().infos(env, stepped, success)
 
     def frame(self, env, i):
-        a = int(self.last_actions[i])
-        return draw_catch_point(env._states[i], None if a < 0 else a)
+        return draw_catch_point(env._states[i], self.shown_action(i))
 
 
 CatchPointEnv, CatchPointVectorEnv = env_classes(CatchPoint, __name__, "CatchPointEnv", "CatchPointVectorEnv")

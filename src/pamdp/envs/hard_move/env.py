@@ -74,15 +74,10 @@ class HardMove(particle.ParticleDomain):
         particle.hard_move_copies(
             env._states, a, p, self.motions, resetting, streams.buffers, streams.cursors, obs, rewards, terminated
         )
-        if env.render_mode is not None:
-            self.last_actions[:] = np.where(resetting, -1, a)
-            self.last_params[:] = p
-        # As Gymnasium's vector envs merge the scalar envs' infos: a copy that was reset reports nothing.
-        return self.infos(env, ~resetting, terminated.copy())
+        return self.stepped(env, resetting, a, p, terminated.copy())
 
     def frame(self, env, i):
-        a = int(self.last_actions[i])
-        return draw_hard_move(env._states[i], self.n, None if a < 0 else a, float(self.last_params[i]))
+        return draw_hard_move(env._states[i], self.n, self.shown_action(i), float(self.last_params[i]))
 
 
 def _gather(params, a, n: int, expected: str) -> np.ndarray:
