@@ -238,11 +238,9 @@ class DomainVectorEnv(Shell, VectorEnv):
         """
         self._check_options(options, self.num_envs, shell_keys=("reset_mask",))
         seeded = np.array([s is not None for s in copy_seeds(seed, self.num_envs)])
-        mask = np.ones(self.num_envs, dtype=bool)
-        if options is not None and "reset_mask" in options:
-            mask = np.asarray(options["reset_mask"])
-            if mask.shape != (self.num_envs,) or mask.dtype != np.bool_:
-                raise ValueError(f"reset_mask must be a bool array of shape ({self.num_envs},), got {shown(mask)}")
+        mask = np.asarray((options or {}).get("reset_mask", np.ones(self.num_envs, dtype=bool)))
+        if mask.shape != (self.num_envs,) or mask.dtype != np.bool_:
+            raise ValueError(f"reset_mask must be a bool array of shape ({self.num_envs},), got {shown(mask)}")
         self.streams.seed(seed)
         self.streams.refill(self.draws_per_step)
         obs = self._outputs()[0]

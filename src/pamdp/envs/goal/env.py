@@ -16,7 +16,6 @@ from pamdp.envs.vector import Domain, column, every_copy, hybrid_space, split_ac
 __all__ = ["Goal", "GoalEnv", "HardGoalEnv", "GoalVectorEnv", "HardGoalVectorEnv", "hard_goal_shot"]
 
 _DRAWN = (dyn.PX, dyn.PY, dyn.PHI, dyn.KX, dyn.KY, dyn.PSI, dyn.BX, dyn.BY)
-NO_TRACE = np.empty((0, dyn.TRACE_SIZE))
 
 
 class Goal(Domain):
@@ -67,7 +66,7 @@ class Goal(Domain):
         (kick, tx, ty), n, streams = parsed, env.num_envs, env.streams
         dyn.reset_copies(env._states, resetting, streams.buffers, streams.cursors)
         substeps, pending = np.zeros(n, dtype=np.int64), ~resetting
-        trace = self.trace if n == 1 and env.render_mode else NO_TRACE
+        trace = self.trace if n == 1 and env.render_mode else self.trace[:0]  # no rows: no record
         while dyn.step_copies(
             env._states, kick, tx, ty, pending, streams.buffers, streams.cursors, substeps, rewards, terminated,
             truncated, trace,

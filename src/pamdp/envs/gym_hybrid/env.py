@@ -53,10 +53,8 @@ class GymHybrid(Domain):
         """``a`` (n,) and the accelerate and turn parameters (n,), float32 or float64 as given, not yet clipped."""
         expected = f"{ACTION_FORM} arrays of shape ({n}, 1) or ({n},), p_break of shape ({n}, 0); a of shape ({n},)"
         a, params = split_actions(actions, self.name, n, expected, n_params=3)
-        columns = []
-        for i in range(2):
-            p = column(params[i], n, i, expected)
-            columns.append(p if p.dtype in (np.float32, np.float64) else p.astype(np.float64))
+        columns = [column(params[i], n, i, expected) for i in range(2)]
+        columns = [p if p.dtype in (np.float32, np.float64) else p.astype(np.float64) for p in columns]
         if np.shape(params[2]) != (n, 0):
             raise ValueError(f"invalid break parameters of shape {np.shape(params[2])}; expected {expected}")
         bad = dyn.first_bad_action(a, *columns)  # one compiled pass instead of a NumPy pass per check

@@ -43,8 +43,7 @@ class HalfFieldOffense(Domain):
         # The goalie's block (8 features) and its uniform number come before the last-action flag.
         self.n_features = self.profile.n_features + (9 if self.profile.n_features == 59 else 8) * self.goalie
         if self.goalie:
-            self.state_size = defense.STATE_SIZE
-            self.name = "Half Field Offense 1v1"
+            self.state_size, self.name = defense.STATE_SIZE, "Half Field Offense 1v1"
         self._step_batch = defense.step_batch if self.goalie else dyn.step_batch
         self._reset_batch = defense.reset_batch if self.goalie else dyn.reset_batch
         self.feature_names = interface.feature_names(self.profile.n_features, self.goalie)

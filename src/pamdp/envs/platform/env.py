@@ -14,8 +14,6 @@ from pamdp.envs.vector import Domain, column, every_copy, hybrid_space, split_ac
 
 __all__ = ["Platform", "PlatformEnv", "PlatformVectorEnv", "ZeroNoise", "platform_action_space"]
 
-NO_TRACE = np.empty((0, physics.TRACE_SIZE))
-
 
 class ZeroNoise:
     """A stand-in for a generator whose standard normals are all zero: the noise-free dynamics (assigned after
@@ -75,7 +73,7 @@ class Platform(Domain):
     def step(self, env, parsed, resetting, obs, rewards, terminated, truncated):
         (a, p), streams, substeps = parsed, env.streams, np.zeros(env.num_envs, dtype=np.int64)
         env._states[resetting] = physics.INITIAL_STATE
-        trace = self.trace if env.num_envs == 1 and env.render_mode else NO_TRACE
+        trace = self.trace if env.num_envs == 1 and env.render_mode else self.trace[:0]  # no rows: no record
         physics.step_copies(
             env._states, a, p, ~resetting, streams.buffers, streams.cursors, rewards, terminated, substeps, trace
         )
