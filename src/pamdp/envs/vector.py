@@ -51,12 +51,13 @@ def column(p, n: int, name: int | str, expected: str, size: int = 1, finite: boo
     """The first number of ``n`` copies' parameters given ``(n, size)`` (one number: or ``(n,)``), numeric (all finite
     if ``finite``), as an ``(n,)`` array (dtype kept); else a ``ValueError`` naming ``name`` (an int ``i``: "parameter
     i") and the bad value."""
-    p, name = np.asarray(p), f"parameter {name}" if isinstance(name, int) else name
-    if p.shape not in ((n, size), (n,) if size == 1 else (n, size)) or p.dtype.kind not in "iuf":
-        raise ValueError(f"invalid {name} of shape {p.shape}: {shown(p)}; expected {expected}")
-    if finite and not np.isfinite(p).all():
-        raise ValueError(f"{name} contains {p[~np.isfinite(p)]}; expected {expected}")
-    return p.reshape(n, size)[:, 0]
+    p = np.asarray(p)
+    bad = p.shape not in ((n, size), (n,) if size == 1 else (n, size)) or p.dtype.kind not in "iuf"
+    if bad or finite and not np.isfinite(p).all():  # (the message is built only here: a step checks many)
+        name = f"parameter {name}" if isinstance(name, int) else name
+        found = f"invalid {name} of shape {p.shape}: {shown(p)}" if bad else f"{name} contains {p[~np.isfinite(p)]}"
+        raise ValueError(f"{found}; expected {expected}")
+    return p.reshape(n) if size == 1 else p[:, 0]
 
 
 def hybrid_space(*boxes) -> spaces.Tuple:

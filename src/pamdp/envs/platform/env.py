@@ -58,10 +58,9 @@ class Platform(Domain):
         a, params = split_actions(actions, self.name, n, expected, 3, 3)
         columns = np.array([column(p, n, i, expected) for i, p in enumerate(params)], dtype=np.float64)
         chosen = np.empty(n)
-        bad = physics.choose(a, columns, chosen)
-        if bad >= 0:
-            p = columns[bad]
-            raise ValueError(f"parameter {bad} contains {p[~np.isfinite(p)]}; expected {expected}")
+        j = physics.choose(a, columns, chosen)
+        if j >= 0:
+            raise ValueError(f"parameter {j} contains {columns[j][~np.isfinite(columns[j])]}; expected {expected}")
         return a.astype(np.int64, copy=False), chosen
 
     def reset(self, env, mask, options, seeded, obs):
