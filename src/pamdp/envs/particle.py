@@ -182,16 +182,26 @@ class ParticleDomain(Domain):
         self.last_actions, self.last_params = np.full(n, -1, dtype=np.int64), np.zeros(n)  # for the pictures
         return np.zeros((n, STATE_SIZE))
 
-    def reset(self, env, mask, options, seeded):
+    def reset(self, env, mask, options, seeded, obs):
         reset_copies(env._states, mask, env.streams.buffers, env.streams.cursors)
         self.last_actions[mask] = -1
-        obs = np.empty((env.num_envs, OBS_SIZE))
         observe(env._states, obs)
-        return obs, self.infos(env)
+        return self.infos(env)
 
     def infos(self, env, stepped=None, success=None) -> dict:
         """The batched ``info`` of a reset (``stepped`` None) or a step."""
         return {} if stepped is None else {"is_success": success, "_is_success": stepped}
+
+    def stepped(self, env, resetting, a, p, success) -> dict:
+        """The end of a step: the actions ``(a, p)`` the pictures show (none where a copy was reset) and the batched
+        ``info`` (as Gymnasium's vector envs merge the scalar envs' infos: a copy that was reset reports nothing)."""
+        if env.render_mode is not None:
+            self.last_actions[:], self.last_params[:] = np.where(resetting, -1, a), p
+        return self.infos(env, ~resetting, success)
+
+    def shown_action(self, i: int) -> int | None:
+        """Copy ``i``'s last action, None after a reset."""
+        return None if self.last_actions[i] < 0 else int(self.last_actions[i])
 
 
 # --- the top view both domains draw ----------------------------------------------------------------

@@ -62,7 +62,8 @@ class DomainEnv(Shell, gymnasium.Env):
         self.streams.follow(0, self.np_random)
         if self.domain.reset_draws:
             self.streams.refill(self.domain.reset_draws)
-        obs, infos = self.domain.reset(self, np.ones(1, dtype=bool), options, np.array([seed is not None]))
+        obs = self._outputs()[0]
+        infos = self.domain.reset(self, np.ones(1, dtype=bool), options, np.array([seed is not None]), obs)
         self._started = True
         self._elapsed = 0
         return obs[0], _first(infos)
@@ -74,7 +75,8 @@ class DomainEnv(Shell, gymnasium.Env):
         self.streams.follow(0, self.np_random)
         if self.domain.step_draws:
             self.streams.refill(self.domain.step_draws)
-        obs, rewards, terminated, truncated, infos = self.domain.step(self, parsed, self._calm)
+        obs, rewards, terminated, truncated = out = self._outputs()
+        infos = self.domain.step(self, parsed, self._calm, *out)
         self._elapsed += 1
         limited = self.max_episode_steps is not None and self._elapsed >= self.max_episode_steps
         return obs[0], float(rewards[0]), bool(terminated[0]), bool(truncated[0]) or limited, _first(infos)

@@ -47,14 +47,17 @@ def split_actions(actions, domain: str, n: int, expected: str, n_actions=None, n
     return a, params
 
 
-def column(p, n: int, name: int | str, expected: str) -> np.ndarray:
-    """One number of ``n`` copies given ``(n,)`` or ``(n, 1)``, numeric, as an ``(n,)`` array (dtype kept); else a
-    ``ValueError`` naming ``name`` (an int ``i``: "parameter i")."""
+def column(p, n: int, name: int | str, expected: str, size: int = 1, finite: bool = False) -> np.ndarray:
+    """The first number of ``n`` copies' parameters given ``(n, size)`` (one number: or ``(n,)``), numeric (all finite
+    if ``finite``), as an ``(n,)`` array (dtype kept); else a ``ValueError`` naming ``name`` (an int ``i``: "parameter
+    i") and the bad value."""
     p = np.asarray(p)
-    if p.shape not in ((n,), (n, 1)) or p.dtype.kind not in "iuf":
+    bad = p.shape not in ((n, size), (n,) if size == 1 else (n, size)) or p.dtype.kind not in "iuf"
+    if bad or finite and not np.isfinite(p).all():  # (the message is built only here: a step checks many)
         name = f"parameter {name}" if isinstance(name, int) else name
-        raise ValueError(f"invalid {name} of shape {p.shape}: {shown(p)}; expected {expected}")
-    return p.reshape(n)
+        found = f"invalid {name} of shape {p.shape}: {shown(p)}" if bad else f"{name} contains {p[~np.isfinite(p)]}"
+        raise ValueError(f"{found}; expected {expected}")
+    return p.reshape(n) if size == 1 else p[:, 0]
 
 
 def hybrid_space(*boxes) -> spaces.Tuple:
@@ -74,7 +77,8 @@ def every_copy(n: int, **values: np.ndarray) -> dict:
 
 class Domain:
     """The contract between a domain and the env shell, subclassed in the domain's ``env.py``: the attributes below,
-    ``action_space`` and ``observation_space`` (one copy's) and the methods; an instance is one variant."""
+    ``action_space`` and ``observation_space`` (one copy's), the methods below and ``parse``, ``reset``, ``step`` and
+    ``frame`` (``docs/environments.md``, "Writing a new domain"); an instance is one variant."""
 
     name: str  # in error messages
     render_fps: int = 10
@@ -97,23 +101,8 @@ class Domain:
         """What the envs' ``state`` shows of the rows (the scalar env's: copy 0's part of it)."""
         return states.copy()
 
-    def parse(self, actions, n: int) -> tuple:
-        """What the compiled step reads of a batch of ``n`` actions, or a ``ValueError`` naming the bad part."""
-        raise NotImplementedError
-
     def check_options(self, options: dict, n: int) -> None:
         """Check the values of ``reset`` options (their keys are checked already); ``ValueError`` naming one."""
-
-    def reset(self, env, mask: np.ndarray, options: dict | None, seeded: np.ndarray) -> tuple:
-        """Start an episode in the copies where ``mask`` is true (``seeded``: those just given a seed)."""
-        raise NotImplementedError
-
-    def step(self, env, parsed: tuple, resetting: np.ndarray) -> tuple:
-        """Reset the copies where ``resetting`` is true, step the others with the ``parsed`` actions."""
-        raise NotImplementedError
-
-    def frame(self, env, i: int) -> np.ndarray:
-        raise NotImplementedError
 
     def substep_frames(self, env) -> list[np.ndarray]:
         """The scalar env's frames of its last step (one per sub-step where the domain records them)."""
@@ -156,8 +145,15 @@ class Shell:
         self.metadata = {**self.metadata, "render_fps": domain.render_fps}
         self.streams = RandomStreams(n, domain.draw, getattr(domain, buffer_size))
         self._states = domain.initial_states(n)
+        self._obs_shape, self._obs_dtype = (n, *domain.observation_space.shape), domain.observation_space.dtype
         self._started = False
         return domain
+
+    def _outputs(self) -> tuple:
+        """New arrays for a step's outputs, which the domain fills: observations (every row), rewards and both flags
+        (zero and false where it writes nothing)."""
+        n = self._obs_shape[0]
+        return np.empty(self._obs_shape, self._obs_dtype), np.zeros(n), np.zeros(n, bool), np.zeros(n, bool)
 
     def __getattr__(self, name: str):
         if name == "np_random":  # the batched env's property refused it; Python then asks here, for the hint
@@ -243,14 +239,13 @@ class DomainVectorEnv(Shell, VectorEnv):
         """
         self._check_options(options, self.num_envs, shell_keys=("reset_mask",))
         seeded = np.array([s is not None for s in copy_seeds(seed, self.num_envs)])
-        mask = np.ones(self.num_envs, dtype=bool)
-        if options is not None and "reset_mask" in options:
-            mask = np.asarray(options["reset_mask"])
-            if mask.shape != (self.num_envs,) or mask.dtype != np.bool_:
-                raise ValueError(f"reset_mask must be a bool array of shape ({self.num_envs},), got {shown(mask)}")
+        mask = np.asarray((options or {}).get("reset_mask", np.ones(self.num_envs, dtype=bool)))
+        if mask.shape != (self.num_envs,) or mask.dtype != np.bool_:
+            raise ValueError(f"reset_mask must be a bool array of shape ({self.num_envs},), got {shown(mask)}")
         self.streams.seed(seed)
         self.streams.refill(self.draws_per_step)
-        obs, infos = self.domain.reset(self, mask, options, seeded)
+        obs = self._outputs()[0]
+        infos = self.domain.reset(self, mask, options, seeded, obs)
         self._started = True
         self._elapsed[mask] = 0
         self._autoreset[mask] = False
@@ -263,7 +258,8 @@ class DomainVectorEnv(Shell, VectorEnv):
         resetting = self._autoreset
         if self.draws_per_step:
             self.streams.refill(self.draws_per_step)
-        obs, rewards, terminated, truncated, infos = self.domain.step(self, parsed, resetting)
+        obs, rewards, terminated, truncated = out = self._outputs()
+        infos = self.domain.step(self, parsed, resetting, *out)
         self._autoreset = np.empty(self.num_envs, dtype=bool)  # a new array: ``resetting`` was handed out
         limit = self.max_episode_steps or 0
         _end_step(resetting, rewards, terminated, truncated, self._elapsed, limit, self._autoreset)

@@ -8,8 +8,7 @@ reads Goal's observation layout (:data:`BALL_X` ...) and aims its shots through 
 
 from __future__ import annotations
 
-from pamdp.envs.goal.dynamics import HALF_GOAL, OBS_SIZE
-from pamdp.envs.goal.env import hard_goal_shot
+from pamdp.envs.goal.dynamics import HALF_GOAL, OBS_SIZE, hard_goal_shot
 
 __all__ = ["MASSON_GOAL_START", "MASSON_HARD_GOAL_START", "linear_map"]
 

@@ -49,26 +49,21 @@ class CatchPoint(particle.ParticleDomain):
             raise ValueError(f"invalid catch parameters of shape {catch}; expected {expected}")
         return a.astype(np.int64, copy=False), theta.astype(np.float64, copy=False)
 
-    def step(self, env, parsed, resetting):
-        (a, theta), n, streams = parsed, env.num_envs, env.streams
-        obs, rewards = np.empty((n, particle.OBS_SIZE)), np.zeros(n)
-        terminated, caught = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
+    def step(self, env, parsed, resetting, obs, rewards, terminated, truncated):
+        (a, theta), n, streams, caught = parsed, env.num_envs, env.streams, np.zeros(env.num_envs, dtype=bool)
         bad = particle.catch_point_copies(
             env._states, a, theta, resetting, streams.buffers, streams.cursors, obs, rewards, terminated, caught
         )
         if bad >= 0:
             raise ValueError(f"copy {bad}: action {a[bad]} with angle {theta[bad]}; expected {expected_actions(n)}")
-        if env.render_mode is not None:
-            self.last_actions[:] = np.where(resetting, -1, a)
-        return obs, rewards, terminated, np.zeros(n, dtype=bool), self.infos(env, ~resetting, caught)
+        return self.stepped(env, resetting, a, theta, caught)
 
     def infos(self, env, stepped=None, success=None) -> dict:
         fails = every_copy(env.num_envs, failed_catches=env._states[:, particle.FAILS].astype(np.int64))
         return fails | super().infos(env, stepped, success)
 
     def frame(self, env, i):
-        a = int(self.last_actions[i])
-        return draw_catch_point(env._states[i], None if a < 0 else a)
+        return draw_catch_point(env._states[i], self.shown_action(i))
 
 
 CatchPointEnv, CatchPointVectorEnv = env_classes(CatchPoint, __name__, "CatchPointEnv", "CatchPointVectorEnv")

@@ -30,7 +30,8 @@ the 100th agent step ends it (truncated, without simulating) with the same penal
 0. ``info["is_success"]`` at the end of an episode says whether it was a goal.
 """
 
-from pamdp.envs.goal.env import Goal, GoalEnv, GoalVectorEnv, HardGoalEnv, HardGoalVectorEnv, hard_goal_shot
+from pamdp.envs.goal.dynamics import hard_goal_shot
+from pamdp.envs.goal.env import Goal, GoalEnv, GoalVectorEnv, HardGoalEnv, HardGoalVectorEnv
 from pamdp.envs.goal.render import draw_goal, save_goal_gif
 
 __all__ = [

@@ -369,3 +369,36 @@ def observe(states, out):
         for j in range(OBS_SIZE):
             raw = s[j] if j < 14 else dx / n if j == 14 else dy / n if j == 15 else pos
             out[i, j] = (2.0 * (raw - OBS_LOW[j])) / OBS_DEN[j] - 1.0
+
+
+# --- the actions' targets (NumPy: the envs' parser reads them, the compiled functions do not) ---------
+KICK_LOW, KICK_HIGH = np.array([0.0, -15.0]), np.array([40.0, 15.0])
+"""Kick-to's box, also the float64 bounds its parameters are clipped to."""
+HARD_GOAL_INTERVALS = ((-1.0, -0.6), (-0.6, -0.2), (0.2, 0.2), (0.2, 0.6), (0.6, 1.0))
+"""HyAR's five parts of the goal mouth, as positions in [-1, 1]; the third is HyAR's typo for
+[-0.2, 0.2], so actions 3 and 8 always aim at the same point."""
+_SLOPE = np.array([(lo - hi) / 2 for lo, hi in HARD_GOAL_INTERVALS])
+_OFFSET = np.array([lo - 1 * m for (lo, _), m in zip(HARD_GOAL_INTERVALS, _SLOPE)])
+_SHOT_RANGE, _SHOT_LOW = 14.020000457763672, -7.010000228881836
+"""Goal's float32 shoot box, its width computed in float32, through which MP-DQN scales a position."""
+
+
+def hard_goal_shot(j, p):
+    """The goal-line y that Hard Goal's shot into part ``j`` (0..4) with parameter ``p`` aims at, before
+    Goal's clip: HyAR's ``q = p * m_j + o_j`` (p = +1 gives the part's lower end; ``p`` is not clipped)
+    scaled from [-1, 1] onto Goal's shoot box. Works on arrays."""
+    q = p * _SLOPE[j] + _OFFSET[j]
+    return (_SHOT_RANGE * (q + 1)) / 2.0 + _SHOT_LOW
+
+
+def targets(a, columns, hard: bool) -> tuple:
+    """Each copy's ``(kick, tx, ty)`` for :func:`step_copies` from its action ``a`` (int64) and the first numbers of
+    every box's parameters ``columns`` (float64): kick-to aims at ``(x, x)`` with ``x`` clipped into [0, 40], a shot
+    at ``(20.4, y)`` with ``y`` (Hard Goal: :func:`hard_goal_shot`'s) clipped into [-7.01, 7.01]."""
+    x = np.clip(columns[0], KICK_LOW[0], KICK_HIGH[0])
+    y = np.stack(columns[1:])[np.maximum(a - 1, 0), np.arange(a.shape[0])]
+    if hard:
+        y = hard_goal_shot((np.maximum(a, 1) - 1) % 5, y)
+    y = np.clip(y, -HALF_GOAL, HALF_GOAL)
+    kick = a == KICK_TO
+    return kick, np.where(kick, x, SHOOT_X), np.where(kick, x, y)

@@ -8,31 +8,14 @@ import numpy as np
 from gymnasium import spaces
 
 import pamdp.envs.goal.dynamics as dyn
+from pamdp.envs.goal.dynamics import hard_goal_shot
 from pamdp.envs.goal.render import RENDER_FPS, draw_goal
 from pamdp.envs.scalar import env_classes
-from pamdp.envs.vector import Domain, every_copy, hybrid_space, shown, split_actions
+from pamdp.envs.vector import Domain, column, every_copy, hybrid_space, split_actions
 
 __all__ = ["Goal", "GoalEnv", "HardGoalEnv", "GoalVectorEnv", "HardGoalVectorEnv", "hard_goal_shot"]
 
-KICK_LOW, KICK_HIGH = np.array([0.0, -15.0]), np.array([40.0, 15.0])
-"""Kick-to's box, also the float64 bounds its parameters are clipped to."""
-HARD_GOAL_INTERVALS = ((-1.0, -0.6), (-0.6, -0.2), (0.2, 0.2), (0.2, 0.6), (0.6, 1.0))
-"""HyAR's five parts of the goal mouth, as positions in [-1, 1]; the third is HyAR's typo for
-[-0.2, 0.2], so actions 3 and 8 always aim at the same point."""
-_SLOPE = np.array([(lo - hi) / 2 for lo, hi in HARD_GOAL_INTERVALS])
-_OFFSET = np.array([lo - 1 * m for (lo, _), m in zip(HARD_GOAL_INTERVALS, _SLOPE)])
-_SHOT_RANGE, _SHOT_LOW = 14.020000457763672, -7.010000228881836
-"""Goal's float32 shoot box, its width computed in float32, through which MP-DQN scales a position."""
 _DRAWN = (dyn.PX, dyn.PY, dyn.PHI, dyn.KX, dyn.KY, dyn.PSI, dyn.BX, dyn.BY)
-NO_TRACE = np.empty((0, dyn.TRACE_SIZE))
-
-
-def hard_goal_shot(j, p):
-    """The goal-line y that Hard Goal's shot into part ``j`` (0..4) with parameter ``p`` aims at, before
-    Goal's clip: HyAR's ``q = p * m_j + o_j`` (p = +1 gives the part's lower end; ``p`` is not clipped)
-    scaled from [-1, 1] onto Goal's shoot box. Works on arrays."""
-    q = p * _SLOPE[j] + _OFFSET[j]
-    return (_SHOT_RANGE * (q + 1)) / 2.0 + _SHOT_LOW
 
 
 class Goal(Domain):
@@ -46,7 +29,7 @@ class Goal(Domain):
     def __init__(self, hard: bool = False):
         self.hard = bool(hard)
         lo, hi, k = (-1.0, 1.0, 10) if self.hard else (-dyn.HALF_GOAL, dyn.HALF_GOAL, 2)
-        self.action_space = hybrid_space((KICK_LOW, KICK_HIGH, 2), *[(lo, hi, 1)] * k)
+        self.action_space = hybrid_space((dyn.KICK_LOW, dyn.KICK_HIGH, 2), *[(lo, hi, 1)] * k)
         self.observation_space = spaces.Box(-np.inf, np.inf, shape=(dyn.OBS_SIZE,), dtype=np.float64)
         self.trace = np.empty((256, dyn.TRACE_SIZE))  # the scalar env's sub-steps, grown for a long step
         self.substeps = 0
@@ -60,47 +43,30 @@ class Goal(Domain):
         }
 
     def parse(self, actions, n):
-        """Each copy's ``(kick, tx, ty)`` for ``dynamics.step``: kick-to aims at ``(x, x)`` with ``x`` clipped
-        into [0, 40], a shot at ``(20.4, y)`` with ``y`` (Hard Goal: :func:`hard_goal_shot`'s) clipped into
-        [-7.01, 7.01]."""
+        """Each copy's ``(kick, tx, ty)`` for ``dynamics.step_copies`` (see ``dynamics.targets``)."""
         k = self.action_space[0].n
         expected = (
             f"(a, (p_0, ..., p_{k - 1})) with a an int array of shape ({n},) in 0..{k - 1}, p_0 a finite array "
             f"of shape ({n}, 2) and each other p of shape ({n}, 1) or ({n},)"
         )
         a, params = split_actions(actions, self.name, n, expected, k, k)
-        columns = []
-        for i, (p, box) in enumerate(zip(params, self.action_space[1])):
-            p, size = np.asarray(p), box.shape[0]
-            if p.shape not in ((n, size), (n,) if size == 1 else (n, size)) or p.dtype.kind not in "iuf":
-                raise ValueError(f"invalid parameter {i} of shape {p.shape}: {shown(p)}; expected {expected}")
-            p = p.reshape(n, size).astype(np.float64)
-            if not np.isfinite(p).all():
-                raise ValueError(f"parameter {i} contains {p[~np.isfinite(p)]}; expected {expected}")
-            columns.append(p[:, 0])
-        a = a.astype(np.int64)
-        x = np.clip(columns[0], KICK_LOW[0], KICK_HIGH[0])
-        y = np.stack(columns[1:])[np.maximum(a - 1, 0), np.arange(n)]
-        if self.hard:
-            y = hard_goal_shot((np.maximum(a, 1) - 1) % 5, y)
-        y = np.clip(y, -dyn.HALF_GOAL, dyn.HALF_GOAL)
-        kick = a == dyn.KICK_TO
-        return kick, np.where(kick, x, dyn.SHOOT_X), np.where(kick, x, y)
+        boxes = enumerate(zip(params, self.action_space[1]))
+        columns = [column(p, n, i, expected, box.shape[0], finite=True).astype(np.float64) for i, (p, box) in boxes]
+        return dyn.targets(a.astype(np.int64), columns, self.hard)
 
-    def reset(self, env, mask, options, seeded):
+    def reset(self, env, mask, options, seeded, obs):
         dyn.reset_copies(env._states, mask, env.streams.buffers, env.streams.cursors)
         self.substeps = 0
-        return self._observe(env), every_copy(env.num_envs, substeps=np.zeros(env.num_envs, dtype=np.int64))
+        dyn.observe(env._states, obs)
+        return every_copy(env.num_envs, substeps=np.zeros(env.num_envs, dtype=np.int64))
 
-    def step(self, env, parsed, resetting):
+    def step(self, env, parsed, resetting, obs, rewards, terminated, truncated):
         """A copy whose numbers run out mid-step stops; its numbers are topped up and the copies still pending
         resume (a shot can take more numbers than a copy keeps drawn ahead)."""
         (kick, tx, ty), n, streams = parsed, env.num_envs, env.streams
         dyn.reset_copies(env._states, resetting, streams.buffers, streams.cursors)
-        rewards, substeps = np.zeros(n), np.zeros(n, dtype=np.int64)
-        terminated, truncated = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
-        pending = ~resetting
-        trace = self.trace if n == 1 and env.render_mode else NO_TRACE
+        substeps, pending = np.zeros(n, dtype=np.int64), ~resetting
+        trace = self.trace if n == 1 and env.render_mode else self.trace[:0]  # no rows: no record
         while dyn.step_copies(
             env._states, kick, tx, ty, pending, streams.buffers, streams.cursors, substeps, rewards, terminated,
             truncated, trace,
@@ -111,12 +77,8 @@ class Goal(Domain):
         self.substeps = int(substeps[0])
         infos = every_copy(n, substeps=substeps)
         infos["is_success"], infos["_is_success"] = terminated & (rewards == dyn.GOAL_REWARD), terminated | truncated
-        return self._observe(env), rewards, terminated, truncated, infos
-
-    def _observe(self, env):
-        out = np.empty((env.num_envs, dyn.OBS_SIZE))
-        dyn.observe(env._states, out)
-        return out
+        dyn.observe(env._states, obs)
+        return infos
 
     def frame(self, env, i):
         return draw_goal(*(env._states[i, k] for k in _DRAWN))

@@ -20,6 +20,9 @@ file alone, so a constant imported from elsewhere could go stale in the cache.
 
 from __future__ import annotations
 
+import math
+import numbers
+
 import numba
 import numpy as np
 
@@ -37,6 +40,25 @@ N_SETTINGS = 6
 SETTING_NAMES = ("max_turn", "max_acceleration", "delta_t", "max_step", "penalty", "break_value")
 DEFAULTS = np.array([np.pi / 2, 0.5, 0.005, 200.0, 0.001, 0.1])
 """The checked configuration: the values the recordings and every published result use."""
+
+
+def check_settings(**settings) -> np.ndarray:
+    """The original constructor's settings (:data:`SETTING_NAMES`; missing ones take
+    :data:`DEFAULTS`) as the settings row of the compiled functions, or ``ValueError`` naming a bad one."""
+    row = DEFAULTS.copy()
+    for name, v in settings.items():
+        if name not in SETTING_NAMES:
+            raise ValueError(f"unknown setting {name!r}; expected one of {list(SETTING_NAMES)}")
+        if name == "max_step":
+            if isinstance(v, bool) or not isinstance(v, numbers.Integral) or v < 1:
+                raise ValueError(f"max_step={v!r}; expected a positive integer")
+        elif isinstance(v, bool) or not isinstance(v, numbers.Real) or not math.isfinite(v):
+            raise ValueError(f"{name}={v!r}; expected a finite number")
+        elif name != "penalty" and v <= 0:
+            raise ValueError(f"{name}={v!r}; expected a positive number")
+        row[SETTING_NAMES.index(name)] = float(v)
+    return row
+
 
 # --- the state of one copy --------------------------------------------------------------------------
 X, Y, SPEED, THETA, PHI, TX, TY, T = range(8)

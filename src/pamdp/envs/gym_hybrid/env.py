@@ -5,13 +5,11 @@ domain's batched actions, ``state`` and ``info``"."""
 
 from __future__ import annotations
 
-import math
-import numbers
-
 import numpy as np
 from gymnasium import spaces
 
 import pamdp.envs.gym_hybrid.dynamics as dyn
+from pamdp.envs.gym_hybrid.dynamics import check_settings
 from pamdp.envs.gym_hybrid.render import RENDER_FPS, draw_gym_hybrid
 from pamdp.envs.scalar import env_classes
 from pamdp.envs.vector import Domain, column, hybrid_space, split_actions
@@ -24,24 +22,6 @@ ACTION_FORM = "(a, (p_accelerate, p_turn, p_break)) with a in {0, 1, 2}, p_accel
 def gym_hybrid_action_space() -> spaces.Tuple:
     """``Tuple(Discrete(3), Tuple(Box(0, 1, (1,)), Box(-1, 1, (1,)), Box(0,)))``, float32 (break: no parameter)."""
     return hybrid_space((0.0, 1.0, 1), (-1.0, 1.0, 1), (0.0, 0.0, 0))
-
-
-def check_settings(**settings) -> np.ndarray:
-    """The original constructor's settings (``dynamics.SETTING_NAMES``; missing ones take
-    ``dynamics.DEFAULTS``) as the settings row of the compiled functions, or ``ValueError`` naming a bad one."""
-    row = dyn.DEFAULTS.copy()
-    for name, v in settings.items():
-        if name not in dyn.SETTING_NAMES:
-            raise ValueError(f"unknown setting {name!r}; expected one of {list(dyn.SETTING_NAMES)}")
-        if name == "max_step":
-            if isinstance(v, bool) or not isinstance(v, numbers.Integral) or v < 1:
-                raise ValueError(f"max_step={v!r}; expected a positive integer")
-        elif isinstance(v, bool) or not isinstance(v, numbers.Real) or not math.isfinite(v):
-            raise ValueError(f"{name}={v!r}; expected a finite number")
-        elif name != "penalty" and v <= 0:
-            raise ValueError(f"{name}={v!r}; expected a positive number")
-        row[dyn.SETTING_NAMES.index(name)] = float(v)
-    return row
 
 
 class GymHybrid(Domain):
@@ -73,10 +53,8 @@ class GymHybrid(Domain):
         """``a`` (n,) and the accelerate and turn parameters (n,), float32 or float64 as given, not yet clipped."""
         expected = f"{ACTION_FORM} arrays of shape ({n}, 1) or ({n},), p_break of shape ({n}, 0); a of shape ({n},)"
         a, params = split_actions(actions, self.name, n, expected, n_params=3)
-        columns = []
-        for i in range(2):
-            p = column(params[i], n, i, expected)
-            columns.append(p if p.dtype in (np.float32, np.float64) else p.astype(np.float64))
+        columns = [column(params[i], n, i, expected) for i in range(2)]
+        columns = [p if p.dtype in (np.float32, np.float64) else p.astype(np.float64) for p in columns]
         if np.shape(params[2]) != (n, 0):
             raise ValueError(f"invalid break parameters of shape {np.shape(params[2])}; expected {expected}")
         bad = dyn.first_bad_action(a, *columns)  # one compiled pass instead of a NumPy pass per check
@@ -87,20 +65,17 @@ class GymHybrid(Domain):
             )
         return a, columns[0], columns[1]
 
-    def reset(self, env, mask, options, seeded):
-        obs = np.empty((env.num_envs, dyn.OBS_SIZE))
+    def reset(self, env, mask, options, seeded, obs):
         dyn.reset_copies(env._states, mask, self.settings, env.streams.buffers, env.streams.cursors, obs)
-        return obs, {}
+        return {}
 
-    def step(self, env, parsed, resetting):
-        (a, p_accelerate, p_turn), n, streams = parsed, env.num_envs, env.streams
-        obs, rewards = np.empty((n, dyn.OBS_SIZE)), np.empty(n)
-        terminated, goal = np.empty(n, dtype=bool), np.empty(n, dtype=bool)
+    def step(self, env, parsed, resetting, obs, rewards, terminated, truncated):
+        (a, p_accelerate, p_turn), streams, goal = parsed, env.streams, np.empty(env.num_envs, dtype=bool)
         dyn.step_copies(
             env._states, a, p_accelerate, p_turn, resetting, self.settings, self.sliding,
             streams.buffers, streams.cursors, obs, rewards, terminated, goal,
         )  # fmt: skip
-        return obs, rewards, terminated, np.zeros(n, dtype=bool), {"is_success": goal, "_is_success": terminated.copy()}
+        return {"is_success": goal, "_is_success": terminated.copy()}
 
     def frame(self, env, i):
         return draw_gym_hybrid(env._states[i], self.sliding)

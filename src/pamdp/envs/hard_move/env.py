@@ -69,21 +69,15 @@ class HardMove(particle.ParticleDomain):
             raise ValueError(f"parameter {j} contains {params[j][~finite[j]]}; expected {expected}")
         return a, params[a, np.arange(n)].astype(np.float64, copy=False)
 
-    def step(self, env, parsed, resetting):
-        (a, p), n, streams = parsed, env.num_envs, env.streams
-        obs, rewards, terminated = np.empty((n, particle.OBS_SIZE)), np.zeros(n), np.zeros(n, dtype=bool)
+    def step(self, env, parsed, resetting, obs, rewards, terminated, truncated):
+        (a, p), streams = parsed, env.streams
         particle.hard_move_copies(
             env._states, a, p, self.motions, resetting, streams.buffers, streams.cursors, obs, rewards, terminated
         )
-        if env.render_mode is not None:
-            self.last_actions[:] = np.where(resetting, -1, a)
-            self.last_params[:] = p
-        # As Gymnasium's vector envs merge the scalar envs' infos: a copy that was reset reports nothing.
-        return obs, rewards, terminated, np.zeros(n, dtype=bool), self.infos(env, ~resetting, terminated.copy())
+        return self.stepped(env, resetting, a, p, terminated.copy())
 
     def frame(self, env, i):
-        a = int(self.last_actions[i])
-        return draw_hard_move(env._states[i], self.n, None if a < 0 else a, float(self.last_params[i]))
+        return draw_hard_move(env._states[i], self.n, self.shown_action(i), float(self.last_params[i]))
 
 
 def _gather(params, a, n: int, expected: str) -> np.ndarray:

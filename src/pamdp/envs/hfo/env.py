@@ -7,30 +7,15 @@ from __future__ import annotations
 import numpy as np
 from gymnasium import spaces
 
-import pamdp.envs.hfo.defense as defense
 import pamdp.envs.hfo.dynamics as dyn
-from pamdp.envs.hfo.interface import (
-    check_settings,
-    draw_half_field,
-    feature_names,
-    hfo_action_space,
-    parse_actions,
-    reset_options,
-)
+from pamdp.envs.hfo import defense, interface
+from pamdp.envs.hfo.interface import kick_mask
 from pamdp.envs.scalar import env_classes
 from pamdp.envs.vector import Domain, every_copy
 
 __all__ = ["HalfFieldOffense", "HalfFieldOffenseEnv", "HalfFieldOffenseVectorEnv", "kick_mask"]
 
 _STATUS_NAMES = np.array(dyn.STATUS_NAMES)
-
-
-def kick_mask(states: np.ndarray) -> np.ndarray:
-    """The actions with an effect in one state vector ``(STATE_SIZE,)`` or a batch ``(N, STATE_SIZE)``: DASH and
-    TURN always, KICK where the agent's kickable test passes (``dynamics.simulate`` drops it otherwise)."""
-    mask = np.ones(states.shape[:-1] + (3,), dtype=bool)
-    mask[..., dyn.KICK] = states[..., dyn.KICKABLE_NOW] != 0.0
-    return mask
 
 
 class HalfFieldOffense(Domain):
@@ -48,7 +33,7 @@ class HalfFieldOffense(Domain):
         first_step_reward: bool = False,
         terminal_deltas: bool = False,
     ):
-        check_settings(profile, body_reset, defense_npcs)
+        interface.check_settings(profile, body_reset, defense_npcs)
         self.profile = dyn.PROFILES[profile]
         self.settings = dyn.settings(
             self.profile, deterministic, timeout_terminal, terminal_deltas, first_step_reward, body_reset == "uniform"
@@ -58,13 +43,12 @@ class HalfFieldOffense(Domain):
         # The goalie's block (8 features) and its uniform number come before the last-action flag.
         self.n_features = self.profile.n_features + (9 if self.profile.n_features == 59 else 8) * self.goalie
         if self.goalie:
-            self.state_size = defense.STATE_SIZE
-            self.name = "Half Field Offense 1v1"
+            self.state_size, self.name = defense.STATE_SIZE, "Half Field Offense 1v1"
         self._step_batch = defense.step_batch if self.goalie else dyn.step_batch
         self._reset_batch = defense.reset_batch if self.goalie else dyn.reset_batch
-        self.feature_names = feature_names(self.profile.n_features, self.goalie)
+        self.feature_names = interface.feature_names(self.profile.n_features, self.goalie)
         self.observation_space = spaces.Box(-1.0, 1.0, (self.n_features,), dtype=np.float32)
-        self.action_space = hfo_action_space()
+        self.action_space = interface.hfo_action_space()
 
     def initial_states(self, n):
         self.copy_streams = np.zeros((n, 4), dtype=np.uint64)
@@ -78,7 +62,7 @@ class HalfFieldOffense(Domain):
     def state(self, states):
         return states
 
-    parse = staticmethod(parse_actions)
+    parse = staticmethod(interface.parse_actions)
 
     def _follow(self, env) -> None:
         """Seed the stream of every copy whose generator is a new one."""
@@ -91,31 +75,27 @@ class HalfFieldOffense(Domain):
                 self._sources[i] = rng
 
     def check_options(self, options, n):
-        reset_options(options, n, shell_keys=("reset_mask",), goalie=self.goalie)
+        interface.reset_options(options, n, shell_keys=("reset_mask",), goalie=self.goalie)
 
-    def reset(self, env, mask, options, seeded):
-        placements = reset_options(options, env.num_envs, shell_keys=("reset_mask",), goalie=self.goalie)
+    def reset(self, env, mask, options, seeded, obs):
+        placements = interface.reset_options(options, env.num_envs, shell_keys=("reset_mask",), goalie=self.goalie)
         self._follow(env)
         env._states[mask & seeded, dyn.BODY] = 0.0  # a new server run faces the goal
         for i in np.flatnonzero(mask & seeded) if self.goalie else ():
             defense.new_goalie(env._states[i])  # and starts a new goalie program
-        obs = np.empty((env.num_envs, self.n_features), dtype=np.float32)
         self._reset_batch(env._states, self.copy_streams, mask, self.settings, placements, obs)
-        return obs, self._infos(env)
+        return self._infos(env)
 
-    def step(self, env, parsed, resetting):
-        (a, dash, turn, kick), n = parsed, env.num_envs
+    def step(self, env, parsed, resetting, obs, rewards, terminated, truncated):
+        (a, dash, turn, kick), status = parsed, np.empty(env.num_envs, dtype=np.int64)
         self._follow(env)
-        obs = np.empty((n, self.n_features), dtype=np.float32)
-        reward, status = np.empty(n), np.empty(n, dtype=np.int64)
-        terminated, truncated = np.empty(n, dtype=bool), np.empty(n, dtype=bool)
         self._step_batch(
-            env._states, self.copy_streams, a, dash, turn, kick, resetting, self.settings, obs, reward, status,
+            env._states, self.copy_streams, a, dash, turn, kick, resetting, self.settings, obs, rewards, status,
             terminated, truncated,
         )  # fmt: skip
         infos = self._infos(env, status)
         infos["is_success"], infos["_is_success"] = status == dyn.GOAL, terminated | truncated
-        return obs, reward, terminated, truncated, infos
+        return infos
 
     def _infos(self, env, status=None) -> dict:
         names = _STATUS_NAMES[status] if status is not None else np.full(env.num_envs, "IN_GAME")
@@ -123,7 +103,7 @@ class HalfFieldOffense(Domain):
         return every_copy(env.num_envs, status=names, step=step, action_mask=kick_mask(env._states))
 
     def frame(self, env, i):
-        return draw_half_field(env._states[i], goalie=self.goalie)
+        return interface.draw_half_field(env._states[i], goalie=self.goalie)
 
 
 HalfFieldOffenseEnv, HalfFieldOffenseVectorEnv = env_classes(

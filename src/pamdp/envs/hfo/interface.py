@@ -1,5 +1,5 @@
-"""The HFO domain's boundary: the action space and the checks of batched actions, settings and reset options,
-and the top-down drawing for ``render_mode="rgb_array"``."""
+"""The HFO domain's boundary: the action space, the action mask, the checks of batched actions, settings and reset
+options, and the top-down drawing for ``render_mode="rgb_array"``."""
 
 from __future__ import annotations
 
@@ -56,6 +56,14 @@ def feature_names(n_basic_plus_flag: int, goalie: bool) -> tuple[str, ...]:
     flag = n_basic_plus_flag == 59
     names = _BASIC_FEATURES + tuple(f"opponent0_{f}" for f in _OPPONENT_FEATURES) * goalie
     return names + ("opponent0_unum",) * (goalie and flag) + ("last_action_ok",) * flag
+
+
+def kick_mask(states: np.ndarray) -> np.ndarray:
+    """The actions with an effect in one state vector ``(STATE_SIZE,)`` or a batch ``(N, STATE_SIZE)``: DASH and
+    TURN always, KICK where the agent's kickable test passes (``dynamics.simulate`` drops it otherwise)."""
+    mask = np.ones(states.shape[:-1] + (3,), dtype=bool)
+    mask[..., dyn.KICK] = states[..., dyn.KICKABLE_NOW] != 0.0
+    return mask
 
 
 def check_settings(profile: str, body_reset: str, defense_npcs: int = 0) -> None:

@@ -14,8 +14,6 @@ from pamdp.envs.vector import Domain, column, every_copy, hybrid_space, split_ac
 
 __all__ = ["Platform", "PlatformEnv", "PlatformVectorEnv", "ZeroNoise", "platform_action_space"]
 
-NO_TRACE = np.empty((0, physics.TRACE_SIZE))
-
 
 class ZeroNoise:
     """A stand-in for a generator whose standard normals are all zero: the noise-free dynamics (assigned after
@@ -58,36 +56,29 @@ class Platform(Domain):
             f"array of shape ({n}, 1) or ({n},)"
         )
         a, params = split_actions(actions, self.name, n, expected, 3, 3)
-        columns = np.empty((3, n))
-        for i, p in enumerate(params):
-            columns[i] = column(p, n, i, expected)
+        columns = np.array([column(p, n, i, expected) for i, p in enumerate(params)], dtype=np.float64)
         chosen = np.empty(n)
-        bad = physics.choose(a, columns, chosen)
-        if bad >= 0:
-            p = columns[bad]
-            raise ValueError(f"parameter {bad} contains {p[~np.isfinite(p)]}; expected {expected}")
+        j = physics.choose(a, columns, chosen)
+        if j >= 0:
+            raise ValueError(f"parameter {j} contains {columns[j][~np.isfinite(columns[j])]}; expected {expected}")
         return a.astype(np.int64, copy=False), chosen
 
-    def reset(self, env, mask, options, seeded):
+    def reset(self, env, mask, options, seeded, obs):
         env._states[mask] = physics.INITIAL_STATE
         self.substeps = 0
-        return self._observe(env), every_copy(env.num_envs, substeps=np.zeros(env.num_envs, dtype=np.int64))
+        physics.observe(env._states, obs)
+        return every_copy(env.num_envs, substeps=np.zeros(env.num_envs, dtype=np.int64))
 
-    def step(self, env, parsed, resetting):
-        (a, p), n, streams = parsed, env.num_envs, env.streams
+    def step(self, env, parsed, resetting, obs, rewards, terminated, truncated):
+        (a, p), streams, substeps = parsed, env.streams, np.zeros(env.num_envs, dtype=np.int64)
         env._states[resetting] = physics.INITIAL_STATE
-        rewards, terminated, substeps = np.zeros(n), np.zeros(n, dtype=bool), np.zeros(n, dtype=np.int64)
-        trace = self.trace if n == 1 and env.render_mode else NO_TRACE
+        trace = self.trace if env.num_envs == 1 and env.render_mode else self.trace[:0]  # no rows: no record
         physics.step_copies(
             env._states, a, p, ~resetting, streams.buffers, streams.cursors, rewards, terminated, substeps, trace
         )
         self.substeps = int(substeps[0])
-        return self._observe(env), rewards, terminated, np.zeros(n, dtype=bool), every_copy(n, substeps=substeps)
-
-    def _observe(self, env):
-        out = np.empty((env.num_envs, physics.OBS_SIZE))
-        physics.observe(env._states, out)
-        return out
+        physics.observe(env._states, obs)
+        return every_copy(env.num_envs, substeps=substeps)
 
     def frame(self, env, i):
         s = env._states[i]
