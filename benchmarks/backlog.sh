@@ -47,7 +47,7 @@ suite() {  # issue 26: the suite's missing cells, the cheapest first, then the o
 }
 
 goalie() {  # issue 43: learning against the goalie, every arm seed by seed (benchmarks/hfo_goalie_learning.md)
-    local curriculum="PATRPO 1v0 stage,PATRPO from 1v0 wide,PATRPO from 1v0,PATRPO from 1v0 entropy 0.05"
+    local curriculum="PATRPO 1v0 stage,PATRPO from 1v0 widened,PATRPO from 1v0 wide,PATRPO from 1v0"
     python bench_hfo_goalie_learning.py --out "$GOALIE_OUT" --runs "$curriculum" --workers 2  # first: 2 cores
     python bench_hfo_goalie_learning.py --out "$GOALIE_OUT"
 }

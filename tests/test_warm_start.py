@@ -154,3 +154,18 @@ def test_kept_tensors_stay_the_new_models_own(tmp_path):
     torch.testing.assert_close(model.policy.pi_c[2].weight, source.policy.pi_c[2].weight)
     with pytest.raises(ValueError, match="keep names policy.bogus; expected tensors of the model"):
         transfer_weights(model, tmp_path / "source.pt", [None] * 68, keep=("policy.bogus",))
+
+
+def test_widened_tensors_take_the_larger_of_the_sources_and_their_own(tmp_path):
+    """``widen``: exploration at least the new settings' where the source's had narrowed, the source's elsewhere."""
+    patrpo = algorithm_class("patrpo")
+    source = patrpo(ONE_V_ZERO, patrpo.config_class.preset("tuned"))
+    with torch.no_grad():
+        source.policy.log_std.copy_(torch.tensor([[-0.7, -3.0], [-1.0, -0.5], [-0.5, -3.7]]))
+    source.save(tmp_path / "source.pt")
+    model = patrpo(ONE_V_ONE, dataclasses.replace(source.config, init_log_std=-2.0))
+    columns = list(range(58)) + [None] * 9 + [58]
+    report = transfer_weights(model, tmp_path / "source.pt", columns, widen=("policy.log_std",))
+    assert report["policy.log_std"] == "widened"
+    expected = torch.tensor([[-0.7, -2.0], [-1.0, -0.5], [-0.5, -2.0]])
+    torch.testing.assert_close(model.policy.log_std.detach(), expected)

@@ -235,6 +235,14 @@ def build_parser() -> argparse.ArgumentParser:
             "policy.log_std (PATRPO's exploration, then set by --init-log-std)",
         )
         p.add_argument(
+            "--init-widen",
+            type=_names,
+            default=(),
+            metavar="TENSORS",
+            help="with --init-from: comma-separated tensors that take, entry by entry, the larger of the model's and "
+            "this run's own initialisation, e.g. policy.log_std: exploration at least --init-log-std",
+        )
+        p.add_argument(
             "--eval-episodes", type=_count, default=1000, help="greedy evaluation episodes at the end (0: none)"
         )
         p.add_argument(
@@ -349,8 +357,9 @@ def _names(text: str) -> tuple[str, ...]:
 
 
 def _train_spec(args, cls) -> RunSpec:
-    if args.init_keep and not args.init_from:
-        raise ValueError(f"--init-keep {','.join(args.init_keep)} without --init-from; expected both or neither")
+    for flag, names in (("--init-keep", args.init_keep), ("--init-widen", args.init_widen)):
+        if names and not args.init_from:
+            raise ValueError(f"{flag} {','.join(names)} without --init-from; expected both or neither")
     file_values = _read_config_file(args.config) if args.config else {}
     file_preset = file_values.pop("preset", None)
     preset = args.preset or file_preset
@@ -373,6 +382,7 @@ def _train_spec(args, cls) -> RunSpec:
         args.eval_every,
         args.init_from or "",
         tuple(args.init_keep),
+        tuple(args.init_widen),
     )
 
 

@@ -106,7 +106,11 @@ def read_checkpoint(path: str | os.PathLike) -> dict:
 
 
 def transfer_weights(
-    model, source: str | os.PathLike, input_columns: list[int | None] | None = None, keep: tuple[str, ...] = ()
+    model,
+    source: str | os.PathLike,
+    input_columns: list[int | None] | None = None,
+    keep: tuple[str, ...] = (),
+    widen: tuple[str, ...] = (),
 ) -> dict[str, str]:
     """Start ``model``'s networks from those of ``source`` (a model file or run directory of the same algorithm and
     action space), trained on an env whose observation may differ: a warm start, not a resumption (optimisers,
@@ -138,7 +142,7 @@ def transfer_weights(
     if old == new and columns != list(range(new)):  # the input layers would not be told from the hidden ones
         raise ValueError(f"input_columns = {input_columns!r:.80}; expected None: both observations have {new} features")
     own_names = {f"{name}.{key}" for name, module in model._modules().items() for key in module.state_dict()}
-    unknown = sorted(set(keep) - own_names)
+    unknown = sorted((set(keep) | set(widen)) - own_names)
     if unknown:
         raise ValueError(f"keep names {', '.join(unknown)}; expected tensors of the model, such as {min(own_names)}")
     states, report = {}, {}
@@ -159,6 +163,14 @@ def transfer_weights(
                     f"{name}.{key} is {tuple(target.shape)} here and "
                     f"{None if weight is None else tuple(weight.shape)} in {source}; expected the same settings"
                 )
+            if f"{name}.{key}" in widen:
+                if mapped is not weight:  # shapes differ: the observation, which no exploration tensor depends on
+                    raise ValueError(
+                        f"widen names {name}.{key}, which depends on the observation; expected one that does not"
+                    )
+                mapped, report[f"{name}.{key}"] = torch.maximum(weight, target), "widened"
+                states[name][key] = mapped
+                continue
             states[name][key], report[f"{name}.{key}"] = mapped, "copied" if mapped is weight else "inputs mapped"
     for name, module in model._modules().items():
         module.load_state_dict(states[name])

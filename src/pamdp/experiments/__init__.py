@@ -5,8 +5,8 @@ the budget, the seeds, optional ``env_kwargs`` for the env's constructor, and a 
 algorithm, a preset, setting overrides, and optionally their own ``env``, ``env_kwargs``, ``total_steps`` and
 ``eval_every``: a suite of domains gives each its own budget; ``init_from``, the label of an earlier run whose
 final model of the same seed starts this one's networks: a curriculum; ``init_keep``, the tensors such a run keeps
-of its own initialisation, e.g. ``["policy.log_std"]``). The experiment's ``env`` and ``total_steps``
-may be left out where every run gives its own.
+of its own initialisation, e.g. ``["policy.log_std"]``, and ``init_widen``, those that take the larger of the
+two). The experiment's ``env`` and ``total_steps`` may be left out where every run gives its own.
 """
 
 from __future__ import annotations
@@ -74,6 +74,7 @@ class Experiment:
                         run.get("eval_every", self.eval_every),
                         run.get("init_from", ""),
                         tuple(run.get("init_keep", ())),
+                        tuple(run.get("init_widen", ())),
                     )
                 )
         return out
@@ -137,6 +138,7 @@ _RUN_KEYS = {
     "eval_every",
     "init_from",
     "init_keep",
+    "init_widen",
 }
 
 
@@ -197,9 +199,14 @@ def _check_experiment(path: Path, data: dict) -> None:
             refuse(f"runs[{i}].eval_every", run["eval_every"], "an integer >= 0")
         if "init_from" in run and run["init_from"] not in [r.get("label") for r in runs[:i]]:
             refuse(f"runs[{i}].init_from", run["init_from"], "the label of a run listed before it")
-        keep = run.get("init_keep", [])
-        if not (isinstance(keep, list) and all(isinstance(k, str) for k in keep)) or keep and "init_from" not in run:
-            refuse(f"runs[{i}].init_keep", keep, "a list of tensor names such as 'policy.log_std', with init_from")
+        for key in ("init_keep", "init_widen"):
+            names = run.get(key, [])
+            if (
+                not (isinstance(names, list) and all(isinstance(k, str) for k in names))
+                or names
+                and "init_from" not in run
+            ):
+                refuse(f"runs[{i}].{key}", names, "a list of tensor names such as 'policy.log_std', with init_from")
         slug = _slug(str(run["label"]))
         if slug in dirs:
             refuse(f"runs[{i}].label", run["label"], f"a label whose directory differs from {dirs[slug]!r}'s ({slug})")

@@ -61,6 +61,7 @@ class RunSpec:
     eval_every: int = 0  # epochs between greedy evaluations of 100 episodes during training (0: none)
     init_from: str = ""  # a model file or run directory whose networks start this run's (transfer_weights)
     init_keep: tuple[str, ...] = ()  # tensors that stay this run's own initialisation in that start
+    init_widen: tuple[str, ...] = ()  # tensors that take the larger of the source's and this run's initialisation
 
     def config(self) -> RunConfig:
         """The run's algorithm and settings: its preset (the env's where it names none, as
@@ -267,6 +268,8 @@ def _prepare(
         run_info["init_from"] = spec.init_from
     if spec.init_keep:
         run_info["init_keep"] = list(spec.init_keep)
+    if spec.init_widen:
+        run_info["init_widen"] = list(spec.init_widen)
     run_file, eval_file = out / "run.json", out / "evaluation.json"
     if (out / CHECKPOINT).exists() or (out / FINAL_MODEL).exists():
         as_written = _read_run_json(run_file)
@@ -304,12 +307,12 @@ def _prepare(
         _check_fresh_directory(out)
         model = cls(spec.env, config, env_kwargs=dict(spec.env_kwargs))
         if spec.init_from:
-            _warm_start(model, spec.init_from, log, spec.init_keep)
+            _warm_start(model, spec.init_from, log, spec.init_keep, spec.init_widen)
     atomic_write_text(run_file, json.dumps({**run_info, "command": sys.argv}, indent=2))
     return model, None
 
 
-def _warm_start(model, source: str, log, keep: tuple[str, ...] = ()) -> None:
+def _warm_start(model, source: str, log, keep: tuple[str, ...] = (), widen: tuple[str, ...] = ()) -> None:
     """Start ``model``'s networks from the model in ``source``, its observation's features matched by name where
     the two envs' observations differ (``feature_names`` of their domains, e.g. Half Field Offense 1v0 and 1v1). A
     run directory gives its final model: a run still training (only a checkpoint) is refused."""
@@ -335,9 +338,10 @@ def _warm_start(model, source: str, log, keep: tuple[str, ...] = ()) -> None:
                 "envs do not name their features; expected a model of an env with this observation"
             )
         columns = [source_names.index(n) if n in source_names else None for n in names]
-    mapped = sum(v == "inputs mapped" for v in transfer_weights(model, source, columns, keep).values())
+    mapped = sum(v == "inputs mapped" for v in transfer_weights(model, source, columns, keep, widen).values())
     new_features = 0 if columns is None else sum(c is None for c in columns)
     kept = f"; kept its own {', '.join(keep)}" if keep else ""
+    kept += f"; widened {', '.join(widen)}" if widen else ""
     log(f"networks started from {source} ({mapped} input layers mapped, {new_features} new features start at 0{kept})")
 
 
