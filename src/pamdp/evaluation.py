@@ -52,14 +52,14 @@ def evaluate(
     try:
         while np.any(done_count < quota):
             step = stepper.step(model.predict(stepper.obs, deterministic=deterministic, action_mask=stepper.masks))
-            status = step.info.get("status") if step.ended.size else None
+            status, reported = step.info.get("status"), step.info.get("_status")  # HFO's endings, where given
             for i, ret, length, success in zip(step.ended, step.returns, step.lengths, step.successes):
                 if done_count[i] < quota[i]:
                     returns.append(float(ret))
                     lengths.append(int(length))
                     succeeded.append(success)
                     done_count[i] += 1
-                    if status is not None and step.info.get("_status", np.ones(len(status), bool))[i]:
+                    if status is not None and (reported is None or reported[i]):
                         endings[str(status[i])] = endings.get(str(status[i]), 0) + 1
     finally:
         env.close()

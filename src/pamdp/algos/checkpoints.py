@@ -121,8 +121,12 @@ def transfer_weights(
     first computes what ``source``'s did, ignoring the new features). ``None``: the same observation. A network
     reads the observation first and what follows it (an action's one-hot, a parameter vector) after, so a weight
     matrix whose input width differs from ``source``'s by the observations' difference has its observation columns
-    mapped and the rest copied. Returns ``{tensor: "copied" or "inputs mapped"}``; any other mismatch is a
-    ``ValueError`` naming the tensor, before ``model`` is changed.
+    mapped and the rest copied; so are the rows of a layer that predicts the observation (HyAR's dynamics head).
+    ``keep``: tensors (``network.name``, e.g. ``policy.log_std``: the exploration of PATRPO's parameters) that stay
+    ``model``'s own, as its settings initialise them; ``widen``: tensors that take, entry by entry, the larger of the
+    source's and ``model``'s own (``policy.log_std``: the source's exploration where it is wider, the new settings'
+    ``init_log_std`` where the source's had narrowed below it). Returns ``{tensor: "copied", "inputs mapped",
+    "kept" or "widened"}``; any other mismatch is a ``ValueError`` naming the tensor, before ``model`` is changed.
     """
     payload = read_checkpoint(source)
     if payload["algo"] != type(model).__name__:
@@ -142,9 +146,12 @@ def transfer_weights(
     if old == new and columns != list(range(new)):  # the input layers would not be told from the hidden ones
         raise ValueError(f"input_columns = {input_columns!r:.80}; expected None: both observations have {new} features")
     own_names = {f"{name}.{key}" for name, module in model._modules().items() for key in module.state_dict()}
-    unknown = sorted((set(keep) | set(widen)) - own_names)
-    if unknown:
-        raise ValueError(f"keep names {', '.join(unknown)}; expected tensors of the model, such as {min(own_names)}")
+    for argument, names in (("keep", keep), ("widen", widen)):
+        unknown = sorted(set(names) - own_names)
+        if unknown:
+            raise ValueError(
+                f"{argument} names {', '.join(unknown)}; expected tensors of the model, such as {min(own_names)}"
+            )
     states, report = {}, {}
     for name, module in model._modules().items():
         saved = payload["modules"].get(name)
@@ -152,26 +159,23 @@ def transfer_weights(
             raise ValueError(f"{source} has no network {name!r}; expected a model made with the same settings")
         states[name] = {}
         for key, target in module.state_dict().items():
-            if f"{name}.{key}" in keep:
-                states[name][key], report[f"{name}.{key}"] = target, "kept"
+            tensor, weight = f"{name}.{key}", saved.get(key)
+            if tensor in keep:
+                states[name][key], report[tensor] = target, "kept"
                 continue
-            weight = saved.get(key)
             fits = weight is not None and weight.ndim == target.ndim
             mapped = _map_observation(weight, target, columns, old) if fits else None
             if mapped is None:
                 raise ValueError(
-                    f"{name}.{key} is {tuple(target.shape)} here and "
+                    f"{tensor} is {tuple(target.shape)} here and "
                     f"{None if weight is None else tuple(weight.shape)} in {source}; expected the same settings"
                 )
-            if f"{name}.{key}" in widen:
-                if mapped is not weight:  # shapes differ: the observation, which no exploration tensor depends on
-                    raise ValueError(
-                        f"widen names {name}.{key}, which depends on the observation; expected one that does not"
-                    )
-                mapped, report[f"{name}.{key}"] = torch.maximum(weight, target), "widened"
-                states[name][key] = mapped
-                continue
-            states[name][key], report[f"{name}.{key}"] = mapped, "copied" if mapped is weight else "inputs mapped"
+            if tensor in widen and mapped is not weight:  # an observation's axis: no exploration tensor has one
+                raise ValueError(f"widen names {tensor}, which depends on the observation; expected one that does not")
+            if tensor in widen:
+                states[name][key], report[tensor] = torch.maximum(weight, target), "widened"
+            else:
+                states[name][key], report[tensor] = mapped, "copied" if mapped is weight else "inputs mapped"
     for name, module in model._modules().items():
         module.load_state_dict(states[name])
     return report
