@@ -54,11 +54,12 @@ class _Parser(argparse.ArgumentParser):
         return parsed
 
 
-def _items(text: str) -> list[str]:
+def _items(text: str, example: str = "64,64") -> list[str]:
     """The items of a comma-separated list; an empty one (``64,,32``, ``64,``) is a slip, not a separator."""
     items = [t.strip() for t in text.split(",")]
     if any(not t for t in items):
-        raise argparse.ArgumentTypeError(f"{text!r} has an empty item; expected comma-separated values such as 64,64")
+        expected = f"expected comma-separated values such as {example}"
+        raise argparse.ArgumentTypeError(f"{text!r} has an empty item; {expected}")
     return items
 
 
@@ -349,11 +350,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _names(text: str) -> tuple[str, ...]:
-    """A comma-separated list of names, none empty."""
-    names = tuple(name.strip() for name in text.split(","))
-    if not all(names):
-        raise argparse.ArgumentTypeError(f"{text!r}; expected comma-separated names such as policy.log_std")
-    return names
+    """A comma-separated list of tensor names, none empty."""
+    return tuple(_items(text, example="policy.log_std"))
 
 
 def _train_spec(args, cls) -> RunSpec:

@@ -87,8 +87,10 @@ class Experiment:
         for the same seed (which must finish first: runs that start from another come after it in the file)."""
 
         def started(spec: RunSpec) -> RunSpec:
+            if not spec.init_from:
+                return spec
             source = self.run_dir(root, dataclasses.replace(spec, label=spec.init_from))
-            return dataclasses.replace(spec, init_from=str(source)) if spec.init_from else spec
+            return dataclasses.replace(spec, init_from=str(source))
 
         return [(started(spec), str(self.run_dir(root, spec))) for spec in specs]
 
