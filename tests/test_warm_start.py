@@ -169,3 +169,71 @@ def test_widened_tensors_take_the_larger_of_the_sources_and_their_own(tmp_path):
     assert report["policy.log_std"] == "widened"
     expected = torch.tensor([[-0.7, -2.0], [-1.0, -0.5], [-0.5, -2.0]])
     torch.testing.assert_close(model.policy.log_std.detach(), expected)
+
+
+def test_a_row_kept_inside_a_widened_tensor(tmp_path):
+    """The goalie's recipe as names: the kick's row (``policy.log_std[2]``) restarts at the new settings' -2.0
+    (narrower kick power, wider kick direction than the 1v0 policy's), every other entry at least -2.0: the
+    log-stds of the model file the 0.906 run started from, which were set by hand."""
+    patrpo = algorithm_class("patrpo")
+    source = patrpo(ONE_V_ZERO, patrpo.config_class.preset("tuned"))
+    with torch.no_grad():
+        source.policy.log_std.copy_(torch.tensor([[-0.75, -2.56], [-0.97, -0.5], [-0.52, -3.69]]))
+    source.save(tmp_path / "source.pt")
+    model = patrpo(ONE_V_ONE, dataclasses.replace(source.config, init_log_std=-2.0))
+    columns = list(range(58)) + [None] * 9 + [58]
+    report = transfer_weights(
+        model, tmp_path / "source.pt", columns, keep=("policy.log_std[2]",), widen=("policy.log_std",)
+    )
+    assert report["policy.log_std"] == "kept rows [2], widened"
+    expected = torch.tensor([[-0.75, -2.0], [-0.97, -0.5], [-2.0, -2.0]])
+    torch.testing.assert_close(model.policy.log_std.detach(), expected)
+    torch.testing.assert_close(model.policy.pi_c[2].weight, source.policy.pi_c[2].weight)
+    model = patrpo(ONE_V_ONE, dataclasses.replace(source.config, init_log_std=-2.0))
+    report = transfer_weights(model, tmp_path / "source.pt", columns, keep=("policy.log_std[0]",))
+    assert report["policy.log_std"] == "kept rows [0], copied"
+    expected = torch.tensor([[-2.0, -2.0], [-0.97, -0.5], [-0.52, -3.69]])
+    torch.testing.assert_close(model.policy.log_std.detach(), expected)
+    for name in ("policy.log_std[3]", "policy.log_std[-1]", "policy.log_std[kick]"):
+        with pytest.raises(ValueError, match=r"keep names .*; expected policy.log_std or one of its rows, .*\[0\] to .*\[2\]"):
+            transfer_weights(model, tmp_path / "source.pt", columns, keep=(name,))
+    with pytest.raises(ValueError, match=r"widen names rows of policy.pi_d.0.weight, which depends on the observation"):
+        transfer_weights(model, tmp_path / "source.pt", columns, widen=("policy.pi_d.0.weight[0]",))
+
+
+def test_a_stage_with_one_seed_starts_every_seed_of_the_next(tmp_path):
+    """A run listing its own single seed is the source of every seed of the runs that start from it; a run's own
+    seeds replace the experiment's."""
+    body = """
+env = "pamdp/Platform-v0"
+total_steps = 1000
+seeds = [0, 1]
+[[runs]]
+label = "stage"
+algo = "patrpo"
+seeds = {stage}
+[[runs]]
+label = "next"
+algo = "patrpo"
+seeds = [5, 6, 7]
+init_from = "stage"
+"""
+    (tmp_path / "e.toml").write_text(body.format(stage="[100]"))
+    exp = load_experiment(tmp_path / "e.toml")
+    jobs = exp.jobs(tmp_path / "out", exp.specs())
+    assert [(spec.label, spec.seed) for spec, _ in jobs] == [("stage", 100), ("next", 5), ("next", 6), ("next", 7)]
+    stage = str(tmp_path / "out" / "e" / "stage" / "seed100")
+    assert [spec.init_from for spec, _ in jobs[1:]] == [stage] * 3
+    (tmp_path / "e.toml").write_text(body.format(stage="[5, 6]"))  # one stage per seed: seed 7 has none
+    exp = load_experiment(tmp_path / "e.toml")
+    sources = [spec.init_from for spec, _ in exp.jobs(tmp_path / "out", exp.specs()) if spec.label == "next"]
+    assert sources == [str(tmp_path / "out" / "e" / "stage" / f"seed{s}") for s in (5, 6, 7)]
+    (tmp_path / "e.toml").write_text(body.format(stage="[100, 100]"))
+    with pytest.raises(ValueError, match=r"runs\[0\].seeds = \[100, 100\]; expected each seed once"):
+        load_experiment(tmp_path / "e.toml")
+    (tmp_path / "e.toml").write_text(body.format(stage="[100]"))
+    exp = load_experiment(tmp_path / "e.toml")
+    jobs = exp.jobs(tmp_path / "out", exp.specs(seeds=[9]))  # --seeds: the experiment's, not a run's own
+    assert [(spec.label, spec.seed, spec.init_from) for spec, _ in jobs] == [
+        ("stage", 100, ""), ("next", 5, stage), ("next", 6, stage), ("next", 7, stage)
+    ]

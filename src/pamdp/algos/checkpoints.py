@@ -125,8 +125,11 @@ def transfer_weights(
     ``keep``: tensors (``network.name``, e.g. ``policy.log_std``: the exploration of PATRPO's parameters) that stay
     ``model``'s own, as its settings initialise them; ``widen``: tensors that take, entry by entry, the larger of the
     source's and ``model``'s own (``policy.log_std``: the source's exploration where it is wider, the new settings'
-    ``init_log_std`` where the source's had narrowed below it). Returns ``{tensor: "copied", "inputs mapped",
-    "kept" or "widened"}``; any other mismatch is a ``ValueError`` naming the tensor, before ``model`` is changed.
+    ``init_log_std`` where the source's had narrowed below it). A name may select one row of a tensor,
+    ``policy.log_std[2]`` (the third action's parameters); a row named in ``keep`` is kept even where its tensor is
+    widened. Returns ``{tensor: "copied", "inputs mapped", "kept", "widened" or, for a tensor whose rows differ,
+    "kept rows [2], widened"}``; any other mismatch is a ``ValueError`` naming the tensor, before ``model`` is
+    changed.
     """
     payload = read_checkpoint(source)
     if payload["algo"] != type(model).__name__:
@@ -145,13 +148,8 @@ def transfer_weights(
         )
     if old == new and columns != list(range(new)):  # the input layers would not be told from the hidden ones
         raise ValueError(f"input_columns = {input_columns!r:.80}; expected None: both observations have {new} features")
-    own_names = {f"{name}.{key}" for name, module in model._modules().items() for key in module.state_dict()}
-    for argument, names in (("keep", keep), ("widen", widen)):
-        unknown = sorted(set(names) - own_names)
-        if unknown:
-            raise ValueError(
-                f"{argument} names {', '.join(unknown)}; expected tensors of the model, such as {min(own_names)}"
-            )
+    own = {f"{name}.{key}": t for name, module in model._modules().items() for key, t in module.state_dict().items()}
+    keep_rows, widen_rows = _selection("keep", keep, own), _selection("widen", widen, own)
     states, report = {}, {}
     for name, module in model._modules().items():
         saved = payload["modules"].get(name)
@@ -160,7 +158,9 @@ def transfer_weights(
         states[name] = {}
         for key, target in module.state_dict().items():
             tensor, weight = f"{name}.{key}", saved.get(key)
-            if tensor in keep:
+            kept, widened = keep_rows.get(tensor, []), widen_rows.get(tensor, [])
+            rows = len(target) if target.ndim else 1
+            if kept == list(range(rows)):  # the whole tensor stays the model's own
                 states[name][key], report[tensor] = target, "kept"
                 continue
             fits = weight is not None and weight.ndim == target.ndim
@@ -170,15 +170,56 @@ def transfer_weights(
                     f"{tensor} is {tuple(target.shape)} here and "
                     f"{None if weight is None else tuple(weight.shape)} in {source}; expected the same settings"
                 )
-            if tensor in widen and mapped is not weight:  # an observation's axis: no exploration tensor has one
-                raise ValueError(f"widen names {tensor}, which depends on the observation; expected one that does not")
-            if tensor in widen:
-                states[name][key], report[tensor] = torch.maximum(weight, target), "widened"
-            else:
-                states[name][key], report[tensor] = mapped, "copied" if mapped is weight else "inputs mapped"
+            if (kept or widened) and mapped is not weight:  # an observation's axis: no exploration tensor has one
+                argument = "widen" if widened else "keep"
+                raise ValueError(
+                    f"{argument} names rows of {tensor}, which depends on the observation; expected one that does not"
+                )
+            start = mapped.clone()
+            if kept or widened:
+                by_row, own_rows = start.view(rows, -1), target.reshape(rows, -1)
+                by_row[widened] = torch.maximum(by_row[widened], own_rows[widened])
+                by_row[kept] = own_rows[kept]
+            states[name][key] = start
+            report[tensor] = _outcome(mapped is weight, kept, widened, rows)
     for name, module in model._modules().items():
         module.load_state_dict(states[name])
     return report
+
+
+def _selection(argument: str, names: tuple[str, ...], own: dict[str, torch.Tensor]) -> dict[str, list[int]]:
+    """``{tensor: its rows}`` that ``names`` select: ``policy.log_std`` all its rows, ``policy.log_std[2]`` one."""
+    rows: dict[str, list[int]] = {}
+    for name in names:
+        base, _, index = name.partition("[")
+        tensor = own.get(base)
+        if tensor is None:
+            raise ValueError(f"{argument} names {name}; expected tensors of the model, such as {min(own)}")
+        if not index:
+            picked = list(range(len(tensor) if tensor.ndim else 1))
+        elif index.endswith("]") and index[:-1].isdigit() and tensor.ndim and int(index[:-1]) < len(tensor):
+            picked = [int(index[:-1])]
+        else:
+            raise ValueError(
+                f"{argument} names {name}; expected {base} or one of its rows, {base}[0] to "
+                f"{base}[{len(tensor) - 1 if tensor.ndim else 0}]"
+            )
+        rows[base] = sorted({*rows.get(base, []), *picked})
+    return rows
+
+
+def _outcome(same_shape: bool, kept: list, widened: list, n_rows: int) -> str:
+    """What :func:`transfer_weights` did to one tensor, for its report."""
+    everything = list(range(n_rows))
+    if widened == everything and not kept:
+        return "widened"
+    if not kept and not widened:
+        return "copied" if same_shape else "inputs mapped"
+    parts = [f"kept rows {kept}"] if kept else []
+    widened_only = [row for row in widened if row not in kept]
+    if widened_only:
+        parts.append("widened" if widened == everything else f"widened rows {widened_only}")
+    return ", ".join(parts + ([] if widened else ["copied"]))
 
 
 def _map_observation(weight: torch.Tensor, target: torch.Tensor, columns: list[int | None], old: int):

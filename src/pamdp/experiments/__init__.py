@@ -4,9 +4,11 @@ Each experiment is a TOML file in ``configs/`` (one per figure of the paper, and
 the budget, the seeds, optional ``env_kwargs`` for the env's constructor, and a list of runs (a label, an
 algorithm, a preset, setting overrides, and optionally their own ``env``, ``env_kwargs``, ``total_steps`` and
 ``eval_every``: a suite of domains gives each its own budget; ``init_from``, the label of an earlier run whose
-final model of the same seed starts this one's networks: a curriculum; ``init_keep``, the tensors such a run keeps
-of its own initialisation, e.g. ``["policy.log_std"]``, and ``init_widen``, those that take the larger of the
-two). The experiment's ``env`` and ``total_steps`` may be left out where every run gives its own.
+final model of the same seed (or of its one seed, for a run that lists a single seed) starts this one's networks:
+a curriculum; ``init_keep``, the tensors such a run keeps of its own initialisation, e.g. ``["policy.log_std"]``,
+or a tensor's row, ``"policy.log_std[2]"``; ``init_widen``, those that take the larger of the two; and ``seeds``,
+a run's own seeds in place of the experiment's). The experiment's ``env`` and ``total_steps`` may be left out
+where every run gives its own.
 """
 
 from __future__ import annotations
@@ -40,8 +42,9 @@ class Experiment:
     eval_every: int = 0
 
     def specs(self, seeds=None, scale: float = 1.0, labels=None) -> list[RunSpec]:
-        """One :class:`RunSpec` per (run, seed); ``scale`` multiplies each run's step budget; ``labels`` (run
-        labels or their directory names) keeps only those runs, in the experiment's order."""
+        """One :class:`RunSpec` per (run, seed); ``seeds`` replaces the experiment's seeds (not a run's own);
+        ``scale`` multiplies each run's step budget; ``labels`` (run labels or their directory names) keeps only
+        those runs, in the experiment's order."""
         if scale <= 0:
             raise ValueError(f"scale = {scale!r}; expected a positive factor")
         runs = self.runs
@@ -57,7 +60,7 @@ class Experiment:
         out = []
         for run in runs:
             steps = max(1, int(round(run.get("total_steps", self.total_steps) * scale)))
-            for seed in self.seeds if seeds is None else seeds:
+            for seed in run.get("seeds", self.seeds if seeds is None else seeds):  # a run's own seeds stay
                 settings = tuple(sorted(run.get("settings", {}).items()))
                 env_kwargs = tuple(sorted({**self.env_kwargs, **run.get("env_kwargs", {})}.items()))
                 out.append(
@@ -84,12 +87,17 @@ class Experiment:
 
     def jobs(self, root: str | os.PathLike, specs: list[RunSpec]) -> list[tuple[RunSpec, str]]:
         """``(spec, run directory)`` for each spec, a run's ``init_from`` label turned into that run's directory
-        for the same seed (which must finish first: runs that start from another come after it in the file)."""
+        for the same seed, or for its one seed where that run lists a single seed: one stage serving every seed
+        of the runs that start from it (it must finish first: runs that start from another come after it in the
+        file)."""
+        own_seeds = {run["label"]: run.get("seeds") for run in self.runs}
 
         def started(spec: RunSpec) -> RunSpec:
             if not spec.init_from:
                 return spec
-            source = self.run_dir(root, dataclasses.replace(spec, label=spec.init_from))
+            seeds = own_seeds.get(spec.init_from)
+            seed = seeds[0] if seeds is not None and len(seeds) == 1 else spec.seed
+            source = self.run_dir(root, dataclasses.replace(spec, label=spec.init_from, seed=seed))
             return dataclasses.replace(spec, init_from=str(source))
 
         return [(started(spec), str(self.run_dir(root, spec))) for spec in specs]
@@ -141,6 +149,7 @@ _RUN_KEYS = {
     "init_from",
     "init_keep",
     "init_widen",
+    "seeds",
 }
 
 
@@ -153,6 +162,13 @@ def _whole(value, low: int, high: int | None = None) -> bool:
 
 def _count(value) -> bool:
     return isinstance(value, int) and _whole(value, 0)
+
+
+def _check_seeds(refuse, what: str, seeds) -> None:
+    if not isinstance(seeds, list) or not seeds or not all(_whole(s, 0) and isinstance(s, int) for s in seeds):
+        refuse(what, seeds, "a list of integer seeds >= 0")
+    if len(set(seeds)) < len(seeds):
+        refuse(what, seeds, "each seed once")
 
 
 def _check_experiment(path: Path, data: dict) -> None:
@@ -170,11 +186,7 @@ def _check_experiment(path: Path, data: dict) -> None:
     budget = f"a whole number of steps from 1 to {MAX_STEPS:.0e}"
     if "total_steps" in data and not _whole(data["total_steps"], 1, MAX_STEPS):
         refuse("total_steps", data["total_steps"], budget)
-    seeds = data["seeds"]
-    if not isinstance(seeds, list) or not seeds or not all(_whole(s, 0) and isinstance(s, int) for s in seeds):
-        refuse("seeds", seeds, "a list of integer seeds >= 0")
-    if len(set(seeds)) < len(seeds):
-        refuse("seeds", seeds, "each seed once")
+    _check_seeds(refuse, "seeds", data["seeds"])
     for key in ("eval_episodes", "eval_every"):
         if key in data and not _count(data[key]):
             refuse(key, data[key], "an integer >= 0")
@@ -197,6 +209,8 @@ def _check_experiment(path: Path, data: dict) -> None:
                 raise ValueError(f"experiment file {path}: run {i} ({run['label']!r}) has no {key}, nor has the file")
         if "total_steps" in run and not _whole(run["total_steps"], 1, MAX_STEPS):
             refuse(f"runs[{i}].total_steps", run["total_steps"], budget)
+        if "seeds" in run:
+            _check_seeds(refuse, f"runs[{i}].seeds", run["seeds"])
         if "eval_every" in run and not _count(run["eval_every"]):
             refuse(f"runs[{i}].eval_every", run["eval_every"], "an integer >= 0")
         if "init_from" in run and run["init_from"] not in [r.get("label") for r in runs[:i]]:
@@ -208,7 +222,11 @@ def _check_experiment(path: Path, data: dict) -> None:
                 or names
                 and "init_from" not in run
             ):
-                refuse(f"runs[{i}].{key}", names, "a list of tensor names such as 'policy.log_std', with init_from")
+                refuse(
+                    f"runs[{i}].{key}",
+                    names,
+                    "a list of tensor names such as 'policy.log_std' or rows such as 'policy.log_std[2]', with init_from",
+                )
         slug = _slug(str(run["label"]))
         if slug in dirs:
             refuse(f"runs[{i}].label", run["label"], f"a label whose directory differs from {dirs[slug]!r}'s ({slug})")
