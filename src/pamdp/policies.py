@@ -36,6 +36,7 @@ __all__ = [
     "LinearizedMLP",
     "HybridPolicy",
     "ValueNetwork",
+    "TwinQ",
 ]
 
 ACTIVATIONS = {"relu": nn.ReLU, "tanh": nn.Tanh, "leaky_relu": nn.LeakyReLU, "elu": nn.ELU}
@@ -297,3 +298,22 @@ class ValueNetwork(nn.Module):
 
     def forward(self, obs: torch.Tensor) -> torch.Tensor:
         return self.net(obs).squeeze(-1)
+
+
+class TwinQ(nn.Module):
+    """Critics ``Q_1, Q_2`` of the same shape on ``[s, inputs...]``, for the clipped double Q-learning of TD3
+    (Fujimoto et al. 2018) and SAC: a target takes the smaller of the two target critics' values (:meth:`smaller`).
+    With ``twin=False`` there is ``Q_1`` alone (``q2`` is ``None``), whose value :meth:`smaller` then is."""
+
+    def __init__(self, in_size: int, out_size: int, hidden_sizes, activation: str, twin: bool = True):
+        super().__init__()
+        self.q1 = mlp(in_size, hidden_sizes, out_size, activation)
+        self.q2 = mlp(in_size, hidden_sizes, out_size, activation) if twin else None
+
+    def forward(self, obs: torch.Tensor, *inputs: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor | None]:
+        inp = torch.cat([obs, *inputs], dim=-1)
+        return self.q1(inp), None if self.q2 is None else self.q2(inp)
+
+    def smaller(self, obs: torch.Tensor, *inputs: torch.Tensor) -> torch.Tensor:
+        q1, q2 = self(obs, *inputs)
+        return q1 if q2 is None else torch.minimum(q1, q2)

@@ -19,7 +19,6 @@ from pamdp.algos.offpolicy import (
     OffPolicyConfig,
     OffPolicyLoop,
     Temperatures,
-    TwinQ,
     learning_starts_setting,
     shared_setting,
     soft_updater,
@@ -29,7 +28,7 @@ from pamdp.algos.offpolicy import (
 from pamdp.algos.optim import apply_gradients, descend
 from pamdp.algos.settings import NON_NEGATIVE, POSITIVE, AlgoConfig, Check, interval, one_of, setting
 from pamdp.distributions import LOG_STD_MAX, LOG_STD_MIN, MASKED, SquashedHybrid, masked_logits
-from pamdp.policies import every_action_mlp, hierarchical_mlps, mlp, small_init_
+from pamdp.policies import TwinQ, every_action_mlp, hierarchical_mlps, mlp, small_init_
 from pamdp.spaces import HybridActionSpace
 
 __all__ = ["HybridSAC", "HybridSACConfig", "HybridSACActor"]
@@ -192,9 +191,9 @@ class HybridSAC(Algorithm):
         """Per state and discrete action, ``min_i Q_i(s, x_all)_a - alpha_c log pi_c(x_a|s,a) - alpha_d log
         pi_d(a|s)`` at a reparameterised draw of ``x_all``, ``(B, K)``, with ``log pi_c`` ``(B, K)``."""
         u, x_all = dist.rsample(self.torch_gen)
-        q1, q2 = critic(obs, self.actor.flat_params(x_all))
         log_pc = dist.log_prob_c(u)
-        return torch.minimum(q1, q2) - alpha_c * log_pc - alpha_d * dist.log_probs_d, log_pc
+        q = critic.smaller(obs, self.actor.flat_params(x_all))
+        return q - alpha_c * log_pc - alpha_d * dist.log_probs_d, log_pc
 
     def _alpha_tensors(self) -> tuple[torch.Tensor, torch.Tensor]:
         t = self.temperatures

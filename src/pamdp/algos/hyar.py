@@ -21,7 +21,6 @@ from pamdp.algos.offpolicy import (
     EpsilonSchedule,
     OffPolicyConfig,
     OffPolicyLoop,
-    TwinQ,
     backprop_actor,
     linear_epsilon,
     shared_setting,
@@ -32,7 +31,7 @@ from pamdp.algos.offpolicy import (
 from pamdp.algos.optim import apply_gradients, descend
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, at_least, interval, one_of, setting
 from pamdp.distributions import LOG_STD_MAX, LOG_STD_MIN, masked_logits
-from pamdp.policies import ACTIVATIONS, mlp
+from pamdp.policies import ACTIVATIONS, TwinQ, mlp
 from pamdp.spaces import HybridActionSpace
 
 __all__ = ["HyAR", "HyARConfig", "ActionRepresentation", "latent_bounds"]
@@ -460,8 +459,8 @@ class HyAR(EpsilonSchedule, Algorithm):
             noise = torch.randn(u_next.shape, generator=self.torch_gen, device=self.device) * cfg.target_noise
             u_next = (u_next + noise.clamp(-cfg.target_noise_clip, cfg.target_noise_clip)).clamp(-1.0, 1.0)
             latent_next = self.rep.snap(self.actor_target.to_latent(u_next), b.get("next_mask"))
-            q1_next, q2_next = (q.squeeze(-1) for q in self.critic_target(next_obs, latent_next))
-            y = b["reward"] + cfg.gamma * (~b["terminated"]).float() * torch.minimum(q1_next, q2_next)
+            q_next = self.critic_target.smaller(next_obs, latent_next).squeeze(-1)
+            y = b["reward"] + cfg.gamma * (~b["terminated"]).float() * q_next
         q1, q2 = (q.squeeze(-1) for q in self.critic(obs, latent))
         critic_loss = F.mse_loss(q1, y) + F.mse_loss(q2, y)
         descend(self.critic_optimizer, critic_loss, self._critic_params, cfg.grad_clip)

@@ -19,7 +19,7 @@ from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, at_least, inter
 from pamdp.algos.subnormals import subnormals_flushed
 from pamdp.algos.vector_env import Step, VectorStepper
 from pamdp.distributions import masked_logits
-from pamdp.policies import ACTIVATIONS, mlp
+from pamdp.policies import ACTIVATIONS
 
 __all__ = [
     "OffPolicyConfig",
@@ -28,7 +28,6 @@ __all__ = [
     "learning_starts_setting",
     "tau_setting",
     "OffPolicyLoop",
-    "TwinQ",
     "Temperatures",
     "temperature_gradient",
     "OUNoise",
@@ -168,20 +167,6 @@ def soft_updater(pairs: Sequence[tuple[nn.Module, nn.Module]]) -> Callable[[floa
             torch._foreach_lerp_(targets, sources, tau)
 
     return update
-
-
-class TwinQ(nn.Module):
-    """Two critics ``Q_1, Q_2`` of the same shape on ``[s, action]``, for the clipped double Q-learning of TD3
-    (Fujimoto et al. 2018) and SAC: a target takes the smaller of the two target critics' values."""
-
-    def __init__(self, in_size: int, out_size: int, hidden_sizes, activation: str):
-        super().__init__()
-        self.q1 = mlp(in_size, hidden_sizes, out_size, activation)
-        self.q2 = mlp(in_size, hidden_sizes, out_size, activation)
-
-    def forward(self, obs: torch.Tensor, action: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
-        inp = torch.cat([obs, action], dim=-1)
-        return self.q1(inp), self.q2(inp)
 
 
 class Temperatures(nn.Module):

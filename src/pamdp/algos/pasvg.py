@@ -34,7 +34,7 @@ from pamdp.algos.offpolicy import (
 from pamdp.algos.optim import apply_gradients, descend
 from pamdp.algos.settings import NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
 from pamdp.distributions import LOG_STD_MAX, LOG_STD_MIN, masked_logits
-from pamdp.policies import every_action_linear, every_action_mlp, hierarchical_mlps, mlp
+from pamdp.policies import TwinQ, every_action_linear, every_action_mlp, hierarchical_mlps
 from pamdp.spaces import HybridActionSpace
 
 __all__ = ["PASVG0", "PASVG0Config", "GumbelHybridPolicy", "expected_q", "gumbel_noise", "gumbel_softmax_sample"]
@@ -235,34 +235,22 @@ def expected_q(
     return logits, (logits.softmax(-1) * q_all).sum(-1)
 
 
-def every_action_q(*critics: Critic) -> Callable:
-    """:func:`expected_q`'s ``critic`` for :class:`Critic` networks: ``Q(s, k, x_k)`` of every ``k`` by
-    :meth:`Critic.every_action` (the states' first copy, the one-hots implied), the smallest of several critics'
-    values (twin critics)."""
+def every_action_q(critic: TwinQ, smaller: bool = False) -> Callable:
+    """:func:`expected_q`'s ``critic`` for a :class:`~pamdp.policies.TwinQ` on ``[s, a, x]``: ``Q_1(s, k, x_k)`` of
+    every ``k`` (``(B, K)``; with ``smaller``, the smaller of both critics' values), the first layer's one-hot part by
+    :func:`~pamdp.policies.every_action_linear` and the parameters' by one product, from the states' first copy."""
+    nets = (critic.q1,) if not smaller or critic.q2 is None else (critic.q1, critic.q2)
 
     def q_all(obs_k: torch.Tensor, onehots: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
-        values = [critic.every_action(obs_k[:, 0], x) for critic in critics]
+        obs, split = obs_k[:, 0], obs_k.shape[-1] + x.shape[-2]
+        values = []
+        for net in nets:
+            first = net[0]
+            pre = every_action_linear(obs, first.weight[:, :split], first.bias) + F.linear(x, first.weight[:, split:])
+            values.append(net[1:](pre).squeeze(-1))
         return values[0] if len(values) == 1 else torch.minimum(*values)
 
     return q_all
-
-
-class Critic(nn.Module):
-    """``Q(s, a, x)`` with the discrete action as a one-hot (or soft sample) ``a``."""
-
-    def __init__(self, obs_dim: int, n_actions: int, param_size: int, hidden_sizes, activation: str):
-        super().__init__()
-        self.net = mlp(obs_dim + n_actions + param_size, hidden_sizes, 1, activation)
-
-    def forward(self, obs: torch.Tensor, a: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
-        return self.net(torch.cat([obs, a, x], dim=-1)).squeeze(-1)
-
-    def every_action(self, obs: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
-        """``Q(s, k, x_k)`` ``(B, K)`` for every action ``k``, its parameters ``x`` ``(B, K, m)``: the first layer's
-        one-hot part by :func:`~pamdp.policies.every_action_linear`, the parameters' by one product."""
-        first, split = self.net[0], obs.shape[-1] + x.shape[-2]
-        pre = every_action_linear(obs, first.weight[:, :split], first.bias) + F.linear(x, first.weight[:, split:])
-        return self.net[1:](pre).squeeze(-1)
 
 
 class PASVG0(Algorithm):
@@ -270,24 +258,19 @@ class PASVG0(Algorithm):
 
     config_class = PASVG0Config
     config: PASVG0Config
-    # entropy_weight with target_entropy only; critic2 and its target with twin_critics only
-    MODULES = ("policy", "critic", "policy_target", "critic_target", "entropy_weight", "critic2", "critic2_target")
+    MODULES = ("policy", "critic", "policy_target", "critic_target", "entropy_weight")  # the last: target_entropy
     OPTIMIZERS = {"policy": "policy_optimizer", "critic": "critic_optimizer", "entropy_weight": "entropy_optimizer"}
 
     def _build(self) -> None:
         cfg, h = self.config, self.hybrid
         self.policy = GumbelHybridPolicy(self.obs_dim, h, cfg.hidden_sizes, cfg.activation, cfg.init_log_std)
         self.policy.log_std.requires_grad_(cfg.learn_std)
-        self.critic = Critic(self.obs_dim, h.n_actions, h.max_param_size, cfg.hidden_sizes, cfg.activation)
+        # Q(s, a, x), the discrete action a one-hot (or the soft sample); with twin_critics a second one
+        in_size = self.obs_dim + h.n_actions + h.max_param_size
+        self.critic = TwinQ(in_size, 1, cfg.hidden_sizes, cfg.activation, twin=cfg.twin_critics)
         self.policy_target = copy.deepcopy(self.policy).requires_grad_(False)
         self.critic_target = copy.deepcopy(self.critic).requires_grad_(False)
-        self.critic2 = self.critic2_target = None
-        critic_params = list(self.critic.parameters())
-        if cfg.twin_critics:
-            self.critic2 = Critic(self.obs_dim, h.n_actions, h.max_param_size, cfg.hidden_sizes, cfg.activation)
-            self.critic2_target = copy.deepcopy(self.critic2).requires_grad_(False)
-            critic_params += list(self.critic2.parameters())
-        self.critic_params = critic_params
+        self.critic_params = list(self.critic.parameters())
         self.critic_updates = 0  # for policy_delay
         # fused: one kernel per step instead of a dozen foreach passes (benchmarks/offpolicy_speed.md).
         self.policy_params = [p for p in self.policy.parameters() if p.requires_grad]
@@ -315,10 +298,7 @@ class PASVG0(Algorithm):
     def _bind_networks(self) -> None:
         """The soft target update over the modules' own tensors and, with the paper's settings, the hand-written
         update's views of the networks (:mod:`pamdp.algos.dense`). Called again by whoever replaces a module."""
-        pairs = [(self.critic_target, self.critic), (self.policy_target, self.policy)]
-        if self.critic2 is not None:
-            pairs.append((self.critic2_target, self.critic2))
-        self._soft_update = soft_updater(pairs)
+        self._soft_update = soft_updater([(self.critic_target, self.critic), (self.policy_target, self.policy)])
         cfg = self.config
         self._dense = None
         # The paper's settings: the Gumbel-Softmax gradient, one critic, no policy delay, a fixed entropy weight.
@@ -327,7 +307,7 @@ class PASVG0(Algorithm):
             self._dense = {
                 "pi_d": Dense.of(self.policy.pi_d),
                 "pi_c": Dense.of(self.policy.pi_c),
-                "critic": Dense.of(self.critic.net),
+                "critic": Dense.of(self.critic.q1),
             }
 
     def _extra_state(self):
@@ -361,10 +341,9 @@ class PASVG0(Algorithm):
             x = torch.where(flip[:, None], self.policy.params(obs, uniform, onehot, eta_x), x)
         return index, x, {"a_in": a_in.cpu().numpy(), "eta_a": eta_a.cpu().numpy(), "eta_x": eta_x.cpu().numpy()}
 
-    def _target_q(self, obs: torch.Tensor, a: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
-        """The target critic's ``Q'``; with ``twin_critics`` the smaller of the two target critics' values."""
-        q = self.critic_target(obs, a, x)
-        return q if self.critic2 is None else torch.minimum(q, self.critic2_target(obs, a, x))
+    def _q1(self, obs: torch.Tensor, a: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
+        """The first critic's ``Q(s, a, x)`` ``(B,)``, which the policy follows."""
+        return self.critic.q1(torch.cat([obs, a, x], dim=-1)).squeeze(-1)
 
     @torch.no_grad()
     def _td_target(self, b: dict[str, torch.Tensor]) -> torch.Tensor:
@@ -375,11 +354,10 @@ class PASVG0(Algorithm):
         next_obs, mask = b["next_obs"], b.get("next_mask")
         eta_a, eta_x = self._noise(len(next_obs))
         if cfg.discrete_gradient == "expected":
-            critics = (self.critic_target,) if self.critic2 is None else (self.critic_target, self.critic2_target)
-            _, q_next = expected_q(self.policy_target, every_action_q(*critics), next_obs, eta_x, mask)
+            _, q_next = expected_q(self.policy_target, every_action_q(self.critic_target, True), next_obs, eta_x, mask)
         else:
             *_, a_next, x_next = self.policy_target(next_obs, eta_a, eta_x, cfg.temperature, cfg.straight_through, mask)
-            q_next = self._target_q(next_obs, a_next, x_next)
+            q_next = self.critic_target.smaller(next_obs, a_next, x_next).squeeze(-1)
         return b["reward"] + cfg.gamma * (~b["terminated"]).float() * q_next
 
     def _update(self) -> dict[str, float]:
@@ -390,10 +368,9 @@ class PASVG0(Algorithm):
         if self._dense is not None:
             return self._update_by_hand(b, y)
         obs = b["obs"]
-        q = self.critic(obs, b["a_in"], b["x"])
-        critic_loss = F.mse_loss(q, y)
-        if self.critic2 is not None:
-            critic_loss = critic_loss + F.mse_loss(self.critic2(obs, b["a_in"], b["x"]), y)
+        q, q2 = self.critic(obs, b["a_in"], b["x"])
+        q = q.squeeze(-1)
+        critic_loss = F.mse_loss(q, y) if q2 is None else F.mse_loss(q, y) + F.mse_loss(q2.squeeze(-1), y)
         descend(self.critic_optimizer, critic_loss, self.critic_params, cfg.grad_clip)
         self.critic_updates += 1
         stats = {"losses/critic_loss": float(critic_loss.detach()), "train/q_mean": float(q.detach().mean())}
@@ -411,7 +388,7 @@ class PASVG0(Algorithm):
             logits, q_pi = expected_q(self.policy, every_action_q(self.critic), obs, b["eta_x"], mask)
         else:
             logits, _, a, x = self.policy(obs, b["eta_a"], b["eta_x"], cfg.temperature, cfg.straight_through, mask)
-            q_pi = self.critic(obs, a, x)
+            q_pi = self._q1(obs, a, x)
         entropy = -(logits.softmax(-1) * logits.log_softmax(-1)).sum(-1).mean()
         alpha = cfg.entropy_coef if self.entropy_weight is None else float(self.entropy_weight.log_alpha.detach().exp())
         actor_loss = -q_pi.mean() - alpha * entropy
