@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 
+import numpy as np
 import torch
 import torch.nn.functional as F
 from torch import nn
@@ -37,6 +38,7 @@ __all__ = [
     "HybridPolicy",
     "ValueNetwork",
     "TwinQ",
+    "DeterministicActor",
 ]
 
 ACTIVATIONS = {"relu": nn.ReLU, "tanh": nn.Tanh, "leaky_relu": nn.LeakyReLU, "elu": nn.ELU}
@@ -317,3 +319,70 @@ class TwinQ(nn.Module):
     def smaller(self, obs: torch.Tensor, *inputs: torch.Tensor) -> torch.Tensor:
         q1, q2 = self(obs, *inputs)
         return q1 if q2 is None else torch.minimum(q1, q2)
+
+
+class DeterministicActor(nn.Module):
+    """``mu(s)``: an :func:`mlp` whose outputs are meant to lie in ``[-1, 1]``, by a Tanh after them with ``squash``,
+    else by the update's bounded gradients (acting clamps them). PADDPG's actor outputs K action scores then every
+    action's parameters (``hybrid`` with ``offset = K``), P-DQN's every action's parameters (``hybrid``), HyAR's a
+    latent action, which :meth:`to_latent` maps onto the latent box ``[low, high]`` (``box``).
+
+    ``passthrough``: Bester et al.'s passthrough layer (P-DQN's ``param_passthrough``), a fixed linear map of the
+    state, the rows of ``[W | b]`` flattened, added to the outputs and never trained; the output layer then starts at
+    zero, so that the first ``mu`` is the map.
+    """
+
+    def __init__(
+        self,
+        obs_dim: int,
+        out_size: int,
+        hidden_sizes: Sequence[int],
+        activation: str,
+        squash: bool,
+        hybrid: HybridActionSpace | None = None,
+        offset: int = 0,
+        passthrough: Sequence[float] = (),
+        box: bool = False,
+    ):
+        super().__init__()
+        self.offset = offset
+        self.net = mlp(obs_dim, hidden_sizes, out_size, activation, nn.Tanh if squash else None)
+        weight = bias = None
+        if passthrough:
+            if len(passthrough) != out_size * (obs_dim + 1):
+                raise ValueError(
+                    f"param_passthrough has {len(passthrough)} numbers; expected {out_size * (obs_dim + 1)} for this "
+                    f"env: {out_size} parameters x ({obs_dim} observation features + 1 bias), row by row"
+                )
+            table = torch.tensor(passthrough, dtype=torch.float32).view(out_size, obs_dim + 1)
+            weight, bias = table[:, :-1].contiguous(), table[:, -1].contiguous()
+            nn.init.zeros_(self.net[-1].weight)
+            nn.init.zeros_(self.net[-1].bias)
+        self.register_buffer("passthrough_weight", weight)
+        self.register_buffer("passthrough_bias", bias)
+        if hybrid is not None:  # where action a's padded parameter i sits in the outputs (0 where unused)
+            index = np.where(hybrid.param_mask, offset + hybrid.param_index, 0)
+            self.register_buffer("param_index", torch.as_tensor(index, dtype=torch.long))
+            self.register_buffer("param_mask", torch.tensor(hybrid.param_mask, dtype=torch.float32))
+        if box:
+            self.register_buffer("low", -torch.ones(out_size))
+            self.register_buffer("high", torch.ones(out_size))
+
+    def forward(self, obs: torch.Tensor) -> torch.Tensor:
+        if self.passthrough_weight is None:
+            return self.net(obs)
+        return self.net(obs) + F.linear(obs, self.passthrough_weight, self.passthrough_bias)
+
+    def select(self, out: torch.Tensor, a: torch.Tensor) -> torch.Tensor:
+        """Action ``a``'s parameters out of the output vectors ``out``, padded with zeros to ``m = max_a m_a``."""
+        return out.gather(1, self.param_index[a]) * self.param_mask[a]
+
+    def action(self, out: torch.Tensor, mask: torch.Tensor | None = None) -> tuple[torch.Tensor, torch.Tensor]:
+        """The executed action of output vectors ``out`` that start with action scores: the argmax of the scores
+        (among the actions ``mask`` allows) and its parameters, clamped to ``[-1, 1]``."""
+        a = masked_logits(out[:, : self.offset], mask).argmax(-1)
+        return a, self.select(out, a).clamp(-1.0, 1.0)
+
+    def to_latent(self, u: torch.Tensor) -> torch.Tensor:
+        """Outputs ``u`` in ``[-1, 1]`` mapped onto the latent box ``[low, high]``."""
+        return self.low + (u + 1.0) * 0.5 * (self.high - self.low)

@@ -31,7 +31,7 @@ from pamdp.algos.offpolicy import (
 from pamdp.algos.optim import apply_gradients, descend
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, at_least, interval, one_of, setting
 from pamdp.distributions import LOG_STD_MAX, LOG_STD_MIN, masked_logits
-from pamdp.policies import ACTIVATIONS, TwinQ, mlp
+from pamdp.policies import ACTIVATIONS, DeterministicActor, TwinQ, mlp
 from pamdp.spaces import HybridActionSpace
 
 __all__ = ["HyAR", "HyARConfig", "ActionRepresentation", "latent_bounds"]
@@ -266,23 +266,6 @@ def latent_bounds(latents: torch.Tensor, percent: float) -> tuple[torch.Tensor, 
     return low, torch.maximum(high, low + 1e-6)
 
 
-class LatentActor(nn.Module):
-    """``u(s)`` in ``[-1, 1]^(d1 + d2)`` (Tanh with ``squash``; else kept there by inverting gradients and clamped
-    when acting), mapped onto the latent box ``[low, high]`` by :meth:`to_latent`."""
-
-    def __init__(self, obs_dim: int, size: int, hidden_sizes, activation: str, squash: bool = True):
-        super().__init__()
-        self.net = mlp(obs_dim, hidden_sizes, size, activation, nn.Tanh if squash else None)
-        self.register_buffer("low", -torch.ones(size))
-        self.register_buffer("high", torch.ones(size))
-
-    def forward(self, obs: torch.Tensor) -> torch.Tensor:
-        return self.net(obs)
-
-    def to_latent(self, u: torch.Tensor) -> torch.Tensor:
-        return self.low + (u + 1.0) * 0.5 * (self.high - self.low)
-
-
 class HyAR(EpsilonSchedule, Algorithm):
     """HyAR-TD3 (Li et al. 2022): TD3 in a learned hybrid action representation. See :class:`HyARConfig`."""
 
@@ -298,7 +281,10 @@ class HyAR(EpsilonSchedule, Algorithm):
             self.obs_dim, h, cfg.embed_dim, cfg.latent_dim, cfg.vae_hidden_sizes, cfg.activation
         )
         squash = cfg.bound == "squash"
-        self.actor = LatentActor(self.obs_dim, self.latent_size, cfg.hidden_sizes, cfg.activation, squash)
+        # u(s) in [-1, 1]^(d1 + d2), mapped onto the latent box
+        self.actor = DeterministicActor(
+            self.obs_dim, self.latent_size, cfg.hidden_sizes, cfg.activation, squash, box=True
+        )
         self.critic = TwinQ(self.obs_dim + self.latent_size, 1, cfg.hidden_sizes, cfg.activation)  # Q_i(s, e, z)
         self.actor_target = copy.deepcopy(self.actor).requires_grad_(False)
         self.critic_target = copy.deepcopy(self.critic).requires_grad_(False)
