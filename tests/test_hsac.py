@@ -15,9 +15,10 @@ from gymnasium import spaces
 from torch.distributions import Normal, TanhTransform, TransformedDistribution
 
 from pamdp import HybridSAC
-from pamdp.algos.hsac import HybridSACActor, HybridSACConfig
+from pamdp.algos.hsac import HybridSACConfig
 from pamdp.algos.offpolicy import temperature_gradient
 from pamdp.distributions import SquashedHybrid
+from pamdp.policies import HybridSACActor
 from pamdp.spaces import HybridActionSpace
 
 SMALL = HybridSACConfig(hidden_sizes=(16, 16), updates_per_step=0.5, **OFF_POLICY_SMALL)

@@ -9,13 +9,9 @@ import torch
 from conftest import HYBRID, OFF_POLICY_SMALL, module_bytes
 
 from pamdp import PASVG0
-from pamdp.algos.pasvg import (
-    GumbelHybridPolicy,
-    PASVG0Config,
-    expected_q,
-    gumbel_noise,
-    gumbel_softmax_sample,
-)
+from pamdp.algos.pasvg import PASVG0Config, expected_q
+from pamdp.distributions import gumbel_noise, gumbel_softmax_sample
+from pamdp.policies import GumbelHybridPolicy
 
 SMALL = PASVG0Config(hidden_sizes=(16, 16), **OFF_POLICY_SMALL)
 

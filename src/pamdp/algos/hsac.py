@@ -12,7 +12,6 @@ import math
 import numpy as np
 import torch
 import torch.nn.functional as F
-from torch import nn
 
 from pamdp.algos.base import Algorithm
 from pamdp.algos.offpolicy import (
@@ -27,13 +26,10 @@ from pamdp.algos.offpolicy import (
 )
 from pamdp.algos.optim import apply_gradients, descend
 from pamdp.algos.settings import NON_NEGATIVE, POSITIVE, AlgoConfig, Check, interval, one_of, setting
-from pamdp.distributions import LOG_STD_MAX, LOG_STD_MIN, MASKED, SquashedHybrid, masked_logits
-from pamdp.policies import TwinQ, every_action_mlp, hierarchical_mlps, mlp, small_init_
-from pamdp.spaces import HybridActionSpace
+from pamdp.distributions import MASKED, SquashedHybrid
+from pamdp.policies import FORMS, HybridSACActor, TwinQ
 
-__all__ = ["HybridSAC", "HybridSACConfig", "HybridSACActor"]
-
-FORMS = ("flat", "hierarchical")
+__all__ = ["HybridSAC", "HybridSACConfig"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -92,46 +88,6 @@ class HybridSACConfig(OffPolicyConfig, AlgoConfig):
             tau=0.01,
         ),
     }
-
-
-class HybridSACActor(nn.Module):
-    """The policy, ``flat`` (``mlp(s) -> [logits | means | log-stds]``) or ``hierarchical`` (``pi_d = mlp(s)``,
-    ``pi_c = mlp([s, onehot(a)])`` for every ``a``); ``forward(obs, mask)`` is a :class:`SquashedHybrid`."""
-
-    def __init__(self, obs_dim: int, hybrid: HybridActionSpace, form: str, hidden_sizes, activation: str):
-        super().__init__()
-        if form not in FORMS:
-            raise ValueError(f"form = {form!r}; expected one of {', '.join(FORMS)}")
-        self.form, self.n_actions, self.m = form, hybrid.n_actions, hybrid.max_param_size
-        mask = hybrid.param_mask
-        self.register_buffer("param_mask", torch.tensor(mask, dtype=torch.float32))
-        self.register_buffer("param_index", torch.tensor(hybrid.param_index, dtype=torch.long).view(-1))
-        self.total = total = hybrid.total_param_size
-        # the all-actions vector's entries in the flattened padded (K * m) layout
-        self.register_buffer("flat_index", torch.tensor(np.flatnonzero(mask), dtype=torch.long))
-        if form == "flat":  # starts near uniform, centred, with unit noise, as the hierarchical form does
-            self.net = mlp(obs_dim, hidden_sizes, self.n_actions + 2 * total, activation)
-            small_init_(self.net[-1])
-        else:
-            self.pi_d, self.pi_c = hierarchical_mlps(obs_dim, self.n_actions, hidden_sizes, activation, 2 * self.m)
-
-    def _padded(self, flat: torch.Tensor) -> torch.Tensor:
-        """``(B, sum_a m_a)`` all-actions values as ``(B, K, m)``, zero where unused."""
-        return flat[:, self.param_index].view(-1, self.n_actions, self.m) * self.param_mask
-
-    def forward(self, obs: torch.Tensor, mask: torch.Tensor | None = None) -> SquashedHybrid:
-        if self.form == "flat":
-            logits, means, log_stds = self.net(obs).split([self.n_actions, self.total, self.total], dim=-1)
-            mean, log_std = self._padded(means), self._padded(log_stds)
-        else:
-            mean, log_std = every_action_mlp(self.pi_c, obs).split(self.m, dim=-1)
-            logits = self.pi_d(obs)
-        log_std = log_std.clamp(LOG_STD_MIN, LOG_STD_MAX)
-        return SquashedHybrid(masked_logits(logits, mask), mean, log_std, self.param_mask)
-
-    def flat_params(self, x: torch.Tensor) -> torch.Tensor:
-        """Every action's parameters ``(B, K, m)`` as the critics' all-actions vector ``(B, sum_a m_a)``."""
-        return x.reshape(x.shape[0], -1)[:, self.flat_index]
 
 
 class HybridSAC(Algorithm):

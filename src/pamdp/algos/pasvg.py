@@ -16,7 +16,6 @@ from collections.abc import Callable
 import numpy as np
 import torch
 import torch.nn.functional as F
-from torch import nn
 
 from pamdp.algos.base import Algorithm
 from pamdp.algos.dense import Dense
@@ -33,11 +32,10 @@ from pamdp.algos.offpolicy import (
 )
 from pamdp.algos.optim import apply_gradients, descend
 from pamdp.algos.settings import NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
-from pamdp.distributions import LOG_STD_MAX, LOG_STD_MIN, masked_logits
-from pamdp.policies import TwinQ, every_action_linear, every_action_mlp, hierarchical_mlps
-from pamdp.spaces import HybridActionSpace
+from pamdp.distributions import LOG_STD_MAX, LOG_STD_MIN, gumbel_noise, masked_logits
+from pamdp.policies import GumbelHybridPolicy, TwinQ, every_action_linear
 
-__all__ = ["PASVG0", "PASVG0Config", "GumbelHybridPolicy", "expected_q", "gumbel_noise", "gumbel_softmax_sample"]
+__all__ = ["PASVG0", "PASVG0Config", "expected_q", "every_action_q"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -135,87 +133,6 @@ class PASVG0Config(OffPolicyConfig, AlgoConfig):
             buffer_size=1_000_000,
         ),
     }
-
-
-def gumbel_noise(shape: tuple[int, ...], generator: torch.Generator) -> torch.Tensor:
-    """Standard Gumbel samples ``-log(-log U)`` from ``generator`` (torch's own sampler uses the global RNG)."""
-    u = torch.rand(shape, generator=generator, device=generator.device).clamp_(1e-10, 1.0 - 1e-7)
-    return -torch.log(-torch.log(u))
-
-
-def gumbel_softmax_sample(
-    logits: torch.Tensor, eta: torch.Tensor, temperature: float, hard: bool
-) -> tuple[torch.Tensor, torch.Tensor]:
-    """The Gumbel-Softmax sample for noise ``eta``: ``(index, sample)``.
-
-    ``index = argmax(logits + eta)`` is an exact draw from ``softmax(logits)`` (the Gumbel-max trick).
-    ``sample`` is ``softmax((logits + eta) / temperature)``, or with ``hard`` the one-hot of ``index`` in the
-    forward pass carrying the softmax's gradient in the backward pass (straight-through).
-    """
-    z = logits.log_softmax(-1) + eta
-    soft = torch.softmax(z / temperature, dim=-1)
-    index = z.argmax(-1)
-    if not hard:
-        return index, soft
-    onehot = F.one_hot(index, logits.shape[-1]).to(soft.dtype)
-    return index, onehot - soft.detach() + soft
-
-
-class GumbelHybridPolicy(nn.Module):
-    """``pi_d`` (logits over K actions) and ``pi_c`` (pre-Tanh means of ``m`` parameters given ``[s, a]``).
-
-    The parameter noise has a state-independent log-std per action and parameter; parameters an action does
-    not use (its entries beyond ``m_a``) are set to 0 so they carry no noise into the critic.
-    """
-
-    def __init__(self, obs_dim: int, hybrid: HybridActionSpace, hidden_sizes, activation: str, init_log_std: float):
-        super().__init__()
-        self.n_actions, self.param_size = hybrid.n_actions, hybrid.max_param_size
-        self.pi_d, self.pi_c = hierarchical_mlps(obs_dim, self.n_actions, hidden_sizes, activation, self.param_size)
-        self.log_std = nn.Parameter(torch.full((self.n_actions, self.param_size), float(init_log_std)))
-        self.register_buffer("mask", torch.tensor(hybrid.param_mask, dtype=torch.float32))
-
-    def std(self) -> torch.Tensor:
-        """The parameter noise's std per action and parameter, ``(K, m)``."""
-        return self.log_std.clamp(LOG_STD_MIN, LOG_STD_MAX).exp()
-
-    def params(self, obs: torch.Tensor, index: torch.Tensor, a: torch.Tensor, eta_x: torch.Tensor) -> torch.Tensor:
-        """``x = g(s, a, eta_x)``: ``pi_c``'s parameters for action ``a`` (one-hot or soft; ``index`` its argmax)."""
-        return torch.tanh(self.pi_c(torch.cat([obs, a], dim=-1)) + self.std()[index] * eta_x) * self.mask[index]
-
-    def params_all(self, obs: torch.Tensor, eta_x: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
-        """Every action's parameters for the noise ``eta_x``: ``(obs_k, onehots, x)``, each ``(B, K, .)``.
-
-        ``obs_k`` and ``onehots`` are the critic's matching state and action inputs, so that
-        ``critic(obs_k, onehots, x)`` is ``Q(s, k, x_k)`` for every ``k`` in one batched pass.
-        """
-        batch, K = len(obs), self.n_actions
-        onehots = torch.eye(K, dtype=obs.dtype, device=obs.device).expand(batch, K, K)
-        obs_k = obs.unsqueeze(-2).expand(batch, K, obs.shape[-1])
-        means = every_action_mlp(self.pi_c, obs)  # without building the B * K inputs (as params would)
-        return obs_k, onehots, torch.tanh(means + self.std() * eta_x.unsqueeze(-2)) * self.mask
-
-    def forward(
-        self,
-        obs: torch.Tensor,
-        eta_a: torch.Tensor,
-        eta_x: torch.Tensor,
-        temperature: float,
-        hard: bool,
-        mask: torch.Tensor | None = None,
-    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
-        """``(logits, index, a, x)`` for the noise ``(eta_a, eta_x)``: ``pi_d``'s logits (restricted to the actions
-        ``mask`` allows), the action, the critic's action input ``a`` and the parameters ``x``, so an update runs
-        ``pi_d`` once."""
-        logits = masked_logits(self.pi_d(obs), mask)
-        index, a = gumbel_softmax_sample(logits, eta_a, temperature, hard)
-        return logits, index, a, self.params(obs, index, a, eta_x)
-
-    def mode(self, obs: torch.Tensor, mask: torch.Tensor | None = None) -> tuple[torch.Tensor, torch.Tensor]:
-        """The greedy action: the most probable (allowed) discrete action and its mean parameters."""
-        index = masked_logits(self.pi_d(obs), mask).argmax(-1)
-        onehot = F.one_hot(index, self.n_actions).to(obs.dtype)
-        return index, torch.tanh(self.pi_c(torch.cat([obs, onehot], dim=-1))) * self.mask[index]
 
 
 def expected_q(
