@@ -22,9 +22,9 @@ from pamdp.algos.offpolicy import (
     shared_setting,
     soft_updater,
     tau_setting,
-    temperature_gradient,
+    td_target,
 )
-from pamdp.algos.optim import apply_gradients, descend
+from pamdp.algos.optim import descend
 from pamdp.algos.settings import NON_NEGATIVE, POSITIVE, AlgoConfig, Check, interval, one_of, setting
 from pamdp.distributions import MASKED, SquashedHybrid
 from pamdp.policies import FORMS, HybridSACActor, TwinQ
@@ -118,8 +118,7 @@ class HybridSAC(Algorithm):
     @property
     def alphas(self) -> tuple[float, float]:
         """The current temperatures ``(alpha_d, alpha_c)``."""
-        alpha_d, alpha_c = self._alpha_tensors()
-        return float(alpha_d), float(alpha_c)
+        return tuple(float(alpha) for alpha in self.temperatures.alphas())
 
     # -- acting ----------------------------------------------------------------------------------
     def _act(self, obs, deterministic, mask=None):
@@ -151,22 +150,13 @@ class HybridSAC(Algorithm):
         q = critic.smaller(obs, self.actor.flat_params(x_all))
         return q - alpha_c * log_pc - alpha_d * dist.log_probs_d, log_pc
 
-    def _alpha_tensors(self) -> tuple[torch.Tensor, torch.Tensor]:
-        t = self.temperatures
-        return t.log_alpha_d.detach().exp(), t.log_alpha_c.detach().exp()
-
     @torch.no_grad()
     def target_value(self, next_obs: torch.Tensor, next_mask: torch.Tensor | None = None) -> torch.Tensor:
         """``V(s')`` ``(B,)``: the soft value under the target critics, exact over the next discrete action
         (masked ones weigh nothing), at one draw of every action's parameters."""
         dist = self.actor(next_obs, next_mask)
-        soft_q, _ = self.soft_value(dist, self.critic_target, next_obs, *self._alpha_tensors())
+        soft_q, _ = self.soft_value(dist, self.critic_target, next_obs, *self.temperatures.alphas())
         return (dist.probs_d * soft_q).sum(-1)
-
-    def temperature_step(self, entropy_d, target_d, entropy_c, target_c) -> None:
-        """One Adam step of each log-temperature along :func:`temperature_gradient` of its part's entropy."""
-        gradients = [temperature_gradient(entropy_d, target_d), temperature_gradient(entropy_c, target_c)]
-        apply_gradients(self.alpha_optimizer, gradients)
 
     def _update(self) -> dict[str, float]:
         """One soft Q step of both critics, one policy step, one step of each temperature, the target update."""
@@ -174,8 +164,8 @@ class HybridSAC(Algorithm):
         b = self.replay.sample(cfg.batch_size, self.np_rng)
         obs, next_obs = b["obs"], b["next_obs"]
         mask, next_mask = b.get("mask"), b.get("next_mask")  # with the action_mask setting only
-        alpha_d, alpha_c = self._alpha_tensors()
-        y = b["reward"] + cfg.gamma * (~b["terminated"]).float() * self.target_value(next_obs, next_mask)
+        alpha_d, alpha_c = self.temperatures.alphas()
+        y = td_target(b, cfg.gamma, self.target_value(next_obs, next_mask))
         a = b["a"][:, None]
         q1, q2 = (q.gather(1, a).squeeze(1) for q in self.critic(obs, b["params"]))
         critic_loss = F.mse_loss(q1, y) + F.mse_loss(q2, y)
@@ -194,7 +184,7 @@ class HybridSAC(Algorithm):
             p = p.detach()
             entropy_c = -(p * log_pc.detach()).sum(-1)  # of the expected action's parameters
             target_c = cfg.target_entropy_c * (p * self.param_sizes).sum(-1)
-        self.temperature_step(entropy_d, target_d, entropy_c, target_c)
+        self.temperatures.step(self.alpha_optimizer, (entropy_d, target_d), (entropy_c, target_c))
         self._soft_update(cfg.tau)
         return {
             "losses/critic_loss": float(critic_loss.detach()),

@@ -14,6 +14,7 @@ import numpy as np
 import torch
 from torch import nn
 
+from pamdp.algos.optim import apply_gradients
 from pamdp.algos.replay import ReplayBuffer, transition_fields
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, at_least, interval, one_of, redeclared, setting
 from pamdp.algos.subnormals import subnormals_flushed
@@ -30,6 +31,7 @@ __all__ = [
     "OffPolicyLoop",
     "Temperatures",
     "temperature_gradient",
+    "td_target",
     "OUNoise",
     "soft_update",
     "soft_updater",
@@ -179,11 +181,26 @@ class Temperatures(nn.Module):
         for name, alpha in initial.items():
             self.register_parameter(f"log_{name}", nn.Parameter(torch.tensor(math.log(alpha), dtype=torch.float32)))
 
+    def alphas(self) -> tuple[torch.Tensor, ...]:
+        """Each ``alpha``, detached, in the order of the keywords."""
+        return tuple(p.detach().exp() for p in self.parameters())
+
+    def step(self, optimizer: torch.optim.Optimizer, *entropies: tuple[torch.Tensor, torch.Tensor | float]) -> None:
+        """One step of ``optimizer`` (over these parameters) on each ``log alpha`` along :func:`temperature_gradient`
+        of its ``(entropy estimates, target)``, computed in the estimates' precision."""
+        grads = [temperature_gradient(h, target).to(p.dtype) for (h, target), p in zip(entropies, self.parameters())]
+        apply_gradients(optimizer, grads)
+
 
 def temperature_gradient(entropy: torch.Tensor, target: torch.Tensor | float) -> torch.Tensor:
     """The gradient in ``log alpha`` of SAC's temperature loss ``mean(log alpha * (H - target))``, the entropy
     estimates ``H`` held fixed: ``mean(H - target)`` (why: docs/algorithms.md, "The off-policy family")."""
     return (entropy - target).mean()
+
+
+def td_target(batch: dict[str, torch.Tensor], gamma: float, next_value: torch.Tensor) -> torch.Tensor:
+    """``y = r + gamma V(s')`` of a replayed batch, with no bootstrap after a termination."""
+    return batch["reward"] + gamma * (~batch["terminated"]).float() * next_value
 
 
 def soft_update(target: nn.Module, source: nn.Module, tau: float) -> None:

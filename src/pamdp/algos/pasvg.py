@@ -27,7 +27,7 @@ from pamdp.algos.offpolicy import (
     shared_setting,
     soft_updater,
     tau_setting,
-    temperature_gradient,
+    td_target,
     uniform_actions,
 )
 from pamdp.algos.optim import apply_gradients, descend
@@ -275,7 +275,7 @@ class PASVG0(Algorithm):
         else:
             *_, a_next, x_next = self.policy_target(next_obs, eta_a, eta_x, cfg.temperature, cfg.straight_through, mask)
             q_next = self.critic_target.smaller(next_obs, a_next, x_next).squeeze(-1)
-        return b["reward"] + cfg.gamma * (~b["terminated"]).float() * q_next
+        return td_target(b, cfg.gamma, q_next)
 
     def _update(self) -> dict[str, float]:
         """One critic TD step and (every ``policy_delay``-th call) one value-gradient step of both policies."""
@@ -307,15 +307,14 @@ class PASVG0(Algorithm):
             logits, _, a, x = self.policy(obs, b["eta_a"], b["eta_x"], cfg.temperature, cfg.straight_through, mask)
             q_pi = self._q1(obs, a, x)
         entropy = -(logits.softmax(-1) * logits.log_softmax(-1)).sum(-1).mean()
-        alpha = cfg.entropy_coef if self.entropy_weight is None else float(self.entropy_weight.log_alpha.detach().exp())
+        alpha = cfg.entropy_coef if self.entropy_weight is None else float(self.entropy_weight.alphas()[0])
         actor_loss = -q_pi.mean() - alpha * entropy
         # The policy loss differentiates Q in (a, x) only: asking for the policy's gradients alone skips the
         # critic's weight gradients, which backward() would compute and the critic must not receive.
         descend(self.policy_optimizer, actor_loss, self.policy_params, cfg.grad_clip)
         if self.entropy_weight is not None:
             # in double, as the loss log_alpha * (float(H) - target) it replaced: the same step
-            gradient = temperature_gradient(entropy.detach().double(), cfg.target_entropy).float()
-            apply_gradients(self.entropy_optimizer, [gradient])
+            self.entropy_weight.step(self.entropy_optimizer, (entropy.detach().double(), cfg.target_entropy))
         self._soft_update(cfg.tau)
         return self._policy_stats(actor_loss.detach(), q_pi, entropy.detach(), alpha)
 
