@@ -22,7 +22,6 @@ from pamdp.algos.offpolicy import (
     shared_setting,
     soft_updater,
     tau_setting,
-    td_target,
 )
 from pamdp.algos.optim import descend
 from pamdp.algos.settings import NON_NEGATIVE, POSITIVE, AlgoConfig, Check, interval, one_of, setting
@@ -165,7 +164,7 @@ class HybridSAC(Algorithm):
         obs, next_obs = b["obs"], b["next_obs"]
         mask, next_mask = b.get("mask"), b.get("next_mask")  # with the action_mask setting only
         alpha_d, alpha_c = self.temperatures.alphas()
-        y = td_target(b, cfg.gamma, self.target_value(next_obs, next_mask))
+        y = self.loop.td_target(b, self.target_value(next_obs, next_mask))
         a = b["a"][:, None]
         q1, q2 = (q.gather(1, a).squeeze(1) for q in self.critic(obs, b["params"]))
         critic_loss = F.mse_loss(q1, y) + F.mse_loss(q2, y)

@@ -26,7 +26,6 @@ from pamdp.algos.offpolicy import (
     shared_setting,
     soft_updater,
     tau_setting,
-    td_target,
     uniform_actions,
 )
 from pamdp.algos.optim import apply_gradients, descend
@@ -447,7 +446,7 @@ class HyAR(EpsilonSchedule, Algorithm):
             u_next = (u_next + noise.clamp(-cfg.target_noise_clip, cfg.target_noise_clip)).clamp(-1.0, 1.0)
             latent_next = self.rep.snap(self.actor_target.to_latent(u_next), b.get("next_mask"))
             q_next = self.critic_target.smaller(next_obs, latent_next).squeeze(-1)
-            y = td_target(b, cfg.gamma, q_next)
+            y = self.loop.td_target(b, q_next)
         q1, q2 = (q.squeeze(-1) for q in self.critic(obs, latent))
         critic_loss = F.mse_loss(q1, y) + F.mse_loss(q2, y)
         descend(self.critic_optimizer, critic_loss, self._critic_params, cfg.grad_clip)

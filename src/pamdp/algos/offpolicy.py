@@ -31,7 +31,6 @@ __all__ = [
     "OffPolicyLoop",
     "Temperatures",
     "temperature_gradient",
-    "td_target",
     "OUNoise",
     "soft_update",
     "soft_updater",
@@ -196,11 +195,6 @@ def temperature_gradient(entropy: torch.Tensor, target: torch.Tensor | float) ->
     """The gradient in ``log alpha`` of SAC's temperature loss ``mean(log alpha * (H - target))``, the entropy
     estimates ``H`` held fixed: ``mean(H - target)`` (why: docs/algorithms.md, "The off-policy family")."""
     return (entropy - target).mean()
-
-
-def td_target(batch: dict[str, torch.Tensor], gamma: float, next_value: torch.Tensor) -> torch.Tensor:
-    """``y = r + gamma V(s')`` of a replayed batch, with no bootstrap after a termination."""
-    return batch["reward"] + gamma * (~batch["terminated"]).float() * next_value
 
 
 def soft_update(target: nn.Module, source: nn.Module, tau: float) -> None:
@@ -368,6 +362,10 @@ class OffPolicyLoop:
         self.tail_value = tail_value
         self.update_credit = 0.0
         self.stepper: VectorStepper | None = None  # the env's copies, from the first epoch on
+
+    def td_target(self, batch: dict[str, torch.Tensor], next_value: torch.Tensor) -> torch.Tensor:
+        """``y = r + gamma V(s')`` of a replayed batch, with no bootstrap after a termination."""
+        return batch["reward"] + self.config.gamma * (~batch["terminated"]).float() * next_value
 
     def budget_note(self, total: int) -> str | None:
         """Why ``total`` more samples make no gradient update (the replay would not reach ``learning_starts``), or

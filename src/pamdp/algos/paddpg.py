@@ -29,7 +29,6 @@ from pamdp.algos.offpolicy import (
     shared_setting,
     soft_updater,
     tau_setting,
-    td_target,
 )
 from pamdp.algos.optim import apply_gradients
 from pamdp.algos.settings import POSITIVE, AlgoConfig, interval, setting
@@ -159,7 +158,7 @@ class PADDPG(EpsilonSchedule, Algorithm):
         with torch.no_grad():
             out_next = self._masked(nets["actor_target"](next_obs).clamp(-1.0, 1.0), b.get("next_mask"))
             q_next = nets["critic_target"](torch.cat([next_obs, out_next], dim=-1)).squeeze(-1)
-            y = td_target(b, cfg.gamma, q_next)
+            y = self.loop.td_target(b, q_next)
             if cfg.beta > 0:
                 y = mixed_target(y, b["mc"], cfg.beta)
             # critic: descend on mean (Q - y)^2 over the batch

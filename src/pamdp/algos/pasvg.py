@@ -27,7 +27,6 @@ from pamdp.algos.offpolicy import (
     shared_setting,
     soft_updater,
     tau_setting,
-    td_target,
     uniform_actions,
 )
 from pamdp.algos.optim import apply_gradients, descend
@@ -275,7 +274,7 @@ class PASVG0(Algorithm):
         else:
             *_, a_next, x_next = self.policy_target(next_obs, eta_a, eta_x, cfg.temperature, cfg.straight_through, mask)
             q_next = self.critic_target.smaller(next_obs, a_next, x_next).squeeze(-1)
-        return td_target(b, cfg.gamma, q_next)
+        return self.loop.td_target(b, q_next)
 
     def _update(self) -> dict[str, float]:
         """One critic TD step and (every ``policy_delay``-th call) one value-gradient step of both policies."""

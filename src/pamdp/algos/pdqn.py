@@ -31,16 +31,10 @@ from pamdp.algos.offpolicy import (
     shared_setting,
     soft_updater,
     tau_setting,
-    td_target,
     uniform_actions,
 )
 from pamdp.algos.optim import apply_gradients
-from pamdp.algos.settings import (
-    POSITIVE,
-    AlgoConfig,
-    Check,
-    setting,
-)
+from pamdp.algos.settings import POSITIVE, AlgoConfig, Check, setting
 from pamdp.distributions import masked_logits
 from pamdp.policies import DeterministicActor, in_chunks, mlp
 from pamdp.spaces import HybridActionSpace
@@ -266,7 +260,7 @@ class PDQN(EpsilonSchedule, Algorithm):
         obs, next_obs, batch = b["obs"], b["next_obs"], len(b["obs"])
         with torch.no_grad():
             q_next = self._next_value(next_obs, b.get("next_mask"))
-            y = td_target(b, cfg.gamma, q_next)
+            y = self.loop.td_target(b, q_next)
             if cfg.beta > 0:
                 y = mixed_target(y, b["mc"], cfg.beta)
             # Q: descend on mean (Q_a - y)^2, the gradient reaching Q_a of the replayed action only
