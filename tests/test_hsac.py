@@ -15,9 +15,10 @@ from gymnasium import spaces
 from torch.distributions import Normal, TanhTransform, TransformedDistribution
 
 from pamdp import HybridSAC
-from pamdp.algos.hsac import HybridSACActor, HybridSACConfig
+from pamdp.algos.hsac import HybridSACConfig
 from pamdp.algos.offpolicy import temperature_gradient
 from pamdp.distributions import SquashedHybrid
+from pamdp.policies import HybridSACActor
 from pamdp.spaces import HybridActionSpace
 
 SMALL = HybridSACConfig(hidden_sizes=(16, 16), updates_per_step=0.5, **OFF_POLICY_SMALL)
@@ -187,14 +188,16 @@ def test_temperature_gradient_sign_and_fixed_point():
     model = _model(alpha_lr=0.01)
     start = model.alphas
     hot = torch.full((8,), 2.0)  # both parts more random than their targets: both temperatures fall
-    model.temperature_step(hot, 1.0, hot, 1.0)
+    model.temperatures.step(model.alpha_optimizer, (hot, 1.0), (hot, 1.0))
     assert model.alphas[0] < start[0] and model.alphas[1] < start[1]
     after = model.alphas
-    model.temperature_step(torch.zeros(8), 1.0, torch.full((8,), -3.0), -2.0)  # less random: both rise
+    model.temperatures.step(
+        model.alpha_optimizer, (torch.zeros(8), 1.0), (torch.full((8,), -3.0), -2.0)
+    )  # less random: both rise
     assert model.alphas[0] > after[0] and model.alphas[1] > after[1]
     fixed = _model(alpha_lr=0.01)
     at_target = torch.tensor([0.5, 1.5])  # mean 1.0: the target
-    fixed.temperature_step(at_target, 1.0, at_target - 3.0, -2.0)
+    fixed.temperatures.step(fixed.alpha_optimizer, (at_target, 1.0), (at_target - 3.0, -2.0))
     assert fixed.alphas == pytest.approx(start, abs=1e-7)
 
 

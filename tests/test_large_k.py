@@ -9,9 +9,9 @@ import torch
 import torch.nn.functional as F
 
 from pamdp import policies
-from pamdp.algos.pasvg import Critic, GumbelHybridPolicy, every_action_q
+from pamdp.algos.pasvg import every_action_q
 from pamdp.algos.pdqn import QNetwork, param_blocks
-from pamdp.policies import HybridPolicy, every_action_linear
+from pamdp.policies import GumbelHybridPolicy, HybridPolicy, TwinQ, every_action_linear
 from pamdp.spaces import HybridActionSpace
 
 SIZES = (2, 0, 1, 3, 1)  # unequal boxes, one without parameters
@@ -95,7 +95,7 @@ def test_policy_acts_as_its_distribution_does_from_the_chosen_action_alone(deter
 
 
 def test_pasvg_critic_and_parameters_of_every_action_are_the_explicit_ones():
-    critic = randomised(Critic(D, K, M, (7, 5), "relu"))
+    critic = randomised(TwinQ(D + K + M, 1, (7, 5), "relu"))
     policy = randomised(GumbelHybridPolicy(D, HYBRID, (6,), "tanh", init_log_std=-0.5))
     obs, eta_x = inputs((B, D), (B, M))
 
@@ -104,7 +104,7 @@ def test_pasvg_critic_and_parameters_of_every_action_are_the_explicit_ones():
         onehots = torch.eye(K, dtype=obs.dtype).expand(B, K, K)
         obs_k = obs.unsqueeze(1).expand(B, K, D)
         x = policy.params(obs_k, index, onehots, eta_x.unsqueeze(1))
-        return torch.cat([x.flatten(1), critic(obs_k, onehots, x)], -1)
+        return torch.cat([x.flatten(1), critic(obs_k, onehots, x)[0].squeeze(-1)], -1)
 
     def fast(obs, eta_x):
         obs_k, onehots, x = policy.params_all(obs, eta_x)
@@ -112,11 +112,10 @@ def test_pasvg_critic_and_parameters_of_every_action_are_the_explicit_ones():
 
     both = torch.nn.ModuleList([critic, policy])
     assert_same_function(both, fast, explicit, obs, eta_x)
-    twin = randomised(Critic(D, K, M, (7, 5), "relu"))
     obs_k, onehots, x = policy.params_all(obs, eta_x)
     torch.testing.assert_close(
-        every_action_q(critic, twin)(obs_k, onehots, x),
-        torch.minimum(critic(obs_k, onehots, x), twin(obs_k, onehots, x)),
+        every_action_q(critic, smaller=True)(obs_k, onehots, x),
+        torch.minimum(*critic(obs_k, onehots, x)).squeeze(-1),
         rtol=1e-12,
         atol=1e-12,
     )

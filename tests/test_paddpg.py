@@ -10,7 +10,8 @@ from conftest import HYBRID, OFF_POLICY_SMALL
 
 from pamdp import PADDPG
 from pamdp.algos.offpolicy import invert_gradients, zero_gradients
-from pamdp.algos.paddpg import Actor, Critic, PADDPGConfig
+from pamdp.algos.paddpg import Critic, PADDPGConfig
+from pamdp.policies import DeterministicActor
 
 SMALL = PADDPGConfig(hidden_sizes=(16, 16), epsilon_steps=300, **OFF_POLICY_SMALL)
 
@@ -71,14 +72,14 @@ def test_only_squash_keeps_outputs_of_large_weights_in_bounds():
     torch.manual_seed(0)
     obs = torch.randn(100, 4)
     for squash in (True, False):
-        actor = Actor(4, HYBRID, (8,), "relu", squash=squash)
+        actor = DeterministicActor(4, 3 + 4, (8,), "relu", squash, HYBRID, offset=3)
         for p in actor.parameters():
             p.data.mul_(100)
         assert (actor(obs).abs().max() <= 1.0) == squash
 
 
 def test_executed_action_is_the_argmax_with_its_own_parameters():
-    actor = Actor(4, HYBRID, (8,), "relu", squash=False)
+    actor = DeterministicActor(4, 3 + 4, (8,), "relu", False, HYBRID, offset=3)
     # Scores for 3 actions, then parameters: action 0 -> [p0], action 1 -> [p1, p2], action 2 -> [p3].
     out = torch.tensor(
         [

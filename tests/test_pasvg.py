@@ -9,13 +9,9 @@ import torch
 from conftest import HYBRID, OFF_POLICY_SMALL, module_bytes
 
 from pamdp import PASVG0
-from pamdp.algos.pasvg import (
-    GumbelHybridPolicy,
-    PASVG0Config,
-    expected_q,
-    gumbel_noise,
-    gumbel_softmax_sample,
-)
+from pamdp.algos.pasvg import PASVG0Config, expected_q
+from pamdp.distributions import gumbel_noise, gumbel_softmax_sample
+from pamdp.policies import GumbelHybridPolicy
 
 SMALL = PASVG0Config(hidden_sizes=(16, 16), **OFF_POLICY_SMALL)
 
@@ -130,7 +126,7 @@ def test_expected_td_target_averages_the_target_policys_actions():
     model.replay.sample = lambda n, rng: batch
     gen_state = model.torch_gen.get_state()
     with torch.no_grad():
-        q = model.critic(batch["obs"], batch["a_in"], batch["x"])
+        q = model._q1(batch["obs"], batch["a_in"], batch["x"])
         model.torch_gen.set_state(gen_state)
         _, eta_x = model._noise(16)
         model.torch_gen.set_state(gen_state)
@@ -139,7 +135,7 @@ def test_expected_td_target_averages_the_target_policys_actions():
         for k in range(K):  # one action at a time, by hand
             onehot = torch.nn.functional.one_hot(torch.full((16,), k), K).float()
             x_k = pt.params(s2, torch.full((16,), k), onehot, eta_x)
-            total += pt.pi_d(s2).softmax(-1)[:, k] * model.critic_target(s2, onehot, x_k)
+            total += pt.pi_d(s2).softmax(-1)[:, k] * model.critic_target.smaller(s2, onehot, x_k).squeeze(-1)
         y = batch["reward"] + 0.99 * (~batch["terminated"]).float() * total
     stats = model._update()
     assert stats["losses/critic_loss"] == pytest.approx(float(((q - y) ** 2).mean()), rel=1e-5)
@@ -234,20 +230,41 @@ def test_twin_critics_learn_towards_the_smaller_target(tmp_path):
     batch = model.replay.sample(16, np.random.default_rng(0))
     model.replay.sample = lambda n, rng: batch
     outs = {}
-    for name in ("critic_target", "critic2_target"):
-        getattr(model, name).register_forward_hook(lambda m, i, o, name=name: outs.__setitem__(name, o.clone()))
+    for name in ("q1", "q2"):
+        net = getattr(model.critic_target, name)
+        net.register_forward_hook(lambda m, i, o, name=name: outs.__setitem__(name, o.squeeze(-1).clone()))
     with torch.no_grad():
-        model.critic2_target.net[-1].bias.fill_(-3.0)  # the second target critic is now the smaller one
-        q1, q2 = (c(batch["obs"], batch["a_in"], batch["x"]) for c in (model.critic, model.critic2))
+        model.critic_target.q2[-1].bias.fill_(-3.0)  # the second target critic is now the smaller one
+        q1, q2 = (q.squeeze(-1) for q in model.critic(batch["obs"], batch["a_in"], batch["x"]))
     stats = model._update()
-    assert torch.all(outs["critic2_target"] < outs["critic_target"])
+    assert torch.all(outs["q2"] < outs["q1"])
     y = batch["reward"] + 0.99 * (~batch["terminated"]).float() * torch.minimum(*outs.values())
     expected = ((q1 - y) ** 2).mean() + ((q2 - y) ** 2).mean()
     assert stats["losses/critic_loss"] == pytest.approx(float(expected), rel=1e-5)
     model.save(tmp_path / "m.pt")
     loaded = PASVG0.load(tmp_path / "m.pt")
     assert module_bytes(loaded) == module_bytes(model)
-    assert torch.equal(loaded.critic2.net[0].weight, model.critic2.net[0].weight) and loaded.critic_updates == 1
+    assert torch.equal(loaded.critic.q2[0].weight, model.critic.q2[0].weight) and loaded.critic_updates == 1
+
+
+@pytest.mark.parametrize("twin", [False, True])
+def test_checkpoints_of_the_critics_before_they_were_one_twin_q_still_load(tmp_path, twin):
+    """Files written when the critics were modules ``critic`` and ``critic2`` (and their targets), each an ``mlp``
+    under ``net``, load into the TwinQ's ``q1`` and ``q2`` (checkpoints.RENAMED)."""
+    model = PASVG0("pamdp/Platform-v0", dataclasses.replace(SMALL, twin_critics=twin))
+    model.learn(100, progress_bar=False)
+    model.save(tmp_path / "new.pt")
+    payload = torch.load(tmp_path / "new.pt", weights_only=True)
+    modules = payload["modules"]
+    for name in ("critic", "critic_target"):
+        state = modules.pop(name)
+        for q, old in (("q1", name), ("q2", name.replace("critic", "critic2"))):
+            keys = [k for k in state if k.startswith(q + ".")]
+            if keys:
+                modules[old] = {"net." + k[3:]: state[k] for k in keys}
+    assert ("critic2" in modules) == twin
+    torch.save(payload, tmp_path / "old.pt")
+    assert module_bytes(PASVG0.load(tmp_path / "old.pt")) == module_bytes(model)
 
 
 def test_policy_delay_updates_the_policy_and_targets_every_kth_step():
@@ -296,7 +313,7 @@ def test_critic_loss_falls_on_a_fixed_batch():
     target = b["reward"]  # a fixed regression target: the one-step reward
     losses = []
     for _ in range(150):
-        loss = (model.critic(b["obs"], b["a_in"], b["x"]) - target).pow(2).mean()
+        loss = (model._q1(b["obs"], b["a_in"], b["x"]) - target).pow(2).mean()
         model.critic_optimizer.zero_grad()
         loss.backward()
         model.critic_optimizer.step()

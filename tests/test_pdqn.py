@@ -15,7 +15,8 @@ from torch import nn
 
 from pamdp import PDQN
 from pamdp.algos.offpolicy import OUNoise, backprop_actor, invert_gradients, mixed_target
-from pamdp.algos.pdqn import ParamActor, PDQNConfig, QNetwork, param_blocks
+from pamdp.algos.pdqn import PDQNConfig, QNetwork, param_blocks
+from pamdp.policies import DeterministicActor
 from pamdp.spaces import HybridActionSpace
 
 SMALL = PDQNConfig(hidden_sizes=(16,), epsilon_steps=300, **OFF_POLICY_SMALL)
@@ -25,7 +26,7 @@ BLOCKS = [slice(0, 1), slice(1, 3), slice(3, 4)]
 
 def test_parameter_blocks_and_selection_by_hand():
     np.testing.assert_array_equal(param_blocks(HYBRID), [[1, 0, 0, 0], [0, 1, 1, 0], [0, 0, 0, 1]])
-    actor = ParamActor(5, HYBRID, (8,), "relu", squash=False)
+    actor = DeterministicActor(5, 4, (8,), "relu", False, HYBRID)
     params = torch.tensor([[0.1, 0.2, 0.3, 0.4]] * 3)
     x = actor.select(params, torch.tensor([0, 1, 2]))
     torch.testing.assert_close(x, torch.tensor([[0.1, 0.0], [0.2, 0.3], [0.4, 0.0]]))
@@ -115,7 +116,7 @@ def test_only_p_dqn_q_depends_on_other_actions_parameters():
 @pytest.mark.parametrize("multi_pass", [False, True])
 def test_actor_gradient_matches_finite_differences_of_sum_of_q(multi_pass):
     torch.manual_seed(2)
-    actor = ParamActor(5, HYBRID, (6,), "tanh", squash=True).double()
+    actor = DeterministicActor(5, 4, (6,), "tanh", True, HYBRID).double()
     q_net = QNetwork(5, HYBRID, (6,), "tanh", multi_pass=multi_pass).double()
     obs = torch.randn(4, 5, dtype=torch.float64)
     _, _, grads = backprop_actor(actor, q_net, obs, "squash", list(actor.parameters()))  # Tanh: the plain gradient
@@ -129,7 +130,7 @@ def test_actor_gradient_matches_finite_differences_of_sum_of_q(multi_pass):
 
 def test_inverted_actor_gradient_matches_finite_differences():
     torch.manual_seed(3)
-    actor = ParamActor(5, HYBRID, (6,), "tanh", squash=False).double()
+    actor = DeterministicActor(5, 4, (6,), "tanh", False, HYBRID).double()
     with torch.no_grad():
         actor.net[-1].weight.mul_(4.0)  # push some outputs past the bounds, where the inversion flips the sign
     q_net = QNetwork(5, HYBRID, (6,), "tanh", multi_pass=True).double()

@@ -31,6 +31,8 @@ __all__ = [
     "SquashedHybrid",
     "draw_action",
     "draw_params",
+    "gumbel_noise",
+    "gumbel_softmax_sample",
     "kl_divergence",
     "masked_logits",
 ]
@@ -80,6 +82,30 @@ def draw_params(
     if not deterministic:
         mu = mu + log_std.exp() * torch.randn(mu.shape, generator=generator, dtype=mu.dtype, device=mu.device)
     return mu * mask
+
+
+def gumbel_noise(shape: tuple[int, ...], generator: torch.Generator) -> torch.Tensor:
+    """Standard Gumbel samples ``-log(-log U)`` from ``generator`` (torch's own sampler uses the global RNG)."""
+    u = torch.rand(shape, generator=generator, device=generator.device).clamp_(1e-10, 1.0 - 1e-7)
+    return -torch.log(-torch.log(u))
+
+
+def gumbel_softmax_sample(
+    logits: torch.Tensor, eta: torch.Tensor, temperature: float, hard: bool
+) -> tuple[torch.Tensor, torch.Tensor]:
+    """The Gumbel-Softmax sample for noise ``eta``: ``(index, sample)``.
+
+    ``index = argmax(logits + eta)`` is an exact draw from ``softmax(logits)`` (the Gumbel-max trick).
+    ``sample`` is ``softmax((logits + eta) / temperature)``, or with ``hard`` the one-hot of ``index`` in the
+    forward pass carrying the softmax's gradient in the backward pass (straight-through).
+    """
+    z = logits.log_softmax(-1) + eta
+    soft = torch.softmax(z / temperature, dim=-1)
+    index = z.argmax(-1)
+    if not hard:
+        return index, soft
+    onehot = F.one_hot(index, logits.shape[-1]).to(soft.dtype)
+    return index, onehot - soft.detach() + soft
 
 
 @dataclass

@@ -16,11 +16,21 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 
+import numpy as np
 import torch
 import torch.nn.functional as F
 from torch import nn
 
-from pamdp.distributions import HybridDistribution, draw_action, draw_params, masked_logits
+from pamdp.distributions import (
+    LOG_STD_MAX,
+    LOG_STD_MIN,
+    HybridDistribution,
+    SquashedHybrid,
+    draw_action,
+    draw_params,
+    gumbel_softmax_sample,
+    masked_logits,
+)
 from pamdp.spaces import HybridActionSpace
 
 __all__ = [
@@ -35,7 +45,12 @@ __all__ = [
     "in_chunks",
     "LinearizedMLP",
     "HybridPolicy",
+    "GumbelHybridPolicy",
+    "FORMS",
+    "HybridSACActor",
     "ValueNetwork",
+    "TwinQ",
+    "DeterministicActor",
 ]
 
 ACTIVATIONS = {"relu": nn.ReLU, "tanh": nn.Tanh, "leaky_relu": nn.LeakyReLU, "elu": nn.ELU}
@@ -288,6 +303,107 @@ class HybridPolicy(nn.Module):
         return HybridDistribution(lin_d.outputs, means, self.log_std, self.mask), jvp
 
 
+class GumbelHybridPolicy(nn.Module):
+    """``pi_d`` (logits over K actions) and ``pi_c`` (pre-Tanh means of ``m`` parameters given ``[s, a]``).
+
+    The parameter noise has a state-independent log-std per action and parameter; parameters an action does
+    not use (its entries beyond ``m_a``) are set to 0 so they carry no noise into the critic.
+    """
+
+    def __init__(self, obs_dim: int, hybrid: HybridActionSpace, hidden_sizes, activation: str, init_log_std: float):
+        super().__init__()
+        self.n_actions, self.param_size = hybrid.n_actions, hybrid.max_param_size
+        self.pi_d, self.pi_c = hierarchical_mlps(obs_dim, self.n_actions, hidden_sizes, activation, self.param_size)
+        self.log_std = nn.Parameter(torch.full((self.n_actions, self.param_size), float(init_log_std)))
+        self.register_buffer("mask", torch.tensor(hybrid.param_mask, dtype=torch.float32))
+
+    def std(self) -> torch.Tensor:
+        """The parameter noise's std per action and parameter, ``(K, m)``."""
+        return self.log_std.clamp(LOG_STD_MIN, LOG_STD_MAX).exp()
+
+    def params(self, obs: torch.Tensor, index: torch.Tensor, a: torch.Tensor, eta_x: torch.Tensor) -> torch.Tensor:
+        """``x = g(s, a, eta_x)``: ``pi_c``'s parameters for action ``a`` (one-hot or soft; ``index`` its argmax)."""
+        return torch.tanh(self.pi_c(torch.cat([obs, a], dim=-1)) + self.std()[index] * eta_x) * self.mask[index]
+
+    def params_all(self, obs: torch.Tensor, eta_x: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+        """Every action's parameters for the noise ``eta_x``: ``(obs_k, onehots, x)``, each ``(B, K, .)``.
+
+        ``obs_k`` and ``onehots`` are the critic's matching state and action inputs, so that
+        ``critic(obs_k, onehots, x)`` is ``Q(s, k, x_k)`` for every ``k`` in one batched pass.
+        """
+        batch, K = len(obs), self.n_actions
+        onehots = torch.eye(K, dtype=obs.dtype, device=obs.device).expand(batch, K, K)
+        obs_k = obs.unsqueeze(-2).expand(batch, K, obs.shape[-1])
+        means = every_action_mlp(self.pi_c, obs)  # without building the B * K inputs (as params would)
+        return obs_k, onehots, torch.tanh(means + self.std() * eta_x.unsqueeze(-2)) * self.mask
+
+    def forward(
+        self,
+        obs: torch.Tensor,
+        eta_a: torch.Tensor,
+        eta_x: torch.Tensor,
+        temperature: float,
+        hard: bool,
+        mask: torch.Tensor | None = None,
+    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
+        """``(logits, index, a, x)`` for the noise ``(eta_a, eta_x)``: ``pi_d``'s logits (restricted to the actions
+        ``mask`` allows), the action, the critic's action input ``a`` and the parameters ``x``, so an update runs
+        ``pi_d`` once."""
+        logits = masked_logits(self.pi_d(obs), mask)
+        index, a = gumbel_softmax_sample(logits, eta_a, temperature, hard)
+        return logits, index, a, self.params(obs, index, a, eta_x)
+
+    def mode(self, obs: torch.Tensor, mask: torch.Tensor | None = None) -> tuple[torch.Tensor, torch.Tensor]:
+        """The greedy action: the most probable (allowed) discrete action and its mean parameters."""
+        index = masked_logits(self.pi_d(obs), mask).argmax(-1)
+        onehot = F.one_hot(index, self.n_actions).to(obs.dtype)
+        return index, torch.tanh(self.pi_c(torch.cat([obs, onehot], dim=-1))) * self.mask[index]
+
+
+FORMS = ("flat", "hierarchical")
+"""Hybrid SAC's policy forms (:class:`HybridSACActor`)."""
+
+
+class HybridSACActor(nn.Module):
+    """The policy, ``flat`` (``mlp(s) -> [logits | means | log-stds]``) or ``hierarchical`` (``pi_d = mlp(s)``,
+    ``pi_c = mlp([s, onehot(a)])`` for every ``a``); ``forward(obs, mask)`` is a :class:`SquashedHybrid`."""
+
+    def __init__(self, obs_dim: int, hybrid: HybridActionSpace, form: str, hidden_sizes, activation: str):
+        super().__init__()
+        if form not in FORMS:
+            raise ValueError(f"form = {form!r}; expected one of {', '.join(FORMS)}")
+        self.form, self.n_actions, self.m = form, hybrid.n_actions, hybrid.max_param_size
+        mask = hybrid.param_mask
+        self.register_buffer("param_mask", torch.tensor(mask, dtype=torch.float32))
+        self.register_buffer("param_index", torch.tensor(hybrid.param_index, dtype=torch.long).view(-1))
+        self.total = total = hybrid.total_param_size
+        # the all-actions vector's entries in the flattened padded (K * m) layout
+        self.register_buffer("flat_index", torch.tensor(np.flatnonzero(mask), dtype=torch.long))
+        if form == "flat":  # starts near uniform, centred, with unit noise, as the hierarchical form does
+            self.net = mlp(obs_dim, hidden_sizes, self.n_actions + 2 * total, activation)
+            small_init_(self.net[-1])
+        else:
+            self.pi_d, self.pi_c = hierarchical_mlps(obs_dim, self.n_actions, hidden_sizes, activation, 2 * self.m)
+
+    def _padded(self, flat: torch.Tensor) -> torch.Tensor:
+        """``(B, sum_a m_a)`` all-actions values as ``(B, K, m)``, zero where unused."""
+        return flat[:, self.param_index].view(-1, self.n_actions, self.m) * self.param_mask
+
+    def forward(self, obs: torch.Tensor, mask: torch.Tensor | None = None) -> SquashedHybrid:
+        if self.form == "flat":
+            logits, means, log_stds = self.net(obs).split([self.n_actions, self.total, self.total], dim=-1)
+            mean, log_std = self._padded(means), self._padded(log_stds)
+        else:
+            mean, log_std = every_action_mlp(self.pi_c, obs).split(self.m, dim=-1)
+            logits = self.pi_d(obs)
+        log_std = log_std.clamp(LOG_STD_MIN, LOG_STD_MAX)
+        return SquashedHybrid(masked_logits(logits, mask), mean, log_std, self.param_mask)
+
+    def flat_params(self, x: torch.Tensor) -> torch.Tensor:
+        """Every action's parameters ``(B, K, m)`` as the critics' all-actions vector ``(B, sum_a m_a)``."""
+        return x.reshape(x.shape[0], -1)[:, self.flat_index]
+
+
 class ValueNetwork(nn.Module):
     """A state-value MLP ``V(s)``, the modern choice of baseline for PATRPO."""
 
@@ -297,3 +413,89 @@ class ValueNetwork(nn.Module):
 
     def forward(self, obs: torch.Tensor) -> torch.Tensor:
         return self.net(obs).squeeze(-1)
+
+
+class TwinQ(nn.Module):
+    """Critics ``Q_1, Q_2`` of the same shape on ``[s, inputs...]``, for the clipped double Q-learning of TD3
+    (Fujimoto et al. 2018) and SAC: a target takes the smaller of the two target critics' values (:meth:`smaller`).
+    With ``twin=False`` there is ``Q_1`` alone (``q2`` is ``None``), whose value :meth:`smaller` then is."""
+
+    def __init__(self, in_size: int, out_size: int, hidden_sizes, activation: str, twin: bool = True):
+        super().__init__()
+        self.q1 = mlp(in_size, hidden_sizes, out_size, activation)
+        self.q2 = mlp(in_size, hidden_sizes, out_size, activation) if twin else None
+
+    def forward(self, obs: torch.Tensor, *inputs: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor | None]:
+        inp = torch.cat([obs, *inputs], dim=-1)
+        return self.q1(inp), None if self.q2 is None else self.q2(inp)
+
+    def smaller(self, obs: torch.Tensor, *inputs: torch.Tensor) -> torch.Tensor:
+        q1, q2 = self(obs, *inputs)
+        return q1 if q2 is None else torch.minimum(q1, q2)
+
+
+class DeterministicActor(nn.Module):
+    """``mu(s)``: an :func:`mlp` whose outputs are meant to lie in ``[-1, 1]``, by a Tanh after them with ``squash``,
+    else by the update's bounded gradients (acting clamps them). PADDPG's actor outputs K action scores then every
+    action's parameters (``hybrid`` with ``offset = K``), P-DQN's every action's parameters (``hybrid``), HyAR's a
+    latent action, which :meth:`to_latent` maps onto the latent box ``[low, high]`` (``box``).
+
+    ``passthrough``: Bester et al.'s passthrough layer (P-DQN's ``param_passthrough``), a fixed linear map of the
+    state, the rows of ``[W | b]`` flattened, added to the outputs and never trained; the output layer then starts at
+    zero, so that the first ``mu`` is the map.
+    """
+
+    def __init__(
+        self,
+        obs_dim: int,
+        out_size: int,
+        hidden_sizes: Sequence[int],
+        activation: str,
+        squash: bool,
+        hybrid: HybridActionSpace | None = None,
+        offset: int = 0,
+        passthrough: Sequence[float] = (),
+        box: bool = False,
+    ):
+        super().__init__()
+        self.offset = offset
+        self.net = mlp(obs_dim, hidden_sizes, out_size, activation, nn.Tanh if squash else None)
+        weight = bias = None
+        if passthrough:
+            if len(passthrough) != out_size * (obs_dim + 1):
+                raise ValueError(
+                    f"param_passthrough has {len(passthrough)} numbers; expected {out_size * (obs_dim + 1)} for this "
+                    f"env: {out_size} parameters x ({obs_dim} observation features + 1 bias), row by row"
+                )
+            table = torch.tensor(passthrough, dtype=torch.float32).view(out_size, obs_dim + 1)
+            weight, bias = table[:, :-1].contiguous(), table[:, -1].contiguous()
+            nn.init.zeros_(self.net[-1].weight)
+            nn.init.zeros_(self.net[-1].bias)
+        self.register_buffer("passthrough_weight", weight)
+        self.register_buffer("passthrough_bias", bias)
+        if hybrid is not None:  # where action a's padded parameter i sits in the outputs (0 where unused)
+            index = np.where(hybrid.param_mask, offset + hybrid.param_index, 0)
+            self.register_buffer("param_index", torch.as_tensor(index, dtype=torch.long))
+            self.register_buffer("param_mask", torch.tensor(hybrid.param_mask, dtype=torch.float32))
+        if box:
+            self.register_buffer("low", -torch.ones(out_size))
+            self.register_buffer("high", torch.ones(out_size))
+
+    def forward(self, obs: torch.Tensor) -> torch.Tensor:
+        if self.passthrough_weight is None:
+            return self.net(obs)
+        return self.net(obs) + F.linear(obs, self.passthrough_weight, self.passthrough_bias)
+
+    def select(self, out: torch.Tensor, a: torch.Tensor) -> torch.Tensor:
+        """Action ``a``'s parameters out of the output vectors ``out``, padded with zeros to ``m = max_a m_a``."""
+        return out.gather(1, self.param_index[a]) * self.param_mask[a]
+
+    def action(self, out: torch.Tensor, mask: torch.Tensor | None = None) -> tuple[torch.Tensor, torch.Tensor]:
+        """The executed action of output vectors ``out`` that start with action scores: the argmax of the scores
+        (among the actions ``mask`` allows) and its parameters, clamped to ``[-1, 1]``."""
+        a = masked_logits(out[:, : self.offset], mask).argmax(-1)
+        return a, self.select(out, a).clamp(-1.0, 1.0)
+
+    def to_latent(self, u: torch.Tensor) -> torch.Tensor:
+        """Outputs ``u`` in ``[-1, 1]`` mapped onto the latent box ``[low, high]``."""
+        return self.low + (u + 1.0) * 0.5 * (self.high - self.low)

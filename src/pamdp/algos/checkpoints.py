@@ -29,6 +29,17 @@ FINAL_MODEL = "final_model.pt"
 CHECKPOINT = "checkpoint.pt"
 FORMAT = "pamdp-checkpoint"
 """The ``format`` entry of every checkpoint, which tells a pamdp checkpoint from any other torch file."""
+RENAMED = {
+    # PASVG(0)'s critics became one TwinQ (its second critic with twin_critics only)
+    "PASVG0": {
+        "critic.net.": "critic.q1.",
+        "critic2.net.": "critic.q2.",
+        "critic_target.net.": "critic_target.q1.",
+        "critic2_target.net.": "critic_target.q2.",
+    },
+}
+"""Per algorithm, the tensors its checkpoints once held under other names, ``{old prefix: new prefix}`` of
+``network.key``: :func:`read_checkpoint` moves them, so that files written before still load."""
 
 
 def _umask() -> int:
@@ -102,6 +113,16 @@ def read_checkpoint(path: str | os.PathLike) -> dict:
         ) from exc
     if not isinstance(payload, dict) or payload.get("format") != FORMAT:
         raise ValueError(f"{path} is not a pamdp checkpoint (no '{FORMAT}' header)")
+    renamed = RENAMED.get(payload["algo"], {})
+    if renamed:
+        modules: dict[str, dict] = {}
+        for name, state in payload["modules"].items():
+            for key, tensor in state.items():
+                full = f"{name}.{key}"
+                old = next((old for old in renamed if full.startswith(old)), None)
+                module, _, key = (full if old is None else renamed[old] + full[len(old) :]).partition(".")
+                modules.setdefault(module, {})[key] = tensor
+        payload["modules"] = modules
     return payload
 
 

@@ -12,29 +12,23 @@ import math
 import numpy as np
 import torch
 import torch.nn.functional as F
-from torch import nn
 
 from pamdp.algos.base import Algorithm
 from pamdp.algos.offpolicy import (
     OffPolicyConfig,
     OffPolicyLoop,
     Temperatures,
-    TwinQ,
     learning_starts_setting,
     shared_setting,
     soft_updater,
     tau_setting,
-    temperature_gradient,
 )
-from pamdp.algos.optim import apply_gradients, descend
+from pamdp.algos.optim import descend
 from pamdp.algos.settings import NON_NEGATIVE, POSITIVE, AlgoConfig, Check, interval, one_of, setting
-from pamdp.distributions import LOG_STD_MAX, LOG_STD_MIN, MASKED, SquashedHybrid, masked_logits
-from pamdp.policies import every_action_mlp, hierarchical_mlps, mlp, small_init_
-from pamdp.spaces import HybridActionSpace
+from pamdp.distributions import MASKED, SquashedHybrid
+from pamdp.policies import FORMS, HybridSACActor, TwinQ
 
-__all__ = ["HybridSAC", "HybridSACConfig", "HybridSACActor"]
-
-FORMS = ("flat", "hierarchical")
+__all__ = ["HybridSAC", "HybridSACConfig"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -95,46 +89,6 @@ class HybridSACConfig(OffPolicyConfig, AlgoConfig):
     }
 
 
-class HybridSACActor(nn.Module):
-    """The policy, ``flat`` (``mlp(s) -> [logits | means | log-stds]``) or ``hierarchical`` (``pi_d = mlp(s)``,
-    ``pi_c = mlp([s, onehot(a)])`` for every ``a``); ``forward(obs, mask)`` is a :class:`SquashedHybrid`."""
-
-    def __init__(self, obs_dim: int, hybrid: HybridActionSpace, form: str, hidden_sizes, activation: str):
-        super().__init__()
-        if form not in FORMS:
-            raise ValueError(f"form = {form!r}; expected one of {', '.join(FORMS)}")
-        self.form, self.n_actions, self.m = form, hybrid.n_actions, hybrid.max_param_size
-        mask = hybrid.param_mask
-        self.register_buffer("param_mask", torch.tensor(mask, dtype=torch.float32))
-        self.register_buffer("param_index", torch.tensor(hybrid.param_index, dtype=torch.long).view(-1))
-        self.total = total = hybrid.total_param_size
-        # the all-actions vector's entries in the flattened padded (K * m) layout
-        self.register_buffer("flat_index", torch.tensor(np.flatnonzero(mask), dtype=torch.long))
-        if form == "flat":  # starts near uniform, centred, with unit noise, as the hierarchical form does
-            self.net = mlp(obs_dim, hidden_sizes, self.n_actions + 2 * total, activation)
-            small_init_(self.net[-1])
-        else:
-            self.pi_d, self.pi_c = hierarchical_mlps(obs_dim, self.n_actions, hidden_sizes, activation, 2 * self.m)
-
-    def _padded(self, flat: torch.Tensor) -> torch.Tensor:
-        """``(B, sum_a m_a)`` all-actions values as ``(B, K, m)``, zero where unused."""
-        return flat[:, self.param_index].view(-1, self.n_actions, self.m) * self.param_mask
-
-    def forward(self, obs: torch.Tensor, mask: torch.Tensor | None = None) -> SquashedHybrid:
-        if self.form == "flat":
-            logits, means, log_stds = self.net(obs).split([self.n_actions, self.total, self.total], dim=-1)
-            mean, log_std = self._padded(means), self._padded(log_stds)
-        else:
-            mean, log_std = every_action_mlp(self.pi_c, obs).split(self.m, dim=-1)
-            logits = self.pi_d(obs)
-        log_std = log_std.clamp(LOG_STD_MIN, LOG_STD_MAX)
-        return SquashedHybrid(masked_logits(logits, mask), mean, log_std, self.param_mask)
-
-    def flat_params(self, x: torch.Tensor) -> torch.Tensor:
-        """Every action's parameters ``(B, K, m)`` as the critics' all-actions vector ``(B, sum_a m_a)``."""
-        return x.reshape(x.shape[0], -1)[:, self.flat_index]
-
-
 class HybridSAC(Algorithm):
     """Hybrid SAC (Delalleau et al. 2019), flat or hierarchical (``form``). See docs/algorithms.md, "Hybrid SAC"."""
 
@@ -163,8 +117,7 @@ class HybridSAC(Algorithm):
     @property
     def alphas(self) -> tuple[float, float]:
         """The current temperatures ``(alpha_d, alpha_c)``."""
-        alpha_d, alpha_c = self._alpha_tensors()
-        return float(alpha_d), float(alpha_c)
+        return tuple(float(alpha) for alpha in self.temperatures.alphas())
 
     # -- acting ----------------------------------------------------------------------------------
     def _act(self, obs, deterministic, mask=None):
@@ -192,26 +145,17 @@ class HybridSAC(Algorithm):
         """Per state and discrete action, ``min_i Q_i(s, x_all)_a - alpha_c log pi_c(x_a|s,a) - alpha_d log
         pi_d(a|s)`` at a reparameterised draw of ``x_all``, ``(B, K)``, with ``log pi_c`` ``(B, K)``."""
         u, x_all = dist.rsample(self.torch_gen)
-        q1, q2 = critic(obs, self.actor.flat_params(x_all))
         log_pc = dist.log_prob_c(u)
-        return torch.minimum(q1, q2) - alpha_c * log_pc - alpha_d * dist.log_probs_d, log_pc
-
-    def _alpha_tensors(self) -> tuple[torch.Tensor, torch.Tensor]:
-        t = self.temperatures
-        return t.log_alpha_d.detach().exp(), t.log_alpha_c.detach().exp()
+        q = critic.smaller(obs, self.actor.flat_params(x_all))
+        return q - alpha_c * log_pc - alpha_d * dist.log_probs_d, log_pc
 
     @torch.no_grad()
     def target_value(self, next_obs: torch.Tensor, next_mask: torch.Tensor | None = None) -> torch.Tensor:
         """``V(s')`` ``(B,)``: the soft value under the target critics, exact over the next discrete action
         (masked ones weigh nothing), at one draw of every action's parameters."""
         dist = self.actor(next_obs, next_mask)
-        soft_q, _ = self.soft_value(dist, self.critic_target, next_obs, *self._alpha_tensors())
+        soft_q, _ = self.soft_value(dist, self.critic_target, next_obs, *self.temperatures.alphas())
         return (dist.probs_d * soft_q).sum(-1)
-
-    def temperature_step(self, entropy_d, target_d, entropy_c, target_c) -> None:
-        """One Adam step of each log-temperature along :func:`temperature_gradient` of its part's entropy."""
-        gradients = [temperature_gradient(entropy_d, target_d), temperature_gradient(entropy_c, target_c)]
-        apply_gradients(self.alpha_optimizer, gradients)
 
     def _update(self) -> dict[str, float]:
         """One soft Q step of both critics, one policy step, one step of each temperature, the target update."""
@@ -219,8 +163,8 @@ class HybridSAC(Algorithm):
         b = self.replay.sample(cfg.batch_size, self.np_rng)
         obs, next_obs = b["obs"], b["next_obs"]
         mask, next_mask = b.get("mask"), b.get("next_mask")  # with the action_mask setting only
-        alpha_d, alpha_c = self._alpha_tensors()
-        y = b["reward"] + cfg.gamma * (~b["terminated"]).float() * self.target_value(next_obs, next_mask)
+        alpha_d, alpha_c = self.temperatures.alphas()
+        y = self.loop.td_target(b, self.target_value(next_obs, next_mask))
         a = b["a"][:, None]
         q1, q2 = (q.gather(1, a).squeeze(1) for q in self.critic(obs, b["params"]))
         critic_loss = F.mse_loss(q1, y) + F.mse_loss(q2, y)
@@ -239,7 +183,7 @@ class HybridSAC(Algorithm):
             p = p.detach()
             entropy_c = -(p * log_pc.detach()).sum(-1)  # of the expected action's parameters
             target_c = cfg.target_entropy_c * (p * self.param_sizes).sum(-1)
-        self.temperature_step(entropy_d, target_d, entropy_c, target_c)
+        self.temperatures.step(self.alpha_optimizer, (entropy_d, target_d), (entropy_c, target_c))
         self._soft_update(cfg.tau)
         return {
             "losses/critic_loss": float(critic_loss.detach()),

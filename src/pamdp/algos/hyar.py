@@ -21,7 +21,6 @@ from pamdp.algos.offpolicy import (
     EpsilonSchedule,
     OffPolicyConfig,
     OffPolicyLoop,
-    TwinQ,
     backprop_actor,
     linear_epsilon,
     shared_setting,
@@ -32,7 +31,7 @@ from pamdp.algos.offpolicy import (
 from pamdp.algos.optim import apply_gradients, descend
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, at_least, interval, one_of, setting
 from pamdp.distributions import LOG_STD_MAX, LOG_STD_MIN, masked_logits
-from pamdp.policies import ACTIVATIONS, mlp
+from pamdp.policies import ACTIVATIONS, DeterministicActor, TwinQ, mlp
 from pamdp.spaces import HybridActionSpace
 
 __all__ = ["HyAR", "HyARConfig", "ActionRepresentation", "latent_bounds"]
@@ -267,23 +266,6 @@ def latent_bounds(latents: torch.Tensor, percent: float) -> tuple[torch.Tensor, 
     return low, torch.maximum(high, low + 1e-6)
 
 
-class LatentActor(nn.Module):
-    """``u(s)`` in ``[-1, 1]^(d1 + d2)`` (Tanh with ``squash``; else kept there by inverting gradients and clamped
-    when acting), mapped onto the latent box ``[low, high]`` by :meth:`to_latent`."""
-
-    def __init__(self, obs_dim: int, size: int, hidden_sizes, activation: str, squash: bool = True):
-        super().__init__()
-        self.net = mlp(obs_dim, hidden_sizes, size, activation, nn.Tanh if squash else None)
-        self.register_buffer("low", -torch.ones(size))
-        self.register_buffer("high", torch.ones(size))
-
-    def forward(self, obs: torch.Tensor) -> torch.Tensor:
-        return self.net(obs)
-
-    def to_latent(self, u: torch.Tensor) -> torch.Tensor:
-        return self.low + (u + 1.0) * 0.5 * (self.high - self.low)
-
-
 class HyAR(EpsilonSchedule, Algorithm):
     """HyAR-TD3 (Li et al. 2022): TD3 in a learned hybrid action representation. See :class:`HyARConfig`."""
 
@@ -299,7 +281,10 @@ class HyAR(EpsilonSchedule, Algorithm):
             self.obs_dim, h, cfg.embed_dim, cfg.latent_dim, cfg.vae_hidden_sizes, cfg.activation
         )
         squash = cfg.bound == "squash"
-        self.actor = LatentActor(self.obs_dim, self.latent_size, cfg.hidden_sizes, cfg.activation, squash)
+        # u(s) in [-1, 1]^(d1 + d2), mapped onto the latent box
+        self.actor = DeterministicActor(
+            self.obs_dim, self.latent_size, cfg.hidden_sizes, cfg.activation, squash, box=True
+        )
         self.critic = TwinQ(self.obs_dim + self.latent_size, 1, cfg.hidden_sizes, cfg.activation)  # Q_i(s, e, z)
         self.actor_target = copy.deepcopy(self.actor).requires_grad_(False)
         self.critic_target = copy.deepcopy(self.critic).requires_grad_(False)
@@ -460,8 +445,8 @@ class HyAR(EpsilonSchedule, Algorithm):
             noise = torch.randn(u_next.shape, generator=self.torch_gen, device=self.device) * cfg.target_noise
             u_next = (u_next + noise.clamp(-cfg.target_noise_clip, cfg.target_noise_clip)).clamp(-1.0, 1.0)
             latent_next = self.rep.snap(self.actor_target.to_latent(u_next), b.get("next_mask"))
-            q1_next, q2_next = (q.squeeze(-1) for q in self.critic_target(next_obs, latent_next))
-            y = b["reward"] + cfg.gamma * (~b["terminated"]).float() * torch.minimum(q1_next, q2_next)
+            q_next = self.critic_target.smaller(next_obs, latent_next).squeeze(-1)
+            y = self.loop.td_target(b, q_next)
         q1, q2 = (q.squeeze(-1) for q in self.critic(obs, latent))
         critic_loss = F.mse_loss(q1, y) + F.mse_loss(q2, y)
         descend(self.critic_optimizer, critic_loss, self._critic_params, cfg.grad_clip)

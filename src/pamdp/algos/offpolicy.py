@@ -14,12 +14,13 @@ import numpy as np
 import torch
 from torch import nn
 
+from pamdp.algos.optim import apply_gradients
 from pamdp.algos.replay import ReplayBuffer, transition_fields
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, at_least, interval, one_of, redeclared, setting
 from pamdp.algos.subnormals import subnormals_flushed
 from pamdp.algos.vector_env import Step, VectorStepper
 from pamdp.distributions import masked_logits
-from pamdp.policies import ACTIVATIONS, mlp
+from pamdp.policies import ACTIVATIONS
 
 __all__ = [
     "OffPolicyConfig",
@@ -28,7 +29,6 @@ __all__ = [
     "learning_starts_setting",
     "tau_setting",
     "OffPolicyLoop",
-    "TwinQ",
     "Temperatures",
     "temperature_gradient",
     "OUNoise",
@@ -170,20 +170,6 @@ def soft_updater(pairs: Sequence[tuple[nn.Module, nn.Module]]) -> Callable[[floa
     return update
 
 
-class TwinQ(nn.Module):
-    """Two critics ``Q_1, Q_2`` of the same shape on ``[s, action]``, for the clipped double Q-learning of TD3
-    (Fujimoto et al. 2018) and SAC: a target takes the smaller of the two target critics' values."""
-
-    def __init__(self, in_size: int, out_size: int, hidden_sizes, activation: str):
-        super().__init__()
-        self.q1 = mlp(in_size, hidden_sizes, out_size, activation)
-        self.q2 = mlp(in_size, hidden_sizes, out_size, activation)
-
-    def forward(self, obs: torch.Tensor, action: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
-        inp = torch.cat([obs, action], dim=-1)
-        return self.q1(inp), self.q2(inp)
-
-
 class Temperatures(nn.Module):
     """Entropy temperatures ``alpha = exp(log alpha)``, one parameter ``log_<name>`` per keyword (its initial
     ``alpha``), tuned by SAC's rule (Haarnoja et al. 2018, "Soft Actor-Critic Algorithms and Applications"):
@@ -193,6 +179,16 @@ class Temperatures(nn.Module):
         super().__init__()
         for name, alpha in initial.items():
             self.register_parameter(f"log_{name}", nn.Parameter(torch.tensor(math.log(alpha), dtype=torch.float32)))
+
+    def alphas(self) -> tuple[torch.Tensor, ...]:
+        """Each ``alpha``, detached, in the order of the keywords."""
+        return tuple(p.detach().exp() for p in self.parameters())
+
+    def step(self, optimizer: torch.optim.Optimizer, *entropies: tuple[torch.Tensor, torch.Tensor | float]) -> None:
+        """One step of ``optimizer`` (over these parameters) on each ``log alpha`` along :func:`temperature_gradient`
+        of its ``(entropy estimates, target)``, computed in the estimates' precision."""
+        grads = [temperature_gradient(h, target).to(p.dtype) for (h, target), p in zip(entropies, self.parameters())]
+        apply_gradients(optimizer, grads)
 
 
 def temperature_gradient(entropy: torch.Tensor, target: torch.Tensor | float) -> torch.Tensor:
@@ -366,6 +362,10 @@ class OffPolicyLoop:
         self.tail_value = tail_value
         self.update_credit = 0.0
         self.stepper: VectorStepper | None = None  # the env's copies, from the first epoch on
+
+    def td_target(self, batch: dict[str, torch.Tensor], next_value: torch.Tensor) -> torch.Tensor:
+        """``y = r + gamma V(s')`` of a replayed batch, with no bootstrap after a termination."""
+        return batch["reward"] + self.config.gamma * (~batch["terminated"]).float() * next_value
 
     def budget_note(self, total: int) -> str | None:
         """Why ``total`` more samples make no gradient update (the replay would not reach ``learning_starts``), or

@@ -32,9 +32,7 @@ from pamdp.algos.offpolicy import (
 )
 from pamdp.algos.optim import apply_gradients
 from pamdp.algos.settings import POSITIVE, AlgoConfig, interval, setting
-from pamdp.distributions import masked_logits
-from pamdp.policies import mlp
-from pamdp.spaces import HybridActionSpace
+from pamdp.policies import DeterministicActor, mlp
 
 __all__ = ["PADDPG", "PADDPGConfig"]
 
@@ -65,31 +63,6 @@ class PADDPGConfig(DeterministicActorConfig, OffPolicyConfig, AlgoConfig):
     }
 
 
-class Actor(nn.Module):
-    """``mu(s)``: K scores then every action's parameters, ``K + sum_a m_a`` outputs (Tanh with ``squash``)."""
-
-    def __init__(self, obs_dim: int, hybrid: HybridActionSpace, hidden_sizes, activation: str, squash: bool):
-        super().__init__()
-        self.n_actions = hybrid.n_actions
-        out = hybrid.n_actions + hybrid.total_param_size
-        self.net = mlp(obs_dim, hidden_sizes, out, activation, nn.Tanh if squash else None)
-        # Where action a's padded parameter i sits in the output: K + offset_a + i (0 where unused).
-        mask = hybrid.param_mask
-        index = np.where(mask, hybrid.n_actions + hybrid.param_index, 0)
-        self.register_buffer("param_index", torch.as_tensor(index, dtype=torch.long))
-        self.register_buffer("param_mask", torch.tensor(mask, dtype=torch.float32))
-
-    def forward(self, obs: torch.Tensor) -> torch.Tensor:
-        return self.net(obs)
-
-    def action(self, out: torch.Tensor, mask: torch.Tensor | None = None) -> tuple[torch.Tensor, torch.Tensor]:
-        """The executed action for output vectors ``out``: argmax of the scores (of the actions ``mask`` allows)
-        and its parameters, padded."""
-        a = masked_logits(out[:, : self.n_actions], mask).argmax(-1)
-        x = out.gather(1, self.param_index[a]) * self.param_mask[a]
-        return a, x.clamp(-1.0, 1.0)
-
-
 class Critic(nn.Module):
     """``Q(s, mu)`` on the state and the actor's whole output vector."""
 
@@ -112,7 +85,11 @@ class PADDPG(EpsilonSchedule, Algorithm):
     def _build(self) -> None:
         cfg, h = self.config, self.hybrid
         self.out_size = h.n_actions + h.total_param_size
-        self.actor = Actor(self.obs_dim, h, cfg.hidden_sizes, cfg.activation, squash=cfg.bound == "squash")
+        # mu(s): K scores then every action's parameters
+        squash = cfg.bound == "squash"
+        self.actor = DeterministicActor(
+            self.obs_dim, self.out_size, cfg.hidden_sizes, cfg.activation, squash, h, h.n_actions
+        )
         self.critic = Critic(self.obs_dim, self.out_size, cfg.hidden_sizes, cfg.activation)
         self.actor_target = copy.deepcopy(self.actor).requires_grad_(False)
         self.critic_target = copy.deepcopy(self.critic).requires_grad_(False)
@@ -181,7 +158,7 @@ class PADDPG(EpsilonSchedule, Algorithm):
         with torch.no_grad():
             out_next = self._masked(nets["actor_target"](next_obs).clamp(-1.0, 1.0), b.get("next_mask"))
             q_next = nets["critic_target"](torch.cat([next_obs, out_next], dim=-1)).squeeze(-1)
-            y = b["reward"] + cfg.gamma * (~b["terminated"]).float() * q_next
+            y = self.loop.td_target(b, q_next)
             if cfg.beta > 0:
                 y = mixed_target(y, b["mc"], cfg.beta)
             # critic: descend on mean (Q - y)^2 over the batch

@@ -16,7 +16,6 @@ from collections.abc import Callable
 import numpy as np
 import torch
 import torch.nn.functional as F
-from torch import nn
 
 from pamdp.algos.base import Algorithm
 from pamdp.algos.dense import Dense
@@ -28,16 +27,14 @@ from pamdp.algos.offpolicy import (
     shared_setting,
     soft_updater,
     tau_setting,
-    temperature_gradient,
     uniform_actions,
 )
 from pamdp.algos.optim import apply_gradients, descend
 from pamdp.algos.settings import NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
-from pamdp.distributions import LOG_STD_MAX, LOG_STD_MIN, masked_logits
-from pamdp.policies import every_action_linear, every_action_mlp, hierarchical_mlps, mlp
-from pamdp.spaces import HybridActionSpace
+from pamdp.distributions import LOG_STD_MAX, LOG_STD_MIN, gumbel_noise, masked_logits
+from pamdp.policies import GumbelHybridPolicy, TwinQ, every_action_linear
 
-__all__ = ["PASVG0", "PASVG0Config", "GumbelHybridPolicy", "expected_q", "gumbel_noise", "gumbel_softmax_sample"]
+__all__ = ["PASVG0", "PASVG0Config", "expected_q", "every_action_q"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -137,87 +134,6 @@ class PASVG0Config(OffPolicyConfig, AlgoConfig):
     }
 
 
-def gumbel_noise(shape: tuple[int, ...], generator: torch.Generator) -> torch.Tensor:
-    """Standard Gumbel samples ``-log(-log U)`` from ``generator`` (torch's own sampler uses the global RNG)."""
-    u = torch.rand(shape, generator=generator, device=generator.device).clamp_(1e-10, 1.0 - 1e-7)
-    return -torch.log(-torch.log(u))
-
-
-def gumbel_softmax_sample(
-    logits: torch.Tensor, eta: torch.Tensor, temperature: float, hard: bool
-) -> tuple[torch.Tensor, torch.Tensor]:
-    """The Gumbel-Softmax sample for noise ``eta``: ``(index, sample)``.
-
-    ``index = argmax(logits + eta)`` is an exact draw from ``softmax(logits)`` (the Gumbel-max trick).
-    ``sample`` is ``softmax((logits + eta) / temperature)``, or with ``hard`` the one-hot of ``index`` in the
-    forward pass carrying the softmax's gradient in the backward pass (straight-through).
-    """
-    z = logits.log_softmax(-1) + eta
-    soft = torch.softmax(z / temperature, dim=-1)
-    index = z.argmax(-1)
-    if not hard:
-        return index, soft
-    onehot = F.one_hot(index, logits.shape[-1]).to(soft.dtype)
-    return index, onehot - soft.detach() + soft
-
-
-class GumbelHybridPolicy(nn.Module):
-    """``pi_d`` (logits over K actions) and ``pi_c`` (pre-Tanh means of ``m`` parameters given ``[s, a]``).
-
-    The parameter noise has a state-independent log-std per action and parameter; parameters an action does
-    not use (its entries beyond ``m_a``) are set to 0 so they carry no noise into the critic.
-    """
-
-    def __init__(self, obs_dim: int, hybrid: HybridActionSpace, hidden_sizes, activation: str, init_log_std: float):
-        super().__init__()
-        self.n_actions, self.param_size = hybrid.n_actions, hybrid.max_param_size
-        self.pi_d, self.pi_c = hierarchical_mlps(obs_dim, self.n_actions, hidden_sizes, activation, self.param_size)
-        self.log_std = nn.Parameter(torch.full((self.n_actions, self.param_size), float(init_log_std)))
-        self.register_buffer("mask", torch.tensor(hybrid.param_mask, dtype=torch.float32))
-
-    def std(self) -> torch.Tensor:
-        """The parameter noise's std per action and parameter, ``(K, m)``."""
-        return self.log_std.clamp(LOG_STD_MIN, LOG_STD_MAX).exp()
-
-    def params(self, obs: torch.Tensor, index: torch.Tensor, a: torch.Tensor, eta_x: torch.Tensor) -> torch.Tensor:
-        """``x = g(s, a, eta_x)``: ``pi_c``'s parameters for action ``a`` (one-hot or soft; ``index`` its argmax)."""
-        return torch.tanh(self.pi_c(torch.cat([obs, a], dim=-1)) + self.std()[index] * eta_x) * self.mask[index]
-
-    def params_all(self, obs: torch.Tensor, eta_x: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
-        """Every action's parameters for the noise ``eta_x``: ``(obs_k, onehots, x)``, each ``(B, K, .)``.
-
-        ``obs_k`` and ``onehots`` are the critic's matching state and action inputs, so that
-        ``critic(obs_k, onehots, x)`` is ``Q(s, k, x_k)`` for every ``k`` in one batched pass.
-        """
-        batch, K = len(obs), self.n_actions
-        onehots = torch.eye(K, dtype=obs.dtype, device=obs.device).expand(batch, K, K)
-        obs_k = obs.unsqueeze(-2).expand(batch, K, obs.shape[-1])
-        means = every_action_mlp(self.pi_c, obs)  # without building the B * K inputs (as params would)
-        return obs_k, onehots, torch.tanh(means + self.std() * eta_x.unsqueeze(-2)) * self.mask
-
-    def forward(
-        self,
-        obs: torch.Tensor,
-        eta_a: torch.Tensor,
-        eta_x: torch.Tensor,
-        temperature: float,
-        hard: bool,
-        mask: torch.Tensor | None = None,
-    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
-        """``(logits, index, a, x)`` for the noise ``(eta_a, eta_x)``: ``pi_d``'s logits (restricted to the actions
-        ``mask`` allows), the action, the critic's action input ``a`` and the parameters ``x``, so an update runs
-        ``pi_d`` once."""
-        logits = masked_logits(self.pi_d(obs), mask)
-        index, a = gumbel_softmax_sample(logits, eta_a, temperature, hard)
-        return logits, index, a, self.params(obs, index, a, eta_x)
-
-    def mode(self, obs: torch.Tensor, mask: torch.Tensor | None = None) -> tuple[torch.Tensor, torch.Tensor]:
-        """The greedy action: the most probable (allowed) discrete action and its mean parameters."""
-        index = masked_logits(self.pi_d(obs), mask).argmax(-1)
-        onehot = F.one_hot(index, self.n_actions).to(obs.dtype)
-        return index, torch.tanh(self.pi_c(torch.cat([obs, onehot], dim=-1))) * self.mask[index]
-
-
 def expected_q(
     policy: GumbelHybridPolicy,
     critic: Callable,
@@ -235,34 +151,22 @@ def expected_q(
     return logits, (logits.softmax(-1) * q_all).sum(-1)
 
 
-def every_action_q(*critics: Critic) -> Callable:
-    """:func:`expected_q`'s ``critic`` for :class:`Critic` networks: ``Q(s, k, x_k)`` of every ``k`` by
-    :meth:`Critic.every_action` (the states' first copy, the one-hots implied), the smallest of several critics'
-    values (twin critics)."""
+def every_action_q(critic: TwinQ, smaller: bool = False) -> Callable:
+    """:func:`expected_q`'s ``critic`` for a :class:`~pamdp.policies.TwinQ` on ``[s, a, x]``: ``Q_1(s, k, x_k)`` of
+    every ``k`` (``(B, K)``; with ``smaller``, the smaller of both critics' values), the first layer's one-hot part by
+    :func:`~pamdp.policies.every_action_linear` and the parameters' by one product, from the states' first copy."""
+    nets = (critic.q1,) if not smaller or critic.q2 is None else (critic.q1, critic.q2)
 
     def q_all(obs_k: torch.Tensor, onehots: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
-        values = [critic.every_action(obs_k[:, 0], x) for critic in critics]
+        obs, split = obs_k[:, 0], obs_k.shape[-1] + x.shape[-2]
+        values = []
+        for net in nets:
+            first = net[0]
+            pre = every_action_linear(obs, first.weight[:, :split], first.bias) + F.linear(x, first.weight[:, split:])
+            values.append(net[1:](pre).squeeze(-1))
         return values[0] if len(values) == 1 else torch.minimum(*values)
 
     return q_all
-
-
-class Critic(nn.Module):
-    """``Q(s, a, x)`` with the discrete action as a one-hot (or soft sample) ``a``."""
-
-    def __init__(self, obs_dim: int, n_actions: int, param_size: int, hidden_sizes, activation: str):
-        super().__init__()
-        self.net = mlp(obs_dim + n_actions + param_size, hidden_sizes, 1, activation)
-
-    def forward(self, obs: torch.Tensor, a: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
-        return self.net(torch.cat([obs, a, x], dim=-1)).squeeze(-1)
-
-    def every_action(self, obs: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
-        """``Q(s, k, x_k)`` ``(B, K)`` for every action ``k``, its parameters ``x`` ``(B, K, m)``: the first layer's
-        one-hot part by :func:`~pamdp.policies.every_action_linear`, the parameters' by one product."""
-        first, split = self.net[0], obs.shape[-1] + x.shape[-2]
-        pre = every_action_linear(obs, first.weight[:, :split], first.bias) + F.linear(x, first.weight[:, split:])
-        return self.net[1:](pre).squeeze(-1)
 
 
 class PASVG0(Algorithm):
@@ -270,24 +174,19 @@ class PASVG0(Algorithm):
 
     config_class = PASVG0Config
     config: PASVG0Config
-    # entropy_weight with target_entropy only; critic2 and its target with twin_critics only
-    MODULES = ("policy", "critic", "policy_target", "critic_target", "entropy_weight", "critic2", "critic2_target")
+    MODULES = ("policy", "critic", "policy_target", "critic_target", "entropy_weight")  # the last: target_entropy
     OPTIMIZERS = {"policy": "policy_optimizer", "critic": "critic_optimizer", "entropy_weight": "entropy_optimizer"}
 
     def _build(self) -> None:
         cfg, h = self.config, self.hybrid
         self.policy = GumbelHybridPolicy(self.obs_dim, h, cfg.hidden_sizes, cfg.activation, cfg.init_log_std)
         self.policy.log_std.requires_grad_(cfg.learn_std)
-        self.critic = Critic(self.obs_dim, h.n_actions, h.max_param_size, cfg.hidden_sizes, cfg.activation)
+        # Q(s, a, x), the discrete action a one-hot (or the soft sample); with twin_critics a second one
+        in_size = self.obs_dim + h.n_actions + h.max_param_size
+        self.critic = TwinQ(in_size, 1, cfg.hidden_sizes, cfg.activation, twin=cfg.twin_critics)
         self.policy_target = copy.deepcopy(self.policy).requires_grad_(False)
         self.critic_target = copy.deepcopy(self.critic).requires_grad_(False)
-        self.critic2 = self.critic2_target = None
-        critic_params = list(self.critic.parameters())
-        if cfg.twin_critics:
-            self.critic2 = Critic(self.obs_dim, h.n_actions, h.max_param_size, cfg.hidden_sizes, cfg.activation)
-            self.critic2_target = copy.deepcopy(self.critic2).requires_grad_(False)
-            critic_params += list(self.critic2.parameters())
-        self.critic_params = critic_params
+        self.critic_params = list(self.critic.parameters())
         self.critic_updates = 0  # for policy_delay
         # fused: one kernel per step instead of a dozen foreach passes (benchmarks/offpolicy_speed.md).
         self.policy_params = [p for p in self.policy.parameters() if p.requires_grad]
@@ -315,10 +214,7 @@ class PASVG0(Algorithm):
     def _bind_networks(self) -> None:
         """The soft target update over the modules' own tensors and, with the paper's settings, the hand-written
         update's views of the networks (:mod:`pamdp.algos.dense`). Called again by whoever replaces a module."""
-        pairs = [(self.critic_target, self.critic), (self.policy_target, self.policy)]
-        if self.critic2 is not None:
-            pairs.append((self.critic2_target, self.critic2))
-        self._soft_update = soft_updater(pairs)
+        self._soft_update = soft_updater([(self.critic_target, self.critic), (self.policy_target, self.policy)])
         cfg = self.config
         self._dense = None
         # The paper's settings: the Gumbel-Softmax gradient, one critic, no policy delay, a fixed entropy weight.
@@ -327,7 +223,7 @@ class PASVG0(Algorithm):
             self._dense = {
                 "pi_d": Dense.of(self.policy.pi_d),
                 "pi_c": Dense.of(self.policy.pi_c),
-                "critic": Dense.of(self.critic.net),
+                "critic": Dense.of(self.critic.q1),
             }
 
     def _extra_state(self):
@@ -361,10 +257,9 @@ class PASVG0(Algorithm):
             x = torch.where(flip[:, None], self.policy.params(obs, uniform, onehot, eta_x), x)
         return index, x, {"a_in": a_in.cpu().numpy(), "eta_a": eta_a.cpu().numpy(), "eta_x": eta_x.cpu().numpy()}
 
-    def _target_q(self, obs: torch.Tensor, a: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
-        """The target critic's ``Q'``; with ``twin_critics`` the smaller of the two target critics' values."""
-        q = self.critic_target(obs, a, x)
-        return q if self.critic2 is None else torch.minimum(q, self.critic2_target(obs, a, x))
+    def _q1(self, obs: torch.Tensor, a: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
+        """The first critic's ``Q(s, a, x)`` ``(B,)``, which the policy follows."""
+        return self.critic.q1(torch.cat([obs, a, x], dim=-1)).squeeze(-1)
 
     @torch.no_grad()
     def _td_target(self, b: dict[str, torch.Tensor]) -> torch.Tensor:
@@ -375,12 +270,11 @@ class PASVG0(Algorithm):
         next_obs, mask = b["next_obs"], b.get("next_mask")
         eta_a, eta_x = self._noise(len(next_obs))
         if cfg.discrete_gradient == "expected":
-            critics = (self.critic_target,) if self.critic2 is None else (self.critic_target, self.critic2_target)
-            _, q_next = expected_q(self.policy_target, every_action_q(*critics), next_obs, eta_x, mask)
+            _, q_next = expected_q(self.policy_target, every_action_q(self.critic_target, True), next_obs, eta_x, mask)
         else:
             *_, a_next, x_next = self.policy_target(next_obs, eta_a, eta_x, cfg.temperature, cfg.straight_through, mask)
-            q_next = self._target_q(next_obs, a_next, x_next)
-        return b["reward"] + cfg.gamma * (~b["terminated"]).float() * q_next
+            q_next = self.critic_target.smaller(next_obs, a_next, x_next).squeeze(-1)
+        return self.loop.td_target(b, q_next)
 
     def _update(self) -> dict[str, float]:
         """One critic TD step and (every ``policy_delay``-th call) one value-gradient step of both policies."""
@@ -390,10 +284,9 @@ class PASVG0(Algorithm):
         if self._dense is not None:
             return self._update_by_hand(b, y)
         obs = b["obs"]
-        q = self.critic(obs, b["a_in"], b["x"])
-        critic_loss = F.mse_loss(q, y)
-        if self.critic2 is not None:
-            critic_loss = critic_loss + F.mse_loss(self.critic2(obs, b["a_in"], b["x"]), y)
+        q, q2 = self.critic(obs, b["a_in"], b["x"])
+        q = q.squeeze(-1)
+        critic_loss = F.mse_loss(q, y) if q2 is None else F.mse_loss(q, y) + F.mse_loss(q2.squeeze(-1), y)
         descend(self.critic_optimizer, critic_loss, self.critic_params, cfg.grad_clip)
         self.critic_updates += 1
         stats = {"losses/critic_loss": float(critic_loss.detach()), "train/q_mean": float(q.detach().mean())}
@@ -411,17 +304,16 @@ class PASVG0(Algorithm):
             logits, q_pi = expected_q(self.policy, every_action_q(self.critic), obs, b["eta_x"], mask)
         else:
             logits, _, a, x = self.policy(obs, b["eta_a"], b["eta_x"], cfg.temperature, cfg.straight_through, mask)
-            q_pi = self.critic(obs, a, x)
+            q_pi = self._q1(obs, a, x)
         entropy = -(logits.softmax(-1) * logits.log_softmax(-1)).sum(-1).mean()
-        alpha = cfg.entropy_coef if self.entropy_weight is None else float(self.entropy_weight.log_alpha.detach().exp())
+        alpha = cfg.entropy_coef if self.entropy_weight is None else float(self.entropy_weight.alphas()[0])
         actor_loss = -q_pi.mean() - alpha * entropy
         # The policy loss differentiates Q in (a, x) only: asking for the policy's gradients alone skips the
         # critic's weight gradients, which backward() would compute and the critic must not receive.
         descend(self.policy_optimizer, actor_loss, self.policy_params, cfg.grad_clip)
         if self.entropy_weight is not None:
             # in double, as the loss log_alpha * (float(H) - target) it replaced: the same step
-            gradient = temperature_gradient(entropy.detach().double(), cfg.target_entropy).float()
-            apply_gradients(self.entropy_optimizer, [gradient])
+            self.entropy_weight.step(self.entropy_optimizer, (entropy.detach().double(), cfg.target_entropy))
         self._soft_update(cfg.tau)
         return self._policy_stats(actor_loss.detach(), q_pi, entropy.detach(), alpha)
 

@@ -34,17 +34,12 @@ from pamdp.algos.offpolicy import (
     uniform_actions,
 )
 from pamdp.algos.optim import apply_gradients
-from pamdp.algos.settings import (
-    POSITIVE,
-    AlgoConfig,
-    Check,
-    setting,
-)
+from pamdp.algos.settings import POSITIVE, AlgoConfig, Check, setting
 from pamdp.distributions import masked_logits
-from pamdp.policies import in_chunks, mlp
+from pamdp.policies import DeterministicActor, in_chunks, mlp
 from pamdp.spaces import HybridActionSpace
 
-__all__ = ["PDQN", "PDQNConfig", "ParamActor", "QNetwork", "param_blocks"]
+__all__ = ["PDQN", "PDQNConfig", "QNetwork", "param_blocks"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -129,52 +124,6 @@ def param_blocks(hybrid: HybridActionSpace) -> np.ndarray:
     return blocks
 
 
-class ParamActor(nn.Module):
-    """``x(s)``: every action's parameters, concatenated (``sum_a m_a`` outputs; Tanh with ``squash``).
-
-    With ``passthrough`` (:attr:`PDQNConfig.param_passthrough`), ``x(s) = net(s) + W s + b`` with ``W`` and ``b``
-    fixed buffers, and ``net``'s output layer starts at zero, so the first ``x`` is the linear map: Bester et al.'s
-    passthrough layer (their ``ParamActor``), whose output layer their Goal script draws with a tiny std instead.
-    """
-
-    def __init__(
-        self,
-        obs_dim: int,
-        hybrid: HybridActionSpace,
-        hidden_sizes,
-        activation: str,
-        squash: bool,
-        passthrough: tuple[float, ...] = (),
-    ):
-        super().__init__()
-        n = hybrid.total_param_size
-        self.net = mlp(obs_dim, hidden_sizes, n, activation, nn.Tanh if squash else None)
-        weight = bias = None
-        if passthrough:
-            if len(passthrough) != n * (obs_dim + 1):
-                raise ValueError(
-                    f"PDQNConfig.param_passthrough has {len(passthrough)} numbers; expected {n * (obs_dim + 1)} for "
-                    f"this env: {n} parameters x ({obs_dim} observation features + 1 bias), row by row"
-                )
-            table = torch.tensor(passthrough, dtype=torch.float32).view(n, obs_dim + 1)
-            weight, bias = table[:, :-1].contiguous(), table[:, -1].contiguous()
-            nn.init.zeros_(self.net[-1].weight)
-            nn.init.zeros_(self.net[-1].bias)
-        self.register_buffer("passthrough_weight", weight)
-        self.register_buffer("passthrough_bias", bias)
-        self.register_buffer("param_index", torch.tensor(hybrid.param_index, dtype=torch.long))
-        self.register_buffer("param_mask", torch.tensor(hybrid.param_mask, dtype=torch.float32))
-
-    def forward(self, obs: torch.Tensor) -> torch.Tensor:
-        if self.passthrough_weight is None:
-            return self.net(obs)
-        return self.net(obs) + F.linear(obs, self.passthrough_weight, self.passthrough_bias)
-
-    def select(self, params: torch.Tensor, a: torch.Tensor) -> torch.Tensor:
-        """Action ``a``'s parameters out of the flat vectors ``params``, padded with zeros to ``m = max_a m_a``."""
-        return params.gather(1, self.param_index[a]) * self.param_mask[a]
-
-
 class QNetwork(nn.Module):
     """``Q(s, x)``: K action values from the state and every action's parameters.
 
@@ -240,8 +189,10 @@ class PDQN(EpsilonSchedule, Algorithm):
 
     def _build(self) -> None:
         cfg, h = self.config, self.hybrid
-        self.actor = ParamActor(
-            self.obs_dim, h, cfg.hidden_sizes, cfg.activation, cfg.bound == "squash", cfg.param_passthrough
+        # x(s): every action's parameters, concatenated
+        squash, n = cfg.bound == "squash", h.total_param_size
+        self.actor = DeterministicActor(
+            self.obs_dim, n, cfg.hidden_sizes, cfg.activation, squash, h, passthrough=cfg.param_passthrough
         )
         self.q_net = QNetwork(self.obs_dim, h, cfg.hidden_sizes, cfg.activation, cfg.multi_pass)
         self.actor_target = copy.deepcopy(self.actor).requires_grad_(False)
@@ -309,7 +260,7 @@ class PDQN(EpsilonSchedule, Algorithm):
         obs, next_obs, batch = b["obs"], b["next_obs"], len(b["obs"])
         with torch.no_grad():
             q_next = self._next_value(next_obs, b.get("next_mask"))
-            y = b["reward"] + cfg.gamma * (~b["terminated"]).float() * q_next
+            y = self.loop.td_target(b, q_next)
             if cfg.beta > 0:
                 y = mixed_target(y, b["mc"], cfg.beta)
             # Q: descend on mean (Q_a - y)^2, the gradient reaching Q_a of the replayed action only
