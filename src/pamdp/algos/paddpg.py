@@ -24,11 +24,7 @@ from pamdp.algos.offpolicy import (
     OffPolicyLoop,
     OUNoise,
     bounded,
-    learning_starts_setting,
-    mixed_target,
-    shared_setting,
     soft_updater,
-    tau_setting,
 )
 from pamdp.algos.optim import apply_gradients
 from pamdp.algos.settings import POSITIVE, AlgoConfig, interval, setting
@@ -43,18 +39,20 @@ class PADDPGConfig(DeterministicActorConfig, OffPolicyConfig, AlgoConfig):
     hidden layers {400, 300} of DDPG (the paper used {400, 300, 200} on Half Field Offense: preset
     ``paper_hfo``; Hausknecht & Stone's own 1024-512-256-128 towers: preset ``hausknecht_stone``)."""
 
-    hidden_sizes: tuple[int, ...] = shared_setting("hidden_sizes", (400, 300), "paper: {400, 300}")
-    activation: str = shared_setting("activation", "leaky_relu", "Hausknecht & Stone: leaky_relu, slope 0.01")
+    hidden_sizes: tuple[int, ...] = OffPolicyConfig.shared_setting("hidden_sizes", (400, 300), "paper: {400, 300}")
+    activation: str = OffPolicyConfig.shared_setting(
+        "activation", "leaky_relu", "Hausknecht & Stone: leaky_relu, slope 0.01"
+    )
     actor_lr: float = setting(1e-5, "Adam learning rate of the actor (Hausknecht & Stone: 1e-5).", POSITIVE)
     critic_lr: float = setting(1e-3, "Adam learning rate of the critic (Hausknecht & Stone: 1e-3).", POSITIVE)
     adam_beta1: float = setting(
         0.95, "Adam's beta1 for both networks (Hausknecht & Stone: 0.95).", interval(0, 1, high_open=True)
     )
-    grad_clip: float = shared_setting("grad_clip", 10.0, "Hausknecht & Stone: 10")
-    batch_size: int = shared_setting("batch_size", 32, "Hausknecht & Stone: 32")
-    tau: float = tau_setting(0.001, "DDPG's 0.001")
-    buffer_size: int = shared_setting("buffer_size", 500_000, "Hausknecht & Stone: 500 000")
-    learning_starts: int = learning_starts_setting(10_000, "the seed paper: 10^4")
+    grad_clip: float = OffPolicyConfig.shared_setting("grad_clip", 10.0, "Hausknecht & Stone: 10")
+    batch_size: int = OffPolicyConfig.shared_setting("batch_size", 32, "Hausknecht & Stone: 32")
+    tau: float = OffPolicyConfig.tau_setting(0.001, "DDPG's 0.001")
+    buffer_size: int = OffPolicyConfig.shared_setting("buffer_size", 500_000, "Hausknecht & Stone: 500 000")
+    learning_starts: int = OffPolicyConfig.learning_starts_setting(10_000, "the seed paper: 10^4")
 
     PRESETS = {
         "paper": {},
@@ -158,9 +156,7 @@ class PADDPG(EpsilonSchedule, Algorithm):
         with torch.no_grad():
             out_next = self._masked(nets["actor_target"](next_obs).clamp(-1.0, 1.0), b.get("next_mask"))
             q_next = nets["critic_target"](torch.cat([next_obs, out_next], dim=-1)).squeeze(-1)
-            y = self.loop.td_target(b, q_next)
-            if cfg.beta > 0:
-                y = mixed_target(y, b["mc"], cfg.beta)
+            y = self.loop.td_target(b, q_next)  # mixed with the Monte-Carlo return with beta > 0
             # critic: descend on mean (Q - y)^2 over the batch
             q, cache = critic.forward_cached(torch.cat([obs, b["out"]], dim=-1))
             q = q.squeeze(-1)
