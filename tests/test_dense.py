@@ -63,6 +63,24 @@ def test_backward_matches_finite_differences():
     assert grads[2][i, j].item() == pytest.approx(((up - down) / (2 * eps)).item(), rel=1e-6)
 
 
+def test_regression_step_is_the_autograd_step_on_the_mean_squared_error():
+    torch.manual_seed(2)
+    net = mlp(7, (16,), 1, "tanh")
+    twin = copy.deepcopy(net)
+    x, y = torch.randn(9, 7), torch.randn(9)
+    opt_a, opt_b = (torch.optim.SGD(n.parameters(), lr=0.1) for n in (net, twin))
+    loss = ((net(x).squeeze(-1) - y) ** 2).mean()
+    loss.backward()
+    nn.utils.clip_grad_norm_(net.parameters(), 0.5)
+    opt_a.step()
+    with torch.no_grad():
+        q, error = Dense.of(twin).regression_step(opt_b, x, y, 0.5)
+    assert float((error**2).mean()) == pytest.approx(float(loss))
+    torch.testing.assert_close(error, q - y)
+    for a, b in zip(net.parameters(), twin.parameters()):
+        torch.testing.assert_close(a, b)
+
+
 def test_layers_it_cannot_apply_are_refused():
     with pytest.raises(TypeError, match="Dropout"):
         Dense.of(nn.Sequential(nn.Linear(3, 4), nn.Dropout(0.1), nn.Linear(4, 1)))

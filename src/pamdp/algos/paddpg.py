@@ -157,11 +157,9 @@ class PADDPG(EpsilonSchedule, Algorithm):
             out_next = self._masked(nets["actor_target"](next_obs).clamp(-1.0, 1.0), b.get("next_mask"))
             q_next = nets["critic_target"](torch.cat([next_obs, out_next], dim=-1)).squeeze(-1)
             y = self.loop.td_target(b, q_next)  # mixed with the Monte-Carlo return with beta > 0
-            # critic: descend on mean (Q - y)^2 over the batch
-            q, cache = critic.forward_cached(torch.cat([obs, b["out"]], dim=-1))
-            q = q.squeeze(-1)
-            error = q - y
-            apply_gradients(self.critic_optimizer, critic.backward(cache, error * (2.0 / batch))[0], cfg.grad_clip)
+            q, error = critic.regression_step(
+                self.critic_optimizer, torch.cat([obs, b["out"]], dim=-1), y, cfg.grad_clip
+            )
             # actor: ascend on Q(s, mu(s)) with the critic just updated, dQ/dmu edited at the bounds
             out, actor_cache = actor.forward_cached(obs)
             q_mu, q_cache = critic.forward_cached(torch.cat([obs, self._masked(out, b.get("mask"))], dim=-1))

@@ -329,11 +329,9 @@ class PASVG0(Algorithm):
         batch, d, K = obs.shape[0], obs.shape[1], policy.n_actions
         temperature, hard = cfg.temperature, cfg.straight_through
         critic = nets["critic"]
-        # critic: descend on mean (Q - y)^2
-        q, cache = critic.forward_cached(torch.cat([obs, b["a_in"], b["x"]], dim=-1))
-        q = q.squeeze(-1)
-        error = q - y
-        apply_gradients(self.critic_optimizer, critic.backward(cache, error * (2.0 / batch))[0], cfg.grad_clip)
+        q, error = critic.regression_step(
+            self.critic_optimizer, torch.cat([obs, b["a_in"], b["x"]], dim=-1), y, cfg.grad_clip
+        )
         self.critic_updates += 1
 
         # policy: descend on -mean Q(s, a, x) - alpha * mean H(pi_d), with the recorded noise
