@@ -118,10 +118,10 @@ def _autograd_update(model):
     obs, next_obs = batch["obs"], batch["next_obs"]
     with torch.no_grad():
         out_next = model._masked(model.actor_target(next_obs).clamp(-1.0, 1.0), batch.get("next_mask"))
-        q_next = model.critic_target(next_obs, out_next)
+        q_next = model.critic_target.smaller(next_obs, out_next).squeeze(-1)
         y = batch["reward"] + cfg.gamma * (~batch["terminated"]).float() * q_next
         y = torch.where(torch.isnan(batch["mc"]), y, cfg.beta * batch["mc"].nan_to_num() + (1 - cfg.beta) * y)
-    q = model.critic(obs, batch["out"])
+    q = model.critic.smaller(obs, batch["out"]).squeeze(-1)
     model.critic_optimizer.zero_grad(set_to_none=True)
     model.actor_optimizer.zero_grad(set_to_none=True)
     (q - y).square().mean().backward()
@@ -129,7 +129,11 @@ def _autograd_update(model):
     model.critic_optimizer.step()
     params = list(model.actor.parameters())
     _, _, grads = backprop_actor(
-        lambda o: model._masked(model.actor(o), batch.get("mask")), model.critic, obs, cfg.bound, params
+        lambda o: model._masked(model.actor(o), batch.get("mask")),
+        lambda o, out: model.critic.smaller(o, out).squeeze(-1),
+        obs,
+        cfg.bound,
+        params,
     )
     for p, g in zip(params, grads):
         p.grad = g

@@ -13,7 +13,6 @@ import dataclasses
 
 import numpy as np
 import torch
-from torch import nn
 
 from pamdp.algos.base import Algorithm
 from pamdp.algos.dense import Dense
@@ -28,7 +27,7 @@ from pamdp.algos.offpolicy import (
 )
 from pamdp.algos.optim import apply_gradients
 from pamdp.algos.settings import POSITIVE, AlgoConfig, interval, setting
-from pamdp.policies import DeterministicActor, mlp
+from pamdp.policies import DeterministicActor, TwinQ
 
 __all__ = ["PADDPG", "PADDPGConfig"]
 
@@ -61,17 +60,6 @@ class PADDPGConfig(DeterministicActorConfig, OffPolicyConfig, AlgoConfig):
     }
 
 
-class Critic(nn.Module):
-    """``Q(s, mu)`` on the state and the actor's whole output vector."""
-
-    def __init__(self, obs_dim: int, out_size: int, hidden_sizes, activation: str):
-        super().__init__()
-        self.net = mlp(obs_dim + out_size, hidden_sizes, 1, activation)
-
-    def forward(self, obs: torch.Tensor, out: torch.Tensor) -> torch.Tensor:
-        return self.net(torch.cat([obs, out], dim=-1)).squeeze(-1)
-
-
 class PADDPG(EpsilonSchedule, Algorithm):
     """Parameterized-action DDPG with inverting gradients (Hausknecht & Stone). See :class:`PADDPGConfig`."""
 
@@ -88,7 +76,8 @@ class PADDPG(EpsilonSchedule, Algorithm):
         self.actor = DeterministicActor(
             self.obs_dim, self.out_size, cfg.hidden_sizes, cfg.activation, squash, h, h.n_actions
         )
-        self.critic = Critic(self.obs_dim, self.out_size, cfg.hidden_sizes, cfg.activation)
+        # Q(s, mu) on the state and the actor's whole output vector
+        self.critic = TwinQ(self.obs_dim + self.out_size, 1, cfg.hidden_sizes, cfg.activation, twin=False)
         self.actor_target = copy.deepcopy(self.actor).requires_grad_(False)
         self.critic_target = copy.deepcopy(self.critic).requires_grad_(False)
         self._bind_networks()
@@ -108,7 +97,8 @@ class PADDPG(EpsilonSchedule, Algorithm):
     def _bind_networks(self) -> None:
         """The update's hand-written passes (:mod:`pamdp.algos.dense`) over the modules' own tensors; called
         again by whoever replaces a module."""
-        self._dense = {name: Dense.of(module.net) for name, module in self._modules().items()}
+        self._dense = {name: Dense.of(getattr(self, name).net) for name in ("actor", "actor_target")}
+        self._dense.update({name: Dense.of(getattr(self, name).q1) for name in ("critic", "critic_target")})
         self._soft_update = soft_updater(((self.actor_target, self.actor), (self.critic_target, self.critic)))
 
     def _act(self, obs, deterministic, mask=None):
@@ -143,7 +133,7 @@ class PADDPG(EpsilonSchedule, Algorithm):
 
     def _target_value(self, obs: torch.Tensor, mask: torch.Tensor | None) -> torch.Tensor:
         """``Q'(s, mu'(s))``, the bootstrap of a truncated episode's Monte-Carlo return."""
-        return self.critic_target(obs, self._masked(self.actor_target(obs).clamp(-1.0, 1.0), mask))
+        return self.critic_target.smaller(obs, self._masked(self.actor_target(obs).clamp(-1.0, 1.0), mask)).squeeze(-1)
 
     def _update(self) -> dict[str, torch.Tensor]:
         """One critic step on the mixed target and one actor step along the bounded ``dQ/dmu``, back-propagated
