@@ -82,7 +82,6 @@ class PADDPG(EpsilonSchedule, Algorithm):
         self.critic_target = copy.deepcopy(self.critic).requires_grad_(False)
         self._bind_networks()
         betas = (cfg.adam_beta1, 0.999)
-        # fused: one kernel per step instead of a dozen foreach passes (benchmarks/offpolicy_speed.md).
         self.actor_optimizer = torch.optim.Adam(self.actor.parameters(), lr=cfg.actor_lr, betas=betas, fused=True)
         self.critic_optimizer = torch.optim.Adam(self.critic.parameters(), lr=cfg.critic_lr, betas=betas, fused=True)
         self.loop = OffPolicyLoop(

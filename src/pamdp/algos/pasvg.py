@@ -179,7 +179,6 @@ class PASVG0(Algorithm):
         self.critic_target = copy.deepcopy(self.critic).requires_grad_(False)
         self.critic_params = list(self.critic.parameters())
         self.critic_updates = 0  # for policy_delay
-        # fused: one kernel per step instead of a dozen foreach passes (benchmarks/offpolicy_speed.md).
         self.policy_params = [p for p in self.policy.parameters() if p.requires_grad]
         self.policy_optimizer = torch.optim.Adam(self.policy_params, lr=cfg.policy_lr, fused=True)
         self.critic_optimizer = torch.optim.Adam(self.critic_params, lr=cfg.critic_lr, fused=True)
