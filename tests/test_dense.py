@@ -63,6 +63,24 @@ def test_backward_matches_finite_differences():
     assert grads[2][i, j].item() == pytest.approx(((up - down) / (2 * eps)).item(), rel=1e-6)
 
 
+def test_regression_step_is_the_autograd_step_on_the_mean_squared_error():
+    torch.manual_seed(2)
+    net = mlp(7, (16,), 1, "tanh")
+    twin = copy.deepcopy(net)
+    x, y = torch.randn(9, 7), torch.randn(9)
+    opt_a, opt_b = (torch.optim.SGD(n.parameters(), lr=0.1) for n in (net, twin))
+    loss = ((net(x).squeeze(-1) - y) ** 2).mean()
+    loss.backward()
+    nn.utils.clip_grad_norm_(net.parameters(), 0.5)
+    opt_a.step()
+    with torch.no_grad():
+        q, error = Dense.of(twin).regression_step(opt_b, x, y, 0.5)
+    assert float((error**2).mean()) == pytest.approx(float(loss.detach()))
+    torch.testing.assert_close(error, q - y)
+    for a, b in zip(net.parameters(), twin.parameters()):
+        torch.testing.assert_close(a, b)
+
+
 def test_layers_it_cannot_apply_are_refused():
     with pytest.raises(TypeError, match="Dropout"):
         Dense.of(nn.Sequential(nn.Linear(3, 4), nn.Dropout(0.1), nn.Linear(4, 1)))
@@ -100,10 +118,10 @@ def _autograd_update(model):
     obs, next_obs = batch["obs"], batch["next_obs"]
     with torch.no_grad():
         out_next = model._masked(model.actor_target(next_obs).clamp(-1.0, 1.0), batch.get("next_mask"))
-        q_next = model.critic_target(next_obs, out_next)
+        q_next = model.critic_target.smaller(next_obs, out_next).squeeze(-1)
         y = batch["reward"] + cfg.gamma * (~batch["terminated"]).float() * q_next
         y = torch.where(torch.isnan(batch["mc"]), y, cfg.beta * batch["mc"].nan_to_num() + (1 - cfg.beta) * y)
-    q = model.critic(obs, batch["out"])
+    q = model.critic.smaller(obs, batch["out"]).squeeze(-1)
     model.critic_optimizer.zero_grad(set_to_none=True)
     model.actor_optimizer.zero_grad(set_to_none=True)
     (q - y).square().mean().backward()
@@ -111,7 +129,11 @@ def _autograd_update(model):
     model.critic_optimizer.step()
     params = list(model.actor.parameters())
     _, _, grads = backprop_actor(
-        lambda o: model._masked(model.actor(o), batch.get("mask")), model.critic, obs, cfg.bound, params
+        lambda o: model._masked(model.actor(o), batch.get("mask")),
+        lambda o, out: model.critic.smaller(o, out).squeeze(-1),
+        obs,
+        cfg.bound,
+        params,
     )
     for p, g in zip(params, grads):
         p.grad = g

@@ -6,12 +6,12 @@ import dataclasses
 import numpy as np
 import pytest
 import torch
-from conftest import HYBRID, OFF_POLICY_SMALL
+from conftest import HYBRID, OFF_POLICY_SMALL, module_bytes
 
 from pamdp import PADDPG
 from pamdp.algos.offpolicy import invert_gradients, zero_gradients
-from pamdp.algos.paddpg import Critic, PADDPGConfig
-from pamdp.policies import DeterministicActor
+from pamdp.algos.paddpg import PADDPGConfig
+from pamdp.policies import DeterministicActor, TwinQ
 
 SMALL = PADDPGConfig(hidden_sizes=(16, 16), epsilon_steps=300, **OFF_POLICY_SMALL)
 
@@ -51,10 +51,10 @@ def test_actor_chasing_an_unbounded_critic_stays_in_bounds(bound):
         model.learn(100, progress_bar=False)
 
     def greedy():  # a critic that wants every output as large as possible: Q = 10 * sum(out), no hidden layer
-        critic = Critic(model.obs_dim, model.out_size, (), "relu")
+        critic = TwinQ(model.obs_dim + model.out_size, 1, (), "relu", twin=False)
         with torch.no_grad():
-            critic.net[0].weight.copy_(torch.cat([torch.zeros(model.obs_dim), torch.full((model.out_size,), 10.0)]))
-            critic.net[0].bias.zero_()
+            critic.q1[0].weight.copy_(torch.cat([torch.zeros(model.obs_dim), torch.full((model.out_size,), 10.0)]))
+            critic.q1[0].bias.zero_()
         return critic
 
     model.critic, model.critic_target = greedy(), greedy().requires_grad_(False)
@@ -127,11 +127,11 @@ def test_beta_zero_stores_no_returns_and_learns_from_the_pure_td_target():
     batch = model.replay.sample(16, np.random.default_rng(0))
     model.replay.sample = lambda n, rng: batch
     with torch.no_grad():
-        q = model.critic(batch["obs"], batch["out"])
+        q = model.critic.smaller(batch["obs"], batch["out"]).squeeze(-1)
         s2 = batch["next_obs"]
-        y = batch["reward"] + 0.99 * (~batch["terminated"]).float() * model.critic_target(
+        y = batch["reward"] + 0.99 * (~batch["terminated"]).float() * model.critic_target.smaller(
             s2, model.actor_target(s2).clamp(-1, 1)
-        )
+        ).squeeze(-1)
     stats = model._update()
     assert stats["losses/critic_loss"] == pytest.approx(float(((q - y) ** 2).mean()), rel=1e-5)
 
@@ -143,9 +143,28 @@ def test_critic_loss_falls_on_a_fixed_batch():
     b = model.replay.sample(128, np.random.default_rng(0))
     losses = []
     for _ in range(150):
-        loss = (model.critic(b["obs"], b["out"]) - b["reward"]).pow(2).mean()
+        loss = (model.critic.smaller(b["obs"], b["out"]).squeeze(-1) - b["reward"]).pow(2).mean()
         model.critic_optimizer.zero_grad()
         loss.backward()
         model.critic_optimizer.step()
         losses.append(loss.item())
     assert losses[-1] < 0.2 * losses[0]
+
+
+def test_checkpoints_of_the_critic_before_it_was_a_twin_q_still_load(tmp_path):
+    """Files written when the critic (and its target) held its ``mlp`` under ``net`` load into the TwinQ's ``q1``
+    (checkpoints.RENAMED), optimiser state included, and act as the model that wrote them."""
+    model = PADDPG("pamdp/Platform-v0", dataclasses.replace(SMALL, learning_starts=64))
+    model.learn(200, progress_bar=False)
+    model.save(tmp_path / "new.pt")
+    payload = torch.load(tmp_path / "new.pt", weights_only=True)
+    for name in ("critic", "critic_target"):
+        state = payload["modules"][name]
+        assert all(k.startswith("q1.") for k in state)
+        payload["modules"][name] = {"net." + k[3:]: v for k, v in state.items()}
+    torch.save(payload, tmp_path / "old.pt")
+    loaded = PADDPG.load(tmp_path / "old.pt")
+    assert module_bytes(loaded) == module_bytes(model)
+    obs = model.replay.data["obs"][:8].numpy()
+    for a, b in zip(loaded.predict(obs), model.predict(obs)):
+        np.testing.assert_array_equal(a, b)

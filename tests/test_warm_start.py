@@ -195,7 +195,9 @@ def test_a_row_kept_inside_a_widened_tensor(tmp_path):
     expected = torch.tensor([[-2.0, -2.0], [-0.97, -0.5], [-0.52, -3.69]])
     torch.testing.assert_close(model.policy.log_std.detach(), expected)
     for name in ("policy.log_std[3]", "policy.log_std[-1]", "policy.log_std[kick]"):
-        with pytest.raises(ValueError, match=r"keep names .*; expected policy.log_std or one of its rows, .*\[0\] to .*\[2\]"):
+        with pytest.raises(
+            ValueError, match=r"keep names .*; expected policy.log_std or one of its rows, .*\[0\] to .*\[2\]"
+        ):
             transfer_weights(model, tmp_path / "source.pt", columns, keep=(name,))
     with pytest.raises(ValueError, match=r"widen names rows of policy.pi_d.0.weight, which depends on the observation"):
         transfer_weights(model, tmp_path / "source.pt", columns, widen=("policy.pi_d.0.weight[0]",))
@@ -235,5 +237,8 @@ init_from = "stage"
     exp = load_experiment(tmp_path / "e.toml")
     jobs = exp.jobs(tmp_path / "out", exp.specs(seeds=[9]))  # --seeds: the experiment's, not a run's own
     assert [(spec.label, spec.seed, spec.init_from) for spec, _ in jobs] == [
-        ("stage", 100, ""), ("next", 5, stage), ("next", 6, stage), ("next", 7, stage)
+        ("stage", 100, ""),
+        ("next", 5, stage),
+        ("next", 6, stage),
+        ("next", 7, stage),
     ]

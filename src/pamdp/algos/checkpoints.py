@@ -37,6 +37,8 @@ RENAMED = {
         "critic_target.net.": "critic_target.q1.",
         "critic2_target.net.": "critic_target.q2.",
     },
+    # PADDPG's critic became a TwinQ of one critic
+    "PADDPG": {"critic.net.": "critic.q1.", "critic_target.net.": "critic_target.q1."},
 }
 """Per algorithm, the tensors its checkpoints once held under other names, ``{old prefix: new prefix}`` of
 ``network.key``: :func:`read_checkpoint` moves them, so that files written before still load."""

@@ -14,6 +14,8 @@ from dataclasses import dataclass
 import torch
 from torch import nn
 
+from pamdp.algos.optim import apply_gradients
+
 __all__ = ["Dense", "MultiPassDense"]
 
 _aten = torch.ops.aten
@@ -133,6 +135,18 @@ class Dense:
                 g = torch.mm(g, self.weights[i])
         grads = [t for pair in reversed(pairs) for t in pair] if weights else None
         return grads, (g if inputs else None)
+
+    def regression_step(
+        self, optimizer: torch.optim.Optimizer, x: torch.Tensor, y: torch.Tensor, max_norm: float = 0.0
+    ) -> tuple[torch.Tensor, torch.Tensor]:
+        """One step of ``optimizer`` (over this network's parameters, in order) down ``mean (f(x) - y)^2`` of a
+        network of one output, its gradient's norm clipped to ``max_norm`` (a critic's TD step); returns ``f(x)``
+        ``(B,)`` and the errors ``f(x) - y``."""
+        q, cache = self.forward_cached(x)
+        q = q.squeeze(-1)
+        error = q - y
+        apply_gradients(optimizer, self.backward(cache, error * (2.0 / len(q)))[0], max_norm)
+        return q, error
 
 
 @dataclass(frozen=True)

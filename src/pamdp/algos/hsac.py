@@ -14,15 +14,7 @@ import torch
 import torch.nn.functional as F
 
 from pamdp.algos.base import Algorithm
-from pamdp.algos.offpolicy import (
-    OffPolicyConfig,
-    OffPolicyLoop,
-    Temperatures,
-    learning_starts_setting,
-    shared_setting,
-    soft_updater,
-    tau_setting,
-)
+from pamdp.algos.offpolicy import OffPolicyConfig, OffPolicyLoop, Temperatures, soft_updater
 from pamdp.algos.optim import descend
 from pamdp.algos.settings import NON_NEGATIVE, POSITIVE, AlgoConfig, Check, interval, one_of, setting
 from pamdp.distributions import MASKED, SquashedHybrid
@@ -43,7 +35,9 @@ class HybridSACConfig(OffPolicyConfig, AlgoConfig):
         "(pi_c(x|s,a) on [s, onehot(a)], the seed paper's).",
         one_of(FORMS),
     )
-    hidden_sizes: tuple[int, ...] = shared_setting("hidden_sizes", (256, 256), "SAC's: 256-256; assumed")
+    hidden_sizes: tuple[int, ...] = OffPolicyConfig.shared_setting(
+        "hidden_sizes", (256, 256), "SAC's: 256-256; assumed"
+    )
     actor_lr: float = setting(3e-4, "Adam learning rate of the policy (SAC: 3e-4; assumed).", POSITIVE)
     critic_lr: float = setting(3e-4, "Adam learning rate of the twin critics (SAC: 3e-4; assumed).", POSITIVE)
     alpha_lr: float = setting(
@@ -64,9 +58,9 @@ class HybridSACConfig(OffPolicyConfig, AlgoConfig):
         "pi_c's target entropy in nats per parameter of the chosen action (SAC: -1 per action dimension; assumed).",
         Check(lambda v: v < math.log(2.0), "a number below log 2 (the uniform's entropy on [-1, 1])"),
     )
-    tau: float = tau_setting(0.005, "of the critics; SAC: 0.005")
-    batch_size: int = shared_setting("batch_size", 256, "SAC: 256; assumed")
-    learning_starts: int = learning_starts_setting(10_000, "SAC: 10 000; assumed")
+    tau: float = OffPolicyConfig.tau_setting(0.005, "of the critics; SAC: 0.005")
+    batch_size: int = OffPolicyConfig.shared_setting("batch_size", 256, "SAC: 256; assumed")
+    learning_starts: int = OffPolicyConfig.learning_starts_setting(10_000, "SAC: 10 000; assumed")
 
     # "tuned" (the command line's default): docs/algorithms.md, "Hybrid SAC"; benchmarks/hsac_platform.md.
     PRESETS = {

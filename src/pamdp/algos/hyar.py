@@ -23,9 +23,7 @@ from pamdp.algos.offpolicy import (
     OffPolicyLoop,
     backprop_actor,
     linear_epsilon,
-    shared_setting,
     soft_updater,
-    tau_setting,
     uniform_actions,
 )
 from pamdp.algos.optim import apply_gradients, descend
@@ -49,7 +47,7 @@ class HyARConfig(OffPolicyConfig, AlgoConfig):
     vae_hidden_sizes: tuple[int, ...] = setting(
         (256, 256), "Hidden layers of the VAE's encoder and decoder (assumed).", LAYERS
     )
-    hidden_sizes: tuple[int, ...] = shared_setting("hidden_sizes", (256, 256), "TD3's: 256-256")
+    hidden_sizes: tuple[int, ...] = OffPolicyConfig.shared_setting("hidden_sizes", (256, 256), "TD3's: 256-256")
     bound: str = setting(
         "squash",
         "Keeping the actor's output in [-1, 1]: squash (Tanh, the paper) or invert (a linear output and Hausknecht "
@@ -97,8 +95,8 @@ class HyARConfig(OffPolicyConfig, AlgoConfig):
     )
     actor_lr: float = setting(3e-4, "Adam learning rate of the actor (TD3: 3e-4).", POSITIVE)
     critic_lr: float = setting(3e-4, "Adam learning rate of the critics (TD3: 3e-4).", POSITIVE)
-    batch_size: int = shared_setting("batch_size", 128, "assumed: 128")
-    tau: float = tau_setting(0.005, "TD3: 0.005")
+    batch_size: int = OffPolicyConfig.shared_setting("batch_size", 128, "assumed: 128")
+    tau: float = OffPolicyConfig.tau_setting(0.005, "TD3: 0.005")
     exploration_noise: float = setting(
         0.1,
         "Std of the Gaussian noise on the actor's [-1, 1] output (TD3: 0.1); with exploration_noise_steps, the std "
@@ -139,7 +137,9 @@ class HyARConfig(OffPolicyConfig, AlgoConfig):
         "warm-up's random actions included.",
         at_least(0),
     )
-    save_replay: bool = shared_setting("save_replay", True, "true here: it is the representation's training data")
+    save_replay: bool = OffPolicyConfig.shared_setting(
+        "save_replay", True, "true here: it is the representation's training data"
+    )
 
     def __post_init__(self):
         """The checks across settings (each setting's own runs in AlgoConfig)."""

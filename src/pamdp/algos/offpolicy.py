@@ -25,9 +25,6 @@ from pamdp.policies import ACTIVATIONS
 __all__ = [
     "OffPolicyConfig",
     "DeterministicActorConfig",
-    "shared_setting",
-    "learning_starts_setting",
-    "tau_setting",
     "OffPolicyLoop",
     "Temperatures",
     "temperature_gradient",
@@ -55,7 +52,7 @@ class OffPolicyConfig:
 
     An algorithm's config inherits it beside :class:`~pamdp.algos.settings.AlgoConfig`
     (``class PADDPGConfig(OffPolicyConfig, AlgoConfig)``) and declares its own ``learning_starts``; a setting
-    whose paper gives another default is declared again with :func:`shared_setting`.
+    whose paper gives another default is declared again with :meth:`shared_setting`.
     """
 
     num_envs: int = setting(
@@ -88,6 +85,28 @@ class OffPolicyConfig:
         (256, 256), "Hidden layers of the actor (or policy) and the critics.", LAYERS
     )
     activation: str = setting("relu", "Hidden activation: relu, leaky_relu, tanh or elu.", one_of(ACTIVATIONS))
+
+    # How an algorithm's config declares its own values of the family's settings; methods of the family config, so
+    # that an algorithm imports its family's names once.
+    @staticmethod
+    def shared_setting(name: str, default, source: str | None = None):
+        """The family's setting ``name`` (of :class:`OffPolicyConfig` or :class:`DeterministicActorConfig`) declared
+        again with an algorithm's own ``default``, its help and check kept (:func:`~pamdp.algos.settings.redeclared`).
+        """
+        base = OffPolicyConfig if name in OffPolicyConfig.__dataclass_fields__ else DeterministicActorConfig
+        return redeclared(base, name, default, source)
+
+    @staticmethod
+    def learning_starts_setting(default: int, source: str) -> int:
+        """The ``learning_starts`` setting of an algorithm's config, with its ``default`` and where the value comes
+        from (HyAR's is no setting: its warm-up, ``warmup_steps``)."""
+        return setting(default, f"Samples in the replay buffer before the first update ({source}).", at_least(0))
+
+    @staticmethod
+    def tau_setting(default: float, source: str) -> float:
+        """A soft target-update rate (:func:`soft_updater`'s ``tau``), with its ``default`` and where it comes from."""
+        help = f"Soft target-update rate, target <- tau * online + (1 - tau) * target ({source})."
+        return setting(default, help, interval(0, 1, low_open=True))
 
 
 @dataclasses.dataclass(frozen=True)
@@ -124,25 +143,6 @@ class DeterministicActorConfig:
         "Mean reversion of the Ornstein-Uhlenbeck noise (DDPG's 0.15); 1 gives i.i.d. Gaussian noise.",
         interval(0, 1, low_open=True),
     )
-
-
-def shared_setting(name: str, default, source: str | None = None):
-    """The family's setting ``name`` (of :class:`OffPolicyConfig` or :class:`DeterministicActorConfig`) declared
-    again with an algorithm's own ``default``, its help and check kept (:func:`~pamdp.algos.settings.redeclared`)."""
-    base = OffPolicyConfig if name in OffPolicyConfig.__dataclass_fields__ else DeterministicActorConfig
-    return redeclared(base, name, default, source)
-
-
-def learning_starts_setting(default: int, source: str) -> int:
-    """The ``learning_starts`` setting of an off-policy config, with its ``default`` and where the value comes
-    from (HyAR's is no setting: its warm-up, ``warmup_steps``)."""
-    return setting(default, f"Samples in the replay buffer before the first update ({source}).", at_least(0))
-
-
-def tau_setting(default: float, source: str) -> float:
-    """A soft target-update rate (:func:`soft_updater`'s ``tau``), with its ``default`` and where it comes from."""
-    help = f"Soft target-update rate, target <- tau * online + (1 - tau) * target ({source})."
-    return setting(default, help, interval(0, 1, low_open=True))
 
 
 # act(obs (N, d) tensor, global step, episode_start (N,) bool, mask (N, K) bool tensor or None)
@@ -364,8 +364,10 @@ class OffPolicyLoop:
         self.stepper: VectorStepper | None = None  # the env's copies, from the first epoch on
 
     def td_target(self, batch: dict[str, torch.Tensor], next_value: torch.Tensor) -> torch.Tensor:
-        """``y = r + gamma V(s')`` of a replayed batch, with no bootstrap after a termination."""
-        return batch["reward"] + self.config.gamma * (~batch["terminated"]).float() * next_value
+        """``y = r + gamma V(s')`` of a replayed batch, with no bootstrap after a termination; where the loop keeps
+        Monte-Carlo returns (``mc_returns``: PADDPG's and P-DQN's ``beta > 0``), :func:`mixed_target` with ``beta``."""
+        y = batch["reward"] + self.config.gamma * (~batch["terminated"]).float() * next_value
+        return mixed_target(y, batch["mc"], self.config.beta) if self.mc_returns else y
 
     def budget_note(self, total: int) -> str | None:
         """Why ``total`` more samples make no gradient update (the replay would not reach ``learning_starts``), or

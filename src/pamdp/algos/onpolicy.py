@@ -18,13 +18,12 @@ from pamdp.policies import ACTIVATIONS, PI_C_INPUTS, HybridPolicy
 
 __all__ = [
     "OnPolicyConfig",
+    "OnPolicy",
     "hybrid_policy",
     "Rollout",
     "gae",
     "advantage_batch",
     "update_tensors",
-    "mask_tensor",
-    "network_values",
     "LinearFeatureBaseline",
 ]
 
@@ -59,6 +58,31 @@ class OnPolicyConfig:
     )
     normalize_advantages: bool = setting(True, "Standardise advantages within the batch.")
     vf_hidden_sizes: tuple[int, ...] = setting((64, 64), "Hidden layers of the value network.", LAYERS)
+
+
+class OnPolicy:
+    """What PATRPO and PAPPO do alike as algorithms, a base beside :class:`~pamdp.algos.base.Algorithm` (as
+    :class:`~pamdp.algos.offpolicy.EpsilonSchedule` is for off-policy ones): their hierarchical ``policy`` acts,
+    their ``value`` network is the baseline, and their updates read an :func:`advantage_batch` alike."""
+
+    def _act(self, obs, deterministic, mask=None):
+        return self.policy.act(obs, mask, deterministic, self.torch_gen)
+
+    def _values(self, obs: np.ndarray, t: np.ndarray) -> np.ndarray:
+        """The value network's ``V(s)`` of a batch of observations (computed on the algorithm's device), as float64
+        for GAE."""
+        with torch.no_grad():
+            return self.value(self._obs_tensor(obs)).double().cpu().numpy()
+
+    def _update_tensors(self, data: dict[str, np.ndarray]) -> tuple[torch.Tensor, ...]:
+        """``(obs, a, x, adv, mask)`` of an :func:`advantage_batch` on the algorithm's device: :func:`update_tensors`
+        and the samples' allowed actions ``(B, K)`` (``None`` without masks)."""
+        mask = torch.as_tensor(data["mask"], device=self.device) if "mask" in data else None
+        return (*update_tensors(data, self.device), mask)
+
+    def _param_std(self) -> float:
+        """``train/param_std``: the parameter noise's std, averaged over the parameters the actions have."""
+        return float(self.policy.log_std.detach().exp()[self.policy.mask].mean())
 
 
 def hybrid_policy(algo) -> HybridPolicy:
@@ -213,19 +237,6 @@ def update_tensors(
         torch.as_tensor(data["x"], device=device),
         torch.as_tensor(data["adv"], dtype=torch.float32, device=device),
     )
-
-
-def mask_tensor(data: dict[str, np.ndarray], device: torch.device | str = "cpu") -> torch.Tensor | None:
-    """The allowed actions ``(B, K)`` of an :func:`advantage_batch`'s samples on ``device``; ``None`` without
-    masks."""
-    return torch.as_tensor(data["mask"], device=device) if "mask" in data else None
-
-
-def network_values(value: torch.nn.Module, obs: np.ndarray, device: torch.device) -> np.ndarray:
-    """A value network's ``V(s)`` of a batch of observations (computed on ``device``, the network's), as float64
-    for GAE."""
-    with torch.no_grad():
-        return value(torch.as_tensor(np.asarray(obs, dtype=np.float32), device=device)).double().cpu().numpy()
 
 
 class LinearFeatureBaseline:

@@ -13,7 +13,6 @@ import dataclasses
 
 import numpy as np
 import torch
-from torch import nn
 
 from pamdp.algos.base import Algorithm
 from pamdp.algos.dense import Dense
@@ -24,15 +23,11 @@ from pamdp.algos.offpolicy import (
     OffPolicyLoop,
     OUNoise,
     bounded,
-    learning_starts_setting,
-    mixed_target,
-    shared_setting,
     soft_updater,
-    tau_setting,
 )
 from pamdp.algos.optim import apply_gradients
 from pamdp.algos.settings import POSITIVE, AlgoConfig, interval, setting
-from pamdp.policies import DeterministicActor, mlp
+from pamdp.policies import DeterministicActor, TwinQ
 
 __all__ = ["PADDPG", "PADDPGConfig"]
 
@@ -43,35 +38,26 @@ class PADDPGConfig(DeterministicActorConfig, OffPolicyConfig, AlgoConfig):
     hidden layers {400, 300} of DDPG (the paper used {400, 300, 200} on Half Field Offense: preset
     ``paper_hfo``; Hausknecht & Stone's own 1024-512-256-128 towers: preset ``hausknecht_stone``)."""
 
-    hidden_sizes: tuple[int, ...] = shared_setting("hidden_sizes", (400, 300), "paper: {400, 300}")
-    activation: str = shared_setting("activation", "leaky_relu", "Hausknecht & Stone: leaky_relu, slope 0.01")
+    hidden_sizes: tuple[int, ...] = OffPolicyConfig.shared_setting("hidden_sizes", (400, 300), "paper: {400, 300}")
+    activation: str = OffPolicyConfig.shared_setting(
+        "activation", "leaky_relu", "Hausknecht & Stone: leaky_relu, slope 0.01"
+    )
     actor_lr: float = setting(1e-5, "Adam learning rate of the actor (Hausknecht & Stone: 1e-5).", POSITIVE)
     critic_lr: float = setting(1e-3, "Adam learning rate of the critic (Hausknecht & Stone: 1e-3).", POSITIVE)
     adam_beta1: float = setting(
         0.95, "Adam's beta1 for both networks (Hausknecht & Stone: 0.95).", interval(0, 1, high_open=True)
     )
-    grad_clip: float = shared_setting("grad_clip", 10.0, "Hausknecht & Stone: 10")
-    batch_size: int = shared_setting("batch_size", 32, "Hausknecht & Stone: 32")
-    tau: float = tau_setting(0.001, "DDPG's 0.001")
-    buffer_size: int = shared_setting("buffer_size", 500_000, "Hausknecht & Stone: 500 000")
-    learning_starts: int = learning_starts_setting(10_000, "the seed paper: 10^4")
+    grad_clip: float = OffPolicyConfig.shared_setting("grad_clip", 10.0, "Hausknecht & Stone: 10")
+    batch_size: int = OffPolicyConfig.shared_setting("batch_size", 32, "Hausknecht & Stone: 32")
+    tau: float = OffPolicyConfig.tau_setting(0.001, "DDPG's 0.001")
+    buffer_size: int = OffPolicyConfig.shared_setting("buffer_size", 500_000, "Hausknecht & Stone: 500 000")
+    learning_starts: int = OffPolicyConfig.learning_starts_setting(10_000, "the seed paper: 10^4")
 
     PRESETS = {
         "paper": {},
         "paper_hfo": dict(hidden_sizes=(400, 300, 200)),
         "hausknecht_stone": dict(hidden_sizes=(1024, 512, 256, 128)),
     }
-
-
-class Critic(nn.Module):
-    """``Q(s, mu)`` on the state and the actor's whole output vector."""
-
-    def __init__(self, obs_dim: int, out_size: int, hidden_sizes, activation: str):
-        super().__init__()
-        self.net = mlp(obs_dim + out_size, hidden_sizes, 1, activation)
-
-    def forward(self, obs: torch.Tensor, out: torch.Tensor) -> torch.Tensor:
-        return self.net(torch.cat([obs, out], dim=-1)).squeeze(-1)
 
 
 class PADDPG(EpsilonSchedule, Algorithm):
@@ -90,12 +76,12 @@ class PADDPG(EpsilonSchedule, Algorithm):
         self.actor = DeterministicActor(
             self.obs_dim, self.out_size, cfg.hidden_sizes, cfg.activation, squash, h, h.n_actions
         )
-        self.critic = Critic(self.obs_dim, self.out_size, cfg.hidden_sizes, cfg.activation)
+        # Q(s, mu) on the state and the actor's whole output vector
+        self.critic = TwinQ(self.obs_dim + self.out_size, 1, cfg.hidden_sizes, cfg.activation, twin=False)
         self.actor_target = copy.deepcopy(self.actor).requires_grad_(False)
         self.critic_target = copy.deepcopy(self.critic).requires_grad_(False)
         self._bind_networks()
         betas = (cfg.adam_beta1, 0.999)
-        # fused: one kernel per step instead of a dozen foreach passes (benchmarks/offpolicy_speed.md).
         self.actor_optimizer = torch.optim.Adam(self.actor.parameters(), lr=cfg.actor_lr, betas=betas, fused=True)
         self.critic_optimizer = torch.optim.Adam(self.critic.parameters(), lr=cfg.critic_lr, betas=betas, fused=True)
         self.loop = OffPolicyLoop(
@@ -110,7 +96,8 @@ class PADDPG(EpsilonSchedule, Algorithm):
     def _bind_networks(self) -> None:
         """The update's hand-written passes (:mod:`pamdp.algos.dense`) over the modules' own tensors; called
         again by whoever replaces a module."""
-        self._dense = {name: Dense.of(module.net) for name, module in self._modules().items()}
+        self._dense = {name: Dense.of(getattr(self, name).net) for name in ("actor", "actor_target")}
+        self._dense.update({name: Dense.of(getattr(self, name).q1) for name in ("critic", "critic_target")})
         self._soft_update = soft_updater(((self.actor_target, self.actor), (self.critic_target, self.critic)))
 
     def _act(self, obs, deterministic, mask=None):
@@ -145,7 +132,7 @@ class PADDPG(EpsilonSchedule, Algorithm):
 
     def _target_value(self, obs: torch.Tensor, mask: torch.Tensor | None) -> torch.Tensor:
         """``Q'(s, mu'(s))``, the bootstrap of a truncated episode's Monte-Carlo return."""
-        return self.critic_target(obs, self._masked(self.actor_target(obs).clamp(-1.0, 1.0), mask))
+        return self.critic_target.smaller(obs, self._masked(self.actor_target(obs).clamp(-1.0, 1.0), mask)).squeeze(-1)
 
     def _update(self) -> dict[str, torch.Tensor]:
         """One critic step on the mixed target and one actor step along the bounded ``dQ/dmu``, back-propagated
@@ -158,14 +145,10 @@ class PADDPG(EpsilonSchedule, Algorithm):
         with torch.no_grad():
             out_next = self._masked(nets["actor_target"](next_obs).clamp(-1.0, 1.0), b.get("next_mask"))
             q_next = nets["critic_target"](torch.cat([next_obs, out_next], dim=-1)).squeeze(-1)
-            y = self.loop.td_target(b, q_next)
-            if cfg.beta > 0:
-                y = mixed_target(y, b["mc"], cfg.beta)
-            # critic: descend on mean (Q - y)^2 over the batch
-            q, cache = critic.forward_cached(torch.cat([obs, b["out"]], dim=-1))
-            q = q.squeeze(-1)
-            error = q - y
-            apply_gradients(self.critic_optimizer, critic.backward(cache, error * (2.0 / batch))[0], cfg.grad_clip)
+            y = self.loop.td_target(b, q_next)  # mixed with the Monte-Carlo return with beta > 0
+            q, error = critic.regression_step(
+                self.critic_optimizer, torch.cat([obs, b["out"]], dim=-1), y, cfg.grad_clip
+            )
             # actor: ascend on Q(s, mu(s)) with the critic just updated, dQ/dmu edited at the bounds
             out, actor_cache = actor.forward_cached(obs)
             q_mu, q_cache = critic.forward_cached(torch.cat([obs, self._masked(out, b.get("mask"))], dim=-1))

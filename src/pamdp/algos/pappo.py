@@ -14,7 +14,7 @@ import numpy as np
 import torch
 
 from pamdp.algos.base import Algorithm
-from pamdp.algos.onpolicy import OnPolicyConfig, Rollout, hybrid_policy, mask_tensor, network_values, update_tensors
+from pamdp.algos.onpolicy import OnPolicy, OnPolicyConfig, Rollout, hybrid_policy
 from pamdp.algos.optim import descend
 from pamdp.algos.settings import NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, setting
 from pamdp.distributions import HybridDistribution, kl_divergence
@@ -118,7 +118,7 @@ def ppo_loss(
     return loss, {k: v.detach() for k, v in parts.items()}
 
 
-class PAPPO(Algorithm):
+class PAPPO(OnPolicy, Algorithm):
     """PPO of the hierarchical policy. See docs/algorithms.md, "PAPPO", for the update and :class:`PAPPOConfig`."""
 
     config_class = PAPPOConfig
@@ -133,16 +133,11 @@ class PAPPO(Algorithm):
         self.optimizer = torch.optim.Adam([*self.policy.parameters(), *self.value.parameters()], lr=cfg.lr)
         self.loop = Rollout(self)  # a loaded model starts new episodes
 
-    def _act(self, obs, deterministic, mask=None):
-        return self.policy.act(obs, mask, deterministic, self.torch_gen)
-
-    def _values(self, obs: np.ndarray, t: np.ndarray) -> np.ndarray:
-        return network_values(self.value, obs, self.device)
-
     def _learn(self, data: dict[str, np.ndarray]) -> dict[str, float]:
         """:meth:`_update` on an :func:`~pamdp.algos.onpolicy.advantage_batch` (the epoch: Rollout.run_epoch)."""
         returns = torch.as_tensor(data["returns"], dtype=torch.float32, device=self.device)
-        return self._update(*update_tensors(data, self.device), returns, mask_tensor(data, self.device))
+        obs, a, x, adv, mask = self._update_tensors(data)
+        return self._update(obs, a, x, adv, returns, mask)
 
     def _update(self, obs, a, x, adv, returns, mask=None) -> dict[str, float]:
         """``n_epochs`` passes of minibatch Adam steps on the joint loss, stopped early by ``target_kl``; ``mask``:
@@ -179,5 +174,5 @@ class PAPPO(Algorithm):
             stats["train/kl"] = float(kl_divergence(old, self.policy(obs, mask)).mean())
         stats["train/updates"] = float(updates)
         stats["train/early_stop"] = float(stopped_at_kl)
-        stats["train/param_std"] = float(self.policy.log_std.detach().exp()[self.policy.mask].mean())
+        stats["train/param_std"] = self._param_std()
         return stats

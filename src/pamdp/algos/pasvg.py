@@ -19,16 +19,7 @@ import torch.nn.functional as F
 
 from pamdp.algos.base import Algorithm
 from pamdp.algos.dense import Dense
-from pamdp.algos.offpolicy import (
-    OffPolicyConfig,
-    OffPolicyLoop,
-    Temperatures,
-    learning_starts_setting,
-    shared_setting,
-    soft_updater,
-    tau_setting,
-    uniform_actions,
-)
+from pamdp.algos.offpolicy import OffPolicyConfig, OffPolicyLoop, Temperatures, soft_updater, uniform_actions
 from pamdp.algos.optim import apply_gradients, descend
 from pamdp.algos.settings import NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
 from pamdp.distributions import LOG_STD_MAX, LOG_STD_MIN, gumbel_noise, masked_logits
@@ -41,10 +32,10 @@ __all__ = ["PASVG0", "PASVG0Config", "expected_q", "every_action_q"]
 class PASVG0Config(OffPolicyConfig, AlgoConfig):
     """PASVG(0)'s settings; the defaults are the paper's preset (DDPG's where the paper says nothing)."""
 
-    hidden_sizes: tuple[int, ...] = shared_setting(
+    hidden_sizes: tuple[int, ...] = OffPolicyConfig.shared_setting(
         "hidden_sizes", (400, 300), "pi_d, pi_c and the critic; paper: {400, 300}"
     )
-    activation: str = shared_setting("activation", "relu", "paper: relu")
+    activation: str = OffPolicyConfig.shared_setting("activation", "relu", "paper: relu")
     temperature: float = setting(
         1.0, "Gumbel-Softmax temperature t (paper: 1.0, fixed); lower is less biased, higher less noisy.", POSITIVE
     )
@@ -97,10 +88,10 @@ class PASVG0Config(OffPolicyConfig, AlgoConfig):
     policy_lr: float = setting(
         1e-5, "Adam learning rate of pi_d and pi_c (paper: 1e-5, which learns slowly).", POSITIVE
     )
-    batch_size: int = shared_setting("batch_size", 64, "DDPG's 64; the paper does not say")
-    tau: float = tau_setting(0.001, "DDPG's 0.001")
-    buffer_size: int = shared_setting("buffer_size", 10_000_000, "paper: 10^7")
-    learning_starts: int = learning_starts_setting(10_000, "paper: 10^4")
+    batch_size: int = OffPolicyConfig.shared_setting("batch_size", 64, "DDPG's 64; the paper does not say")
+    tau: float = OffPolicyConfig.tau_setting(0.001, "DDPG's 0.001")
+    buffer_size: int = OffPolicyConfig.shared_setting("buffer_size", 10_000_000, "paper: 10^7")
+    learning_starts: int = OffPolicyConfig.learning_starts_setting(10_000, "paper: 10^4")
 
     def __post_init__(self):
         """The checks across settings (each setting's own runs in AlgoConfig)."""
@@ -188,7 +179,6 @@ class PASVG0(Algorithm):
         self.critic_target = copy.deepcopy(self.critic).requires_grad_(False)
         self.critic_params = list(self.critic.parameters())
         self.critic_updates = 0  # for policy_delay
-        # fused: one kernel per step instead of a dozen foreach passes (benchmarks/offpolicy_speed.md).
         self.policy_params = [p for p in self.policy.parameters() if p.requires_grad]
         self.policy_optimizer = torch.optim.Adam(self.policy_params, lr=cfg.policy_lr, fused=True)
         self.critic_optimizer = torch.optim.Adam(self.critic_params, lr=cfg.critic_lr, fused=True)
@@ -338,11 +328,9 @@ class PASVG0(Algorithm):
         batch, d, K = obs.shape[0], obs.shape[1], policy.n_actions
         temperature, hard = cfg.temperature, cfg.straight_through
         critic = nets["critic"]
-        # critic: descend on mean (Q - y)^2
-        q, cache = critic.forward_cached(torch.cat([obs, b["a_in"], b["x"]], dim=-1))
-        q = q.squeeze(-1)
-        error = q - y
-        apply_gradients(self.critic_optimizer, critic.backward(cache, error * (2.0 / batch))[0], cfg.grad_clip)
+        q, error = critic.regression_step(
+            self.critic_optimizer, torch.cat([obs, b["a_in"], b["x"]], dim=-1), y, cfg.grad_clip
+        )
         self.critic_updates += 1
 
         # policy: descend on -mean Q(s, a, x) - alpha * mean H(pi_d), with the recorded noise

@@ -15,15 +15,7 @@ import numpy as np
 import torch
 
 from pamdp.algos.base import Algorithm
-from pamdp.algos.onpolicy import (
-    LinearFeatureBaseline,
-    OnPolicyConfig,
-    Rollout,
-    hybrid_policy,
-    mask_tensor,
-    network_values,
-    update_tensors,
-)
+from pamdp.algos.onpolicy import LinearFeatureBaseline, OnPolicy, OnPolicyConfig, Rollout, hybrid_policy
 from pamdp.algos.optim import descend
 from pamdp.algos.settings import NON_NEGATIVE, POSITIVE, AlgoConfig, at_least, interval, one_of, redeclared, setting
 from pamdp.algos.trpo import (
@@ -125,7 +117,7 @@ class PATRPOConfig(OnPolicyConfig, AlgoConfig):
     }
 
 
-class PATRPO(Algorithm):
+class PATRPO(OnPolicy, Algorithm):
     """Parameterized Actions TRPO. See docs/algorithms.md, "PATRPO", for the update and :class:`PATRPOConfig`."""
 
     config_class = PATRPOConfig
@@ -153,13 +145,10 @@ class PATRPO(Algorithm):
         if self.config.baseline == "linear":
             self.linear_baseline.coef = state["linear_baseline"].numpy()
 
-    def _act(self, obs, deterministic, mask=None):
-        return self.policy.act(obs, mask, deterministic, self.torch_gen)
-
     # -- one epoch (the rollout and the advantages: Rollout.run_epoch) ------------------------------
     def _learn(self, data: dict[str, np.ndarray]) -> dict[str, float]:
         """The policy's step on an :func:`~pamdp.algos.onpolicy.advantage_batch`, then the baseline's fit."""
-        stats = self._update_policy(*update_tensors(data, self.device), mask_tensor(data, self.device))
+        stats = self._update_policy(*self._update_tensors(data))
         stats["train/updates"] = 1.0 - stats.get("train/update_skipped", 0.0)  # one natural-gradient step a batch
         stats["losses/value_loss"] = self._fit_baseline(data["obs"], data["t"], data["returns"])
         return stats
@@ -191,7 +180,7 @@ class PATRPO(Algorithm):
         stats = {
             "train/entropy": float(old.entropy().mean()),
             "train/grad_norm": float(g.norm()),
-            "train/param_std": float(self.policy.log_std.detach().exp()[self.policy.mask].mean()),
+            "train/param_std": self._param_std(),
         }
         if not (np.isfinite(shs) and shs > 0):  # no direction (a vanishing gradient): no step, no line search
             nothing = ("train/line_search_success", "train/backtracks", "losses/surrogate_improvement", "train/kl")
@@ -237,7 +226,7 @@ class PATRPO(Algorithm):
         """The baseline ``V(s)`` of observations at step ``t`` of their episodes."""
         if self.config.baseline == "linear":
             return self.linear_baseline.predict(obs, t)
-        return network_values(self.value, obs, self.device)
+        return super()._values(obs, t)
 
     def _fit_baseline(self, obs: np.ndarray, t: np.ndarray, returns: np.ndarray) -> float:
         cfg = self.config

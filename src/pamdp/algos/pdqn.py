@@ -26,11 +26,7 @@ from pamdp.algos.offpolicy import (
     OffPolicyLoop,
     OUNoise,
     bounded,
-    learning_starts_setting,
-    mixed_target,
-    shared_setting,
     soft_updater,
-    tau_setting,
     uniform_actions,
 )
 from pamdp.algos.optim import apply_gradients
@@ -51,7 +47,7 @@ class PDQNConfig(DeterministicActorConfig, OffPolicyConfig, AlgoConfig):
     multi_pass: bool = setting(
         False, "MP-DQN: Q_k from a pass that sees only action k's parameters; false: P-DQN's joint input."
     )
-    hidden_sizes: tuple[int, ...] = shared_setting(
+    hidden_sizes: tuple[int, ...] = OffPolicyConfig.shared_setting(
         "hidden_sizes", (128,), "Bester et al. on Platform: one layer of 128"
     )
     param_passthrough: tuple[float, ...] = setting(
@@ -70,14 +66,14 @@ class PDQNConfig(DeterministicActorConfig, OffPolicyConfig, AlgoConfig):
     actor_lr: float = setting(
         1e-4, "Adam learning rate of the parameter actor (Bester et al. on Platform: 1e-4).", POSITIVE
     )
-    grad_clip: float = shared_setting("grad_clip", 10.0, "assumed: 10")
-    batch_size: int = shared_setting("batch_size", 128, "Bester et al.: 128")
-    gamma: float = shared_setting("gamma", 0.9, "Bester et al. on Platform: 0.9")
-    tau_q: float = tau_setting(0.1, "of the Q-network; Bester et al.: 0.1")
-    tau_actor: float = tau_setting(0.001, "of the actor; Bester et al.: 0.001")
-    beta: float = shared_setting("beta", 0.0, "0 on Platform")
-    epsilon_end: float = shared_setting("epsilon_end", 0.01, "Bester et al.: 0.01")
-    epsilon_steps: int = shared_setting(
+    grad_clip: float = OffPolicyConfig.shared_setting("grad_clip", 10.0, "assumed: 10")
+    batch_size: int = OffPolicyConfig.shared_setting("batch_size", 128, "Bester et al.: 128")
+    gamma: float = OffPolicyConfig.shared_setting("gamma", 0.9, "Bester et al. on Platform: 0.9")
+    tau_q: float = OffPolicyConfig.tau_setting(0.1, "of the Q-network; Bester et al.: 0.1")
+    tau_actor: float = OffPolicyConfig.tau_setting(0.001, "of the actor; Bester et al.: 0.001")
+    beta: float = OffPolicyConfig.shared_setting("beta", 0.0, "0 on Platform")
+    epsilon_end: float = OffPolicyConfig.shared_setting("epsilon_end", 0.01, "Bester et al.: 0.01")
+    epsilon_steps: int = OffPolicyConfig.shared_setting(
         "epsilon_steps", 5_000, "Bester et al.: 1000 episodes; Platform's early episodes last 2 to 5 steps"
     )
     explore_params: bool = setting(
@@ -85,9 +81,9 @@ class PDQNConfig(DeterministicActorConfig, OffPolicyConfig, AlgoConfig):
         "With an epsilon draw, also draw that action's parameters uniformly in [-1, 1] (Xiong et al.); false "
         "keeps the actor's, noise included (assumed for Bester et al.).",
     )
-    ou_sigma: float = shared_setting("ou_sigma", 0.0001, "Bester et al.: 1e-4")
-    buffer_size: int = shared_setting("buffer_size", 10_000, "Bester et al. on Platform: 10 000")
-    learning_starts: int = learning_starts_setting(500, "assumed: 500")
+    ou_sigma: float = OffPolicyConfig.shared_setting("ou_sigma", 0.0001, "Bester et al.: 1e-4")
+    buffer_size: int = OffPolicyConfig.shared_setting("buffer_size", 10_000, "Bester et al. on Platform: 10 000")
+    learning_starts: int = OffPolicyConfig.learning_starts_setting(500, "assumed: 500")
 
     def __post_init__(self):
         super().__post_init__()
@@ -260,9 +256,7 @@ class PDQN(EpsilonSchedule, Algorithm):
         obs, next_obs, batch = b["obs"], b["next_obs"], len(b["obs"])
         with torch.no_grad():
             q_next = self._next_value(next_obs, b.get("next_mask"))
-            y = self.loop.td_target(b, q_next)
-            if cfg.beta > 0:
-                y = mixed_target(y, b["mc"], cfg.beta)
+            y = self.loop.td_target(b, q_next)  # mixed with the Monte-Carlo return with beta > 0
             # Q: descend on mean (Q_a - y)^2, the gradient reaching Q_a of the replayed action only
             q_all, cache = self.q_net.forward_cached(obs, b["params"])
             a = b["a"][:, None]

@@ -225,7 +225,8 @@ def _check_experiment(path: Path, data: dict) -> None:
                 refuse(
                     f"runs[{i}].{key}",
                     names,
-                    "a list of tensor names such as 'policy.log_std' or rows such as 'policy.log_std[2]', with init_from",
+                    "a list of tensor names such as 'policy.log_std' or rows such as 'policy.log_std[2]', "
+                    "with init_from",
                 )
         slug = _slug(str(run["label"]))
         if slug in dirs:
