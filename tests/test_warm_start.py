@@ -156,44 +156,44 @@ def test_kept_tensors_stay_the_new_models_own(tmp_path):
         transfer_weights(model, tmp_path / "source.pt", [None] * 68, keep=("policy.bogus",))
 
 
-def test_widened_tensors_take_the_larger_of_the_sources_and_their_own(tmp_path):
-    """``widen``: exploration at least the new settings' where the source's had narrowed, the source's elsewhere."""
+GOALIE_START = [[-0.75, -2.56], [-0.97, -0.5], [-0.52, -3.69]]  # the 1v0 stage's log-stds (DASH, TURN, KICK)
+
+
+@pytest.mark.parametrize(
+    "keep, widen, report, expected",
+    [
+        # widen: exploration at least the new settings' where the source's had narrowed, the source's elsewhere
+        ((), ("policy.log_std",), "widened", [[-0.75, -2.0], [-0.97, -0.5], [-0.52, -2.0]]),
+        # the goalie's recipe as names: the kick's row restarts at the new settings' -2.0 (narrower kick power,
+        # wider kick direction than the 1v0 policy's), every other entry at least -2.0: the log-stds of the model
+        # file the 0.906 run started from, which were set by hand
+        (
+            ("policy.log_std[2]",),
+            ("policy.log_std",),
+            "kept rows [2], widened",
+            [[-0.75, -2.0], [-0.97, -0.5], [-2.0, -2.0]],
+        ),
+        (("policy.log_std[0]",), (), "kept rows [0], copied", [[-2.0, -2.0], [-0.97, -0.5], [-0.52, -3.69]]),
+    ],
+)
+def test_kept_and_widened_rows_of_the_exploration(tmp_path, keep, widen, report, expected):
     patrpo = algorithm_class("patrpo")
     source = patrpo(ONE_V_ZERO, patrpo.config_class.preset("tuned"))
     with torch.no_grad():
-        source.policy.log_std.copy_(torch.tensor([[-0.7, -3.0], [-1.0, -0.5], [-0.5, -3.7]]))
+        source.policy.log_std.copy_(torch.tensor(GOALIE_START))
     source.save(tmp_path / "source.pt")
     model = patrpo(ONE_V_ONE, dataclasses.replace(source.config, init_log_std=-2.0))
     columns = list(range(58)) + [None] * 9 + [58]
-    report = transfer_weights(model, tmp_path / "source.pt", columns, widen=("policy.log_std",))
-    assert report["policy.log_std"] == "widened"
-    expected = torch.tensor([[-0.7, -2.0], [-1.0, -0.5], [-0.5, -2.0]])
-    torch.testing.assert_close(model.policy.log_std.detach(), expected)
-
-
-def test_a_row_kept_inside_a_widened_tensor(tmp_path):
-    """The goalie's recipe as names: the kick's row (``policy.log_std[2]``) restarts at the new settings' -2.0
-    (narrower kick power, wider kick direction than the 1v0 policy's), every other entry at least -2.0: the
-    log-stds of the model file the 0.906 run started from, which were set by hand."""
-    patrpo = algorithm_class("patrpo")
-    source = patrpo(ONE_V_ZERO, patrpo.config_class.preset("tuned"))
-    with torch.no_grad():
-        source.policy.log_std.copy_(torch.tensor([[-0.75, -2.56], [-0.97, -0.5], [-0.52, -3.69]]))
-    source.save(tmp_path / "source.pt")
-    model = patrpo(ONE_V_ONE, dataclasses.replace(source.config, init_log_std=-2.0))
-    columns = list(range(58)) + [None] * 9 + [58]
-    report = transfer_weights(
-        model, tmp_path / "source.pt", columns, keep=("policy.log_std[2]",), widen=("policy.log_std",)
-    )
-    assert report["policy.log_std"] == "kept rows [2], widened"
-    expected = torch.tensor([[-0.75, -2.0], [-0.97, -0.5], [-2.0, -2.0]])
-    torch.testing.assert_close(model.policy.log_std.detach(), expected)
+    assert transfer_weights(model, tmp_path / "source.pt", columns, keep=keep, widen=widen)["policy.log_std"] == report
+    torch.testing.assert_close(model.policy.log_std.detach(), torch.tensor(expected))
     torch.testing.assert_close(model.policy.pi_c[2].weight, source.policy.pi_c[2].weight)
-    model = patrpo(ONE_V_ONE, dataclasses.replace(source.config, init_log_std=-2.0))
-    report = transfer_weights(model, tmp_path / "source.pt", columns, keep=("policy.log_std[0]",))
-    assert report["policy.log_std"] == "kept rows [0], copied"
-    expected = torch.tensor([[-2.0, -2.0], [-0.97, -0.5], [-0.52, -3.69]])
-    torch.testing.assert_close(model.policy.log_std.detach(), expected)
+
+
+def test_rows_out_of_range_and_of_input_layers_are_refused(tmp_path):
+    patrpo = algorithm_class("patrpo")
+    patrpo(ONE_V_ZERO).save(tmp_path / "source.pt")
+    model = patrpo(ONE_V_ONE)
+    columns = list(range(58)) + [None] * 9 + [58]
     for name in ("policy.log_std[3]", "policy.log_std[-1]", "policy.log_std[kick]"):
         with pytest.raises(
             ValueError, match=r"keep names .*; expected policy.log_std or one of its rows, .*\[0\] to .*\[2\]"
@@ -206,19 +206,11 @@ def test_a_row_kept_inside_a_widened_tensor(tmp_path):
 def test_a_stage_with_one_seed_starts_every_seed_of_the_next(tmp_path):
     """A run listing its own single seed is the source of every seed of the runs that start from it; a run's own
     seeds replace the experiment's."""
-    body = """
-env = "pamdp/Platform-v0"
+    body = """env = "pamdp/Platform-v0"
 total_steps = 1000
 seeds = [0, 1]
-[[runs]]
-label = "stage"
-algo = "patrpo"
-seeds = {stage}
-[[runs]]
-label = "next"
-algo = "patrpo"
-seeds = [5, 6, 7]
-init_from = "stage"
+runs = [{{ label = "stage", algo = "patrpo", seeds = {stage} }},
+        {{ label = "next", algo = "patrpo", seeds = [5, 6, 7], init_from = "stage" }}]
 """
     (tmp_path / "e.toml").write_text(body.format(stage="[100]"))
     exp = load_experiment(tmp_path / "e.toml")
