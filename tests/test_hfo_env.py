@@ -233,6 +233,30 @@ def test_render_and_gif(tmp_path):
     assert (tmp_path / "hfo.gif").stat().st_size > 0 and str(path).endswith("hfo.gif")
 
 
+def test_a_masked_policy_is_recorded_with_the_envs_masks(tmp_path):
+    """``record_episode(..., action_mask=True)`` hands the policy each step's ``info["action_mask"]`` (what
+    ``pamdp render`` does for a model trained with masks): the same masks as stepping the env by hand."""
+    env = HalfFieldOffenseEnv(render_mode="rgb_array")
+    given = []
+    record_episode(
+        env,
+        lambda obs, action_mask: given.append(action_mask) or scripted_scorer(obs),
+        tmp_path / "m.gif",
+        seed=3,
+        action_mask=True,
+    )
+    obs, info = env.reset(seed=3)
+    expected = [info["action_mask"]]
+    while True:
+        obs, _, terminated, truncated, info = env.step(scripted_scorer(obs))
+        if terminated or truncated:
+            break
+        expected.append(info["action_mask"])
+    assert len(given) == len(expected) > 10
+    np.testing.assert_array_equal(np.array(given), np.array(expected))
+    assert {tuple(m) for m in given} == {(True, True, False), (True, True, True)}  # KICK masked until kickable
+
+
 def test_record_episode_rejects_a_path_that_is_not_a_gif_before_playing(tmp_path):
     env = HalfFieldOffenseEnv(render_mode="rgb_array")
     played = []

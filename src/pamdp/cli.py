@@ -557,10 +557,10 @@ def cmd_render(args) -> int:
     from pamdp.spaces import HybridActionSpace
 
     if args.source in gymnasium.registry:
-        env_id, env_kwargs, policy = args.source, {}, None
-    else:
+        env_id, env_kwargs, policy, masked = args.source, {}, None, False
+    else:  # a model trained with the env's action masks acts with them, as in training and evaluate
         model = load_model(args.source)
-        env_id, env_kwargs, policy = model.env_id, model.env_kwargs, model.predict
+        env_id, env_kwargs, policy, masked = model.env_id, model.env_kwargs, model.predict, model.config.action_mask
     modes = getattr(env_creator(env_id), "metadata", {}).get("render_modes", [])
     if "rgb_array" not in modes:
         raise ValueError(f"env {env_id!r} draws no frames (render modes {modes}); expected one with 'rgb_array'")
@@ -578,7 +578,7 @@ def cmd_render(args) -> int:
         ) from None
     try:
         fps = env.metadata.get("render_fps") or 20  # the env's real time (Goal's sub-steps: 30 a second)
-        path, total = record_episode(env, policy, args.out, seed=args.seed, fps=fps)
+        path, total = record_episode(env, policy, args.out, seed=args.seed, fps=fps, action_mask=masked)
     except gymnasium.error.Error as exc:
         raise ValueError(f"env {env_id!r} cannot draw its frames ({exc})") from None
     finally:

@@ -83,10 +83,13 @@ def record_episode(
     seed: int | None = None,
     max_steps: int = 10_000,
     fps: float = 20.0,
+    action_mask: bool = False,
 ) -> tuple[str, float]:
     """Play one episode in ``env`` (made with ``render_mode="rgb_array"``) and save it as a GIF.
 
-    ``policy`` maps an observation to an env action; ``None`` samples random actions. An env whose
+    ``policy`` maps an observation to an env action; ``None`` samples random actions. ``action_mask``: the policy
+    also takes the valid actions, ``policy(obs, action_mask=info["action_mask"])``, as a model trained with masks
+    does (``model.predict``): without them it may pick an action that was masked throughout training. An env whose
     agent step spans several physics sub-steps may offer ``render_substeps()``, one frame per sub-step of
     the last step (Platform does); those frames are recorded instead of one frame per step.
     Returns the GIF's path and the episode's return.
@@ -94,14 +97,17 @@ def record_episode(
     if getattr(env, "render_mode", None) != "rgb_array":
         raise ValueError(f"record_episode needs an env made with render_mode='rgb_array', got {env.render_mode!r}")
     _check_gif_path(path)  # before the episode, not after it
-    obs, _ = env.reset(seed=seed)
+    obs, info = env.reset(seed=seed)
     if seed is not None:
         env.action_space.seed(seed)
     substep_frames = getattr(env.unwrapped, "render_substeps", None)
     frames, total = [env.render()], 0.0
     for _ in range(max_steps):
-        action = env.action_space.sample() if policy is None else policy(obs)
-        obs, reward, terminated, truncated, _ = env.step(action)
+        if policy is None:
+            action = env.action_space.sample()
+        else:
+            action = policy(obs, action_mask=info["action_mask"]) if action_mask else policy(obs)
+        obs, reward, terminated, truncated, info = env.step(action)
         total += float(reward)
         if substep_frames is None:
             frames.append(env.render())
