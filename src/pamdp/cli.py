@@ -233,7 +233,7 @@ def build_parser() -> argparse.ArgumentParser:
             default=(),
             metavar="TENSORS",
             help="with --init-from: comma-separated tensors that keep this run's own initialisation, e.g. "
-            "policy.log_std (PATRPO's exploration, then set by --init-log-std)",
+            "policy.log_std (PATRPO's exploration, then set by --init-log-std), or rows of one: policy.log_std[2]",
         )
         p.add_argument(
             "--init-widen",
