@@ -259,7 +259,10 @@ G_PX, G_PY, G_VX, G_VY, G_TH, G_ST, G_EF, G_RC = range(8)
 G_BX, G_BY, G_UX, G_UY, G_QX, G_QY, G_WX, G_WY, G_PHI = range(8, 17)
 G_DB, G_AB, G_OPP_KICKABLE, G_SELF_KICKABLE, G_LAST_KICKER_ME, G_PLAY_ON = range(17, 23)
 G_N_OPP, G_N_SELF, G_OPP_TACKLING, G_CYCLE, G_PLAYER_RAND, G_BALL_RAND = range(23, 29)
-G_SIZE = 29
+#: Where the long stage of the self-intercept table stands (:func:`_long_steps`): whether it has cycles left, M,
+#: the next cycle n, the bound L_max, whether it found an interception.
+G_LONG_OPEN, G_M, G_LONG_N, G_LONG_MAX, G_LONG_FOUND = range(29, 34)
+G_SIZE = 34
 
 
 @jit
@@ -775,13 +778,28 @@ def _long_step(g, n, bx, by, c, infos, count):
 
 
 @jit
-def _long_steps(g, m_len, infos, count):
-    ua = th(g[G_UX], g[G_UY])
-    lateral = abs(rel(g[G_PX] - g[G_BX], g[G_PY] - g[G_BY], ua)[1])
-    n = max(6, int(math.ceil(lateral - KICKABLE_AREA - 0.2)))
-    n_max = m_len
-    found = False
+def _may_matter(n, n_opp):
+    """Whether an interception after n cycles can be chosen by :func:`_best_info` against an opponent reaching
+    the ball after ``n_opp`` cycles (goalie box: n < N_opp - 1; aggressive: n < N_opp - 5; the others:
+    n < 0.7 N_opp); false from some n on, so the table can stop there."""
+    return n < n_opp - 1 or n < 0.7 * n_opp
+
+
+@jit
+def _long_steps(g, infos, count, n_opp):
+    """Stage 3, resumable: its cycles n from ``g[G_LONG_N]`` while n < L_max, pausing before the first n at which
+    the table already has a candidate and ``_may_matter(n, n_opp)`` fails (-inf: at the first candidate, all
+    N_self needs; inf: never). Where the stage ends without an interception, stage 4 follows.
+
+    Its candidates have larger reaches than all earlier ones, so the paused table is the whole table's first
+    rows, and the rows it leaves out are never chosen (spec 2.8.5, best info)."""
+    if not g[G_LONG_OPEN]:
+        return count
+    n, n_max, found, m_len = int(g[G_LONG_N]), int(g[G_LONG_MAX]), g[G_LONG_FOUND] != 0.0, int(g[G_M])
     while n < n_max:
+        if count > 0 and not _may_matter(n, n_opp):
+            g[G_LONG_N], g[G_LONG_MAX], g[G_LONG_FOUND] = n, n_max, found
+            return _sort_infos(infos, count)
         bx, by = ball_at(g, n)
         if abs(bx) > 62.5 or abs(by) > 44.0:
             break
@@ -792,7 +810,10 @@ def _long_steps(g, m_len, infos, count):
                 found = True
                 n_max = min(m_len, n + 10)
         n += 1
-    return count, found
+    g[G_LONG_OPEN] = 0.0
+    if not found:
+        count = _final_step(g, m_len, infos, count)
+    return _sort_infos(infos, count)
 
 
 @jit
@@ -809,24 +830,40 @@ def _final_step(g, m_len, infos, count):
 
 
 @jit
-def self_intercept(g, m_len, infos):
-    """The goalie's candidate interceptions (rows of ``infos``, sorted by reach); returns their number."""
-    count = 0
-    count = _one_step(g, infos, count)
-    count = _short_steps(g, m_len, infos, count)
-    count, found = _long_steps(g, m_len, infos, count)
-    if not found:
-        count = _final_step(g, m_len, infos, count)
-    # Insertion sort by reach, then by fewer turns (stable: equal keys keep the stages' order).
+def _sort_infos(infos, count):
+    """Insertion sort by reach, then by fewer turns (stable: equal keys keep the stages' order); the stages
+    append in reach order, so rows rarely move."""
     for i in range(1, count):
+        key = (infos[i, I_TURNS] + infos[i, I_DASHES], infos[i, I_TURNS])
+        if (infos[i - 1, I_TURNS] + infos[i - 1, I_DASHES], infos[i - 1, I_TURNS]) <= key:
+            continue
         row = infos[i].copy()
-        key = (row[I_TURNS] + row[I_DASHES], row[I_TURNS])
         j = i - 1
         while j >= 0 and (infos[j, I_TURNS] + infos[j, I_DASHES], infos[j, I_TURNS]) > key:
             infos[j + 1] = infos[j]
             j -= 1
         infos[j + 1] = row
     return count
+
+
+@jit
+def _first_intercepts(g, m_len, infos):
+    """The table's first rows: stages 1 and 2, and stage 3 up to its first interception if those found none
+    (or stage 4), so that its first row, N_self, is the whole table's. :func:`_long_steps` adds the rest."""
+    count = 0
+    count = _one_step(g, infos, count)
+    count = _short_steps(g, m_len, infos, count)
+    ua = th(g[G_UX], g[G_UY])
+    lateral = abs(rel(g[G_PX] - g[G_BX], g[G_PY] - g[G_BY], ua)[1])
+    g[G_LONG_OPEN], g[G_M], g[G_LONG_MAX], g[G_LONG_FOUND] = 1.0, m_len, m_len, 0.0
+    g[G_LONG_N] = max(6, int(math.ceil(lateral - KICKABLE_AREA - 0.2)))
+    return _long_steps(g, infos, count, -math.inf)
+
+
+@jit
+def self_intercept(g, m_len, infos):
+    """The goalie's candidate interceptions (rows of ``infos``, sorted by reach); returns their number."""
+    return _long_steps(g, infos, _first_intercepts(g, m_len, infos), math.inf)
 
 
 # --- Movement primitives ---------------------------------------------------------------------------------
@@ -1282,6 +1319,7 @@ def _intercept(g, infos, count, save):
     if g[G_N_SELF] > 100:
         fx, fy = ball_at(g, 1000)
         return _go_to_point(g, fx, fy, 2.0, 100.0, -1.0, 100, True, 15.0)
+    count = _long_steps(g, infos, count, g[G_N_OPP])  # the rows of the table the choice can take
     i = _best_info(g, infos, count, save)
     row = infos[i]
     reach = int(row[I_TURNS] + row[I_DASHES])
@@ -1645,7 +1683,7 @@ def decide(world, memory):
     if g[G_SELF_KICKABLE]:
         g[G_N_SELF] = 0
     else:
-        count = self_intercept(g, min(30, length), infos)
+        count = _first_intercepts(g, min(30, length), infos)  # the rest only if the intercept needs it
         g[G_N_SELF] = infos[0, I_TURNS] + infos[0, I_DASHES] if count and not infos[0, I_EXHAUST] else 1000
     if not g[G_SELF_KICKABLE] and g[G_DB] < KICKABLE_AREA - 0.001 and _forced_kickable(g):
         g[G_SELF_KICKABLE] = 1.0
