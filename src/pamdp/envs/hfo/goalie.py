@@ -123,6 +123,9 @@ BALL_SPEED_MAX = 3.0
 #: Ball prediction horizon of the intercept table.
 MAX_CACHE = 31
 MAX_INFOS = 64
+#: The table's last two rows are the stages' scratch (the best candidate so far and the one being built), so that
+#: the compiled loop allocates nothing per candidate; candidates fill the rows before them (at most 31 needed).
+BEST_ROW, CAND_ROW = MAX_INFOS - 2, MAX_INFOS - 1
 #: Columns of an intercept candidate ("info").
 I_EXHAUST, I_TURNS, I_DASHES, I_POWER, I_DIR, I_END_X, I_END_Y, I_BALL_DIST, I_STAMINA = range(9)
 INFO_SIZE = 9
@@ -421,7 +424,7 @@ def _fill(row, exhaust, turns, dashes, power, direction, ex, ey, ball_dist, stam
 
 @jit
 def _append(infos, count, exhaust, turns, dashes, power, direction, ex, ey, ball_dist, stamina):
-    if count < MAX_INFOS:
+    if count < BEST_ROW:
         _fill(infos[count], exhaust, turns, dashes, power, direction, ex, ey, ball_dist, stamina)
         return count + 1
     return count
@@ -469,7 +472,8 @@ def _one_step(g, infos, count):
         if ok:
             st = stamina_wait(g[G_ST], g[G_EF], g[G_RC])[0]
             return _append(infos, count, 0.0, 1.0, 0.0, 0.0, 0.0, m1x, m1y, r, st)
-    best = np.full(INFO_SIZE, np.nan)
+    best = infos[BEST_ROW]
+    best[:] = np.nan
     s_b = max(c - 0.2 - speed * g[G_BALL_RAND], 0.665)
     for k in range(8):
         direction = -180.0 + 45.0 * k
@@ -541,9 +545,8 @@ def _offer(best, cand, s_b):
 
 
 @jit
-def _short_turn_dash(g, n, bx, by, c, backward, buffer, best, s_b):
+def _short_turn_dash(g, n, bx, by, c, backward, buffer, best, cand, s_b):
     """Turn towards the ball's position after n cycles, then dash with the power that just gets there."""
-    cand = np.empty(INFO_SIZE)
     ix, iy = self_at(g, n)
     dist = math.hypot(bx - ix, by - iy)
     ang = th(bx - ix, by - iy)
@@ -603,9 +606,8 @@ def _short_turn_dash(g, n, bx, by, c, backward, buffer, best, s_b):
 
 
 @jit
-def _short_omni_dash(g, n, bx, by, c, best, s_b):
+def _short_omni_dash(g, n, bx, by, c, best, cand, s_b):
     """Side-step onto the line the body points along through the ball, then dash forward along it."""
-    cand = np.empty(INFO_SIZE)
     ix, iy = self_at(g, n)
     theta = g[G_TH]
     if line_distance(ix, iy, bx, by, theta) < c - 0.4:
@@ -669,7 +671,7 @@ def _short_steps(g, m_len, infos, count):
     n_min = int(math.ceil(lateral - KICKABLE_AREA))
     if n_min >= n_max:
         return count
-    best = np.empty(INFO_SIZE)
+    best, cand = infos[BEST_ROW], infos[CAND_ROW]
     for n in range(max(n_min, 2), n_max + 1):
         bx, by = ball_at(g, n)
         c = _control_radius(g, bx, by, -36.5, 19.66, CATCHABLE_AREA)
@@ -678,13 +680,13 @@ def _short_steps(g, m_len, infos, count):
         best[:] = np.nan
         s_b = max(c - 0.2 - math.hypot(g[G_BX] - bx, g[G_BY] - by) * g[G_BALL_RAND], 0.665)
         wide, tight = max(0.1, c - 0.4), c - 0.15
-        _short_turn_dash(g, n, bx, by, c, False, wide, best, s_b)
-        _short_turn_dash(g, n, bx, by, c, False, tight, best, s_b)
-        _short_turn_dash(g, n, bx, by, c, True, wide, best, s_b)
-        _short_turn_dash(g, n, bx, by, c, True, tight, best, s_b)
+        _short_turn_dash(g, n, bx, by, c, False, wide, best, cand, s_b)
+        _short_turn_dash(g, n, bx, by, c, False, tight, best, cand, s_b)
+        _short_turn_dash(g, n, bx, by, c, True, wide, best, cand, s_b)
+        _short_turn_dash(g, n, bx, by, c, True, tight, best, cand, s_b)
         if n <= 2:
-            _short_omni_dash(g, n, bx, by, c, best, s_b)
-        if not np.isnan(best[0]) and count < MAX_INFOS:
+            _short_omni_dash(g, n, bx, by, c, best, cand, s_b)
+        if not np.isnan(best[0]) and count < BEST_ROW:
             infos[count] = best
             count += 1
     return count
