@@ -344,9 +344,21 @@ def ball_cache(g, cache):
         vy *= BALL_DECAY
         cache[n, 0], cache[n, 1] = x, y
         n += 1
-        if (i >= 5 and math.hypot(vx, vy) < 0.01) or abs(x) > 57.5 or abs(y) > 39.0:
+        if (i >= 5 and _below(vx, vy, 0.01)) or abs(x) > 57.5 or abs(y) > 39.0:
             break
     return n
+
+
+@jit
+def _below(x, y, r):
+    """``math.hypot(x, y) < r``, calling hypot only within 1 % of r (the length lies between max(|x|, |y|) and
+    |x| + |y|, and hypot is exact to an ulp)."""
+    ax, ay = abs(x), abs(y)
+    if ax + ay < 0.99 * r:
+        return True
+    if max(ax, ay) > 1.01 * r:
+        return False
+    return math.hypot(x, y) < r
 
 
 @jit
