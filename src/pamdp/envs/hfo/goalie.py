@@ -351,14 +351,25 @@ def ball_cache(g, cache):
 
 @jit
 def _below(x, y, r):
-    """``math.hypot(x, y) < r``, calling hypot only within 1 % of r (the length lies between max(|x|, |y|) and
-    |x| + |y|, and hypot is exact to an ulp)."""
+    """``math.hypot(x, y) < r`` for r > 0, calling hypot only within 1 % of r (the length lies between
+    max(|x|, |y|) and |x| + |y|, and hypot is exact to an ulp)."""
     ax, ay = abs(x), abs(y)
     if ax + ay < 0.99 * r:
         return True
     if max(ax, ay) > 1.01 * r:
         return False
     return math.hypot(x, y) < r
+
+
+@jit
+def _beyond(x, y, r):
+    """``r < math.hypot(x, y)`` for r > 0, as :func:`_below` decides it."""
+    ax, ay = abs(x), abs(y)
+    if ax + ay < 0.99 * r:
+        return False
+    if max(ax, ay) > 1.01 * r:
+        return True
+    return r < math.hypot(x, y)
 
 
 @jit
@@ -400,7 +411,7 @@ def opponent_reach(g, cache, length):
     n0 = int(math.floor(abs(rel(qx - g[G_BX], qy - g[G_BY], th(g[G_UX], g[G_UY]))[1])))
     for n in range(n0, length):
         bx, by = cache[n, 0], cache[n, 1]
-        if c + 1.0 * n + 0.5 < math.hypot(qx - bx, qy - by):
+        if _beyond(qx - bx, qy - by, c + 1.0 * n + 0.5):
             continue
         n_turn = _opponent_turns(g, n, bx, by)
         if n - n_turn < 0:
