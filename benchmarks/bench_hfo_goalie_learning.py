@@ -27,7 +27,9 @@ def with_recipe(arms: dict, out_root: str) -> dict:
     """The packaged recipe's arms (``hfo-goalie``, each with its own seeds) before ``arms``."""
     recipe = load_experiment("hfo-goalie")
     jobs = recipe.jobs(out_root, recipe.specs())
-    found = {run["label"]: [(spec, Path(out)) for spec, out in jobs if spec.label == run["label"]] for run in recipe.runs}
+    found = {
+        run["label"]: [(spec, Path(out)) for spec, out in jobs if spec.label == run["label"]] for run in recipe.runs
+    }
     return {**{f"recipe: {label}": pairs for label, pairs in found.items()}, **arms}
 
 

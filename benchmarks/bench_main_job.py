@@ -13,8 +13,15 @@ from __future__ import annotations
 import json
 
 import numpy as np
-from _record import HERE, cpu_ms_per_sample, progress_rows, record_head, seed_by_seed_main, where_unfinished
-from _record import write_record
+from _record import (
+    HERE,
+    cpu_ms_per_sample,
+    progress_rows,
+    record_head,
+    seed_by_seed_main,
+    where_unfinished,
+    write_record,
+)
 
 from pamdp.experiments import load_experiment
 from pamdp.experiments.runner import is_finished

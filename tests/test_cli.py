@@ -32,7 +32,7 @@ def test_train_writes_run_directory_and_evaluation(tmp_path, capsys):
     printed = capsys.readouterr().out
     assert "greedy return over 20 episodes" in printed
     run = json.loads((out / "run.json").read_text())
-    assert run["config"]["hidden_sizes"] == [16] and run["preset"] == "tuned"
+    assert run["config"]["hidden_sizes"] == [16] and run["preset"] == "platform"
 
     assert main(["evaluate", str(out), "--episodes", "30", "--json"]) == 0
     result = json.loads(capsys.readouterr().out)

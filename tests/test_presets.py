@@ -80,8 +80,10 @@ def test_python_and_the_command_line_give_one_config(tmp_path):
     assert RunSpec("patrpo", HFO, 10).config().config == model.config
     model.save(tmp_path / "m.pt")
     assert PATRPO.load(tmp_path / "m.pt").preset == "hfo"  # the file keeps it
-    model = PATRPO("pamdp/Platform-v0")
-    assert model.preset == "tuned" and model.config == PATRPOConfig.preset("tuned")
+    model = PATRPO("pamdp/Platform-v0")  # the main job's preset: the tuned one with the paper's parameter noise
+    assert model.preset == "platform" and model.config == dataclasses.replace(
+        PATRPOConfig.preset("tuned"), init_log_std=0.0
+    )
     # An explicit config is never overridden.
     model = PATRPO(HFO, PATRPOConfig.preset("paper"))
     assert model.preset is None and model.config == PATRPOConfig.preset("paper") and not model.config.action_mask
@@ -122,7 +124,7 @@ def test_an_explicit_preset_wins_over_the_envs(tmp_path):
     assert RunSpec("pdqn", HFO, 1000, preset="paper").config().preset == "paper"
 
 
-@pytest.mark.parametrize("env", ["pamdp/Platform-v0", "CartPole-v1", None])
+@pytest.mark.parametrize("env", ["CartPole-v1", None])
 def test_an_env_without_a_preset_falls_back_to_the_algorithms_default(env):
     for algo, expected in (("pdqn", "tuned"), ("patrpo", "tuned"), ("hyar", "cpu"), ("paddpg", "paper")):
         assert default_preset(algorithm_class(algo).config_class, env) == expected
