@@ -12,11 +12,20 @@ Each domain's folder holds its dynamics (compiled by Numba), its scalar ``gymnas
 ``gymnasium.vector.VectorEnv``, registered as its ``vector_entry_point``, so ``gymnasium.make_vec(id,
 num_envs=N, vectorization_mode="vector_entry_point")`` returns the batched version. What the batched envs
 share is ``vector.py``; ``rendering.py`` has the drawing primitives and episode-to-GIF recording.
+
+Numba caches the compiled dynamics on disk, each function keyed by its own file only; importing this package first
+deletes those caches if any source under ``envs/`` changed since they were written (``_numba_cache.py``), so an
+edit of a module that a cached loop inlines (``hfo/goalie.py`` in ``hfo/defense.py``'s) is never run stale.
 """
 
 from __future__ import annotations
 
 import gymnasium
+
+from pamdp.envs._numba_cache import guard as _guard_numba_cache
+
+# Before any domain module is imported: they load their cached functions as they are imported or first called.
+_guard_numba_cache()
 
 _REGISTRATIONS = {
     "pamdp/Platform-v0": dict(

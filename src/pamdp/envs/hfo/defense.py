@@ -21,8 +21,8 @@ observation. Its body angle is never reset (180 degrees at a new server run). Th
 The state row extends the 1v0 one (indices of ``dynamics`` first, then the goalie's below).
 
 Numba's on-disk cache is keyed by each module's own file, and these functions inline ``dynamics``, ``goalie``
-and ``two_player``: after editing one of those, clear the cache (``__pycache__/*.nbi``, ``*.nbc``) before timing
-or replaying the 1v1 env.
+and ``two_player``: ``import pamdp.envs`` deletes the envs' caches whenever any of their sources changed
+(``envs/_numba_cache.py``), so an edit of those modules alone is compiled in, not replayed from the old cache.
 """
 
 from __future__ import annotations
