@@ -2,7 +2,7 @@
 # The long learning runs still owed to issues 26, 27 and 43, as resumable queues, one core each.
 #
 #   nohup benchmarks/backlog.sh > backlog.log 2>&1 &      # at the start of a session, from the repo root
-#   nohup benchmarks/backlog.sh goalie > goalie.log 2>&1 &   # only the named queues (soccer, suite, goalie)
+#   nohup benchmarks/backlog.sh goalie > goalie.log 2>&1 &   # only the named queues (soccer, suite, goalie, seeds)
 #
 # Every step resumes where an earlier, interrupted invocation stopped (finished runs are skipped, partial
 # ones continue from their last checkpoint; the off-policy runs keep their replay buffer in it), so a
@@ -46,17 +46,23 @@ suite() {  # issue 26: the suite's missing cells, the cheapest first, then the o
     for seed in 1 2; do pamdp reproduce hfo_learning.toml --runs PAPPO --seeds "$seed" --out "$HFO_OUT"; done
 }
 
-goalie() {  # issue 43: learning against the goalie, every arm seed by seed (benchmarks/hfo_goalie_learning.md)
-    local curriculum="PATRPO 1v0 stage,PATRPO from 1v0 widened,PATRPO from 1v0 wide,PATRPO from 1v0"
-    python bench_hfo_goalie_learning.py --out "$GOALIE_OUT" --runs "$curriculum" --workers 2  # first: 2 cores
+goalie() {  # issue 43: the recipe (pamdp reproduce hfo-goalie, done 2026-12-04), then the arms tried on the way
+    pamdp reproduce hfo-goalie --out "$GOALIE_OUT" --workers 2
     python bench_hfo_goalie_learning.py --out "$GOALIE_OUT"
 }
 
-queues=("${@:-soccer}" ) && [ $# -eq 0 ] && queues=(soccer suite goalie)
+seeds() {  # issue 44: seeds 3 and 4 of the suite's cells (5 a cell), PATRPO's cheap runs first, then HyAR-TD3, MP-DQN
+    local s="pamdp reproduce benchmark-suite --out $SUITE_OUT --seeds 3,4"
+    $s --runs "PATRPO_on_Platform,PATRPO_on_Goal,PATRPO_on_Hard_Goal,PATRPO_on_Catch_Point,PATRPO_on_Hard_Move_n=4"
+    $s --runs "HyAR-TD3_on_Platform,MP-DQN_on_Platform,HyAR-TD3_on_Goal,MP-DQN_on_Goal,HyAR-TD3_on_Hard_Goal"
+    $s --runs "MP-DQN_on_Hard_Goal,HyAR-TD3_on_Catch_Point,MP-DQN_on_Catch_Point,Hybrid_SAC_on_Catch_Point"
+}
+
+queues=("${@:-soccer}" ) && [ $# -eq 0 ] && queues=(soccer suite seeds)
 for name in "${queues[@]}"; do
     case $name in
-        soccer | suite | goalie) ;;
-        *) echo "backlog.sh: unknown queue '$name'; expected some of soccer, suite, goalie" >&2 && exit 2 ;;
+        soccer | suite | goalie | seeds) ;;
+        *) echo "backlog.sh: unknown queue '$name'; expected some of soccer, suite, goalie, seeds" >&2 && exit 2 ;;
     esac
 done
 for name in "${queues[@]}"; do "$name" & done

@@ -257,7 +257,7 @@ DOMAIN_PRESETS: dict[tuple[str, str, tuple], DomainPreset] = {
         "platform",
         "tuned",
         "The tuned preset with the paper's initial parameter noise (std 1 instead of 0.61): with the tuned noise, "
-        "3 of 10 seeds of the README's main job ended near 0.90, short of the last platform (benchmarks/main_job.md).",
+        "4 of 10 seeds of the README's main job ended near 0.90, short of the last platform (benchmarks/main_job.md).",
         ("init_log_std", 0.0, "measured: benchmarks/main_job.md (issue 45)"),
     ),
     ("patrpo", HFO, ANY): _derived(
