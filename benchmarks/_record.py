@@ -79,6 +79,19 @@ def where_unfinished(spec, rows: list[dict], metric: str | None = None, digits: 
     return f"seed {spec.seed} at {int(float(rows[-1]['time/total_timesteps'])):,}{unit}{last}"
 
 
+def arm_runs(jobs, metric: str, digits: int = 2, unit: str = "") -> tuple[list, list[str]]:
+    """An arm's runs as a record table reads them: ``[(seed, evaluation, CPU ms per sample), ...]`` of its finished
+    runs (``evaluation.json`` read) and :func:`where_unfinished` (of ``metric``) of each started one."""
+    done, partial = [], []
+    for spec, out in jobs:
+        rows = progress_rows(out)
+        if is_finished(out, spec):
+            done.append((spec.seed, json.loads((out / "evaluation.json").read_text()), cpu_ms_per_sample(rows)))
+        elif rows:
+            partial.append(where_unfinished(spec, rows, metric, digits, unit))
+    return done, partial
+
+
 def run_together(commands: list[list[str]]) -> list[dict]:
     """Start the worker processes ``commands`` and let them time together: each prints ``ready`` once built and
     warmed up, starts on a line ``go`` on its stdin, and ends by printing its result as one JSON line."""

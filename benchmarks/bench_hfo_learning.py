@@ -14,25 +14,22 @@ runs already under DIR (``pamdp reproduce benchmarks/hfo_learning.toml --out DIR
 
 from __future__ import annotations
 
-import json
 import shutil
 from pathlib import Path
 
 import numpy as np
 from _record import (
     HERE,
-    cpu_ms_per_sample,
+    arm_runs,
     progress_rows,
     record_head,
     seed_by_seed_main,
-    where_unfinished,
     write_record,
 )
 
 from pamdp.algos.logger import success_of
 from pamdp.experiments import load_experiment
 from pamdp.experiments.report import write_report
-from pamdp.experiments.runner import is_finished
 
 RECORD = HERE / "hfo_learning.md"
 
@@ -43,16 +40,9 @@ CAPTURED = "CAPTURED_BY_DEFENSE"
 def _arm_row(label: str, jobs, captures: bool = False) -> str:
     """One line of the table: the finished seeds' goal rates and steps, their medians, the cost per sample, and
     where the unfinished seeds stand; ``captures``: also each seed's share of episodes the goalie captured."""
-    done, costs, partial = [], [], []
-    for spec, out in jobs:
-        rows = progress_rows(out)
-        if is_finished(out, spec):
-            evaluation = json.loads((out / "evaluation.json").read_text())
-            rate, steps = success_of(evaluation)
-            done.append((spec.seed, rate, steps, evaluation.get("endings", {}).get(CAPTURED, 0.0)))
-            costs.append(cpu_ms_per_sample(rows))
-        elif rows:
-            partial.append(where_unfinished(spec, rows, "eval/success_rate"))
+    runs, partial = arm_runs(jobs, "eval/success_rate")
+    done = [(seed, *success_of(e), e.get("endings", {}).get(CAPTURED, 0.0)) for seed, e, _ in runs]
+    costs = [cost for _, _, cost in runs]
     per_seed = ", ".join(
         (f"{s}: {r:.3f} in {n:.1f}" if n else f"{s}: {r:.3f}") + (f" (captured {c:.3f})" if captures else "")
         for s, r, n, c in done

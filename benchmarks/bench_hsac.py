@@ -12,35 +12,25 @@ continues the benchmark; the record keeps its hand-written notes.
 
 from __future__ import annotations
 
-import json
-
 import numpy as np
 from _record import (
     HERE,
-    cpu_ms_per_sample,
-    progress_rows,
+    arm_runs,
     record_head,
     seed_by_seed_main,
-    where_unfinished,
     write_record,
 )
 
 from pamdp.experiments import load_experiment
-from pamdp.experiments.runner import is_finished
 
 RECORD = HERE / "hsac_platform.md"
 
 
 def _arm_lines(label: str, jobs) -> list[str]:
     """One row of the table: the finished seeds' greedy returns, their median and mean, the cost per sample."""
-    returns, costs, partial = [], [], []
-    for spec, out in jobs:
-        rows = progress_rows(out)
-        if is_finished(out, spec):
-            returns.append((spec.seed, json.loads((out / "evaluation.json").read_text())["mean_return"]))
-            costs.append(cpu_ms_per_sample(rows))
-        elif rows:
-            partial.append(where_unfinished(spec, rows, "eval/mean_return", 3, " samples"))
+    runs, partial = arm_runs(jobs, "eval/mean_return", 3, " samples")
+    returns = [(seed, evaluation["mean_return"]) for seed, evaluation, _ in runs]
+    costs = [cost for _, _, cost in runs]
     values = np.array([r for _, r in returns])
     per_seed = ", ".join(f"{s}: {r:.3f}" for s, r in returns) or "-"
     median = f"{np.median(values):.3f}" if len(values) else "-"

@@ -10,35 +10,25 @@ checkpoint, and rewrites benchmarks/main_job.md after every seed.
 
 from __future__ import annotations
 
-import json
-
 import numpy as np
 from _record import (
     HERE,
-    cpu_ms_per_sample,
-    progress_rows,
+    arm_runs,
     record_head,
     seed_by_seed_main,
-    where_unfinished,
     write_record,
 )
 
 from pamdp.experiments import load_experiment
-from pamdp.experiments.runner import is_finished
 
 RECORD = HERE / "main_job.md"
 SOLVED = 0.99  # the bar: Platform's greedy return, 1.0 for crossing every gap
 
 
 def arm_row(label: str, jobs) -> str:
-    done, minutes, partial = [], [], []
-    for spec, out in jobs:
-        rows = progress_rows(out)
-        if is_finished(out, spec):
-            done.append((spec.seed, json.loads((out / "evaluation.json").read_text())["mean_return"]))
-            minutes.append(cpu_ms_per_sample(rows) * spec.total_steps / 6e4)
-        elif rows:
-            partial.append(where_unfinished(spec, rows, "eval/mean_return"))
+    runs, partial = arm_runs(jobs, "eval/mean_return")
+    done = [(seed, evaluation["mean_return"]) for seed, evaluation, _ in runs]
+    minutes = [cost * jobs[0][0].total_steps / 6e4 for _, _, cost in runs]
     returns = [r for _, r in done]
     solved = sum(r >= SOLVED for r in returns)
     return (
