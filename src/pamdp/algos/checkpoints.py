@@ -198,8 +198,9 @@ def transfer_weights(
                 raise ValueError(
                     f"{argument} names rows of {tensor}, which depends on the observation; expected one that does not"
                 )
-            start = mapped.clone()
-            if kept or widened:
+            start = mapped
+            if kept or widened:  # a copy, so that the source's tensor is left as it was read
+                start = mapped.clone()
                 by_row, own_rows = start.view(rows, -1), target.reshape(rows, -1)
                 by_row[widened] = torch.maximum(by_row[widened], own_rows[widened])
                 by_row[kept] = own_rows[kept]
