@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The long learning runs still owed to issues 26, 27 and 43, as resumable queues, one core each.
+# The long learning runs still owed to issues 26, 27, 43 and 44, as resumable queues, one core each.
 #
 #   nohup benchmarks/backlog.sh > backlog.log 2>&1 &      # at the start of a session, from the repo root
 #   nohup benchmarks/backlog.sh goalie > goalie.log 2>&1 &   # only the named queues (soccer, suite, goalie, seeds)
@@ -51,11 +51,16 @@ goalie() {  # issue 43: the recipe (pamdp reproduce hfo-goalie, done 2026-12-04)
     python bench_hfo_goalie_learning.py --out "$GOALIE_OUT"
 }
 
-seeds() {  # issue 44: seeds 3 and 4 of the suite's cells (5 a cell), PATRPO's cheap runs first, then HyAR-TD3, MP-DQN
-    local s="pamdp reproduce benchmark-suite --out $SUITE_OUT --seeds 3,4"
-    $s --runs "PATRPO_on_Platform,PATRPO_on_Goal,PATRPO_on_Hard_Goal,PATRPO_on_Catch_Point,PATRPO_on_Hard_Move_n=4"
-    $s --runs "HyAR-TD3_on_Platform,MP-DQN_on_Platform,HyAR-TD3_on_Goal,MP-DQN_on_Goal,HyAR-TD3_on_Hard_Goal"
-    $s --runs "MP-DQN_on_Hard_Goal,HyAR-TD3_on_Catch_Point,MP-DQN_on_Catch_Point,Hybrid_SAC_on_Catch_Point"
+seeds() {  # issue 44: 5 seeds a cell, 10 where a run costs under 10 CPU minutes; the cheapest and the domains' best first
+    local s="pamdp reproduce benchmark-suite --out $SUITE_OUT"
+    local patrpo="PATRPO_on_Platform,PATRPO_on_Goal,PATRPO_on_Hard_Goal,PATRPO_on_Catch_Point"
+    patrpo="$patrpo,PATRPO_on_Hard_Move_n=4,PATRPO_on_Hard_Move_n=6,PATRPO_on_Hard_Move_n=8,PATRPO_on_Hard_Move_n=10"
+    $s --seeds 3,4 --runs "$patrpo"                           # 0.5-3 CPU minutes a run (2026-12-04)
+    $s --seeds 3,4 --runs "Hybrid_SAC_on_Catch_Point,HyAR-TD3_on_Platform,MP-DQN_on_Platform,Hybrid_SAC_on_Platform"
+    $s --seeds 5,6,7,8,9 --runs "$patrpo"
+    $s --seeds 3,4 --runs "HyAR-TD3_on_Goal,MP-DQN_on_Goal,HyAR-TD3_on_Hard_Goal,MP-DQN_on_Hard_Goal"
+    $s --seeds 3,4 --runs "HyAR-TD3_on_Catch_Point,MP-DQN_on_Catch_Point"
+    $s --seeds 5,6,7,8,9 --runs "HyAR-TD3_on_Platform,Hybrid_SAC_on_Platform,HyAR-TD3_on_Goal,HyAR-TD3_on_Hard_Goal"
 }
 
 queues=("${@:-soccer}" ) && [ $# -eq 0 ] && queues=(soccer suite seeds)
