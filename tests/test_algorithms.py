@@ -311,3 +311,20 @@ def test_cli_trains_skips_a_finished_run_resumes_and_evaluates(case, tmp_path, c
     result = json.loads(capsys.readouterr().out)
     assert result["episodes"] == 3 and result["policy"] == "greedy"
     assert 0.0 <= result["mean_return"] <= 1.0 and result["mean_length"] >= 1  # Platform's returns lie in [0, 1]
+
+
+def test_a_model_made_on_a_users_vector_env_keeps_the_envs_own_arguments(tmp_path):
+    """``gymnasium.make_vec`` records its own arguments (num_envs, vectorization_mode, ...) in the vector env's
+    ``spec.kwargs`` beside the env's; a model made on such an env keeps only the env's (Hard Move's ``n``), so that
+    evaluating it (which makes copies of the env) and loading it make the same env, not a TypeError."""
+    from pamdp.evaluation import evaluate
+
+    vec = gymnasium.make_vec("pamdp/HardMove-v0", num_envs=4, vectorization_mode="sync", n=6)
+    model = CASES["patrpo"].cls(vec, CASES["patrpo"].config(num_envs=4))
+    assert (model.env_id, model.env_kwargs) == ("pamdp/HardMove-v0", {"n": 6})
+    model.learn(STEPS, progress_bar=False)
+    result = evaluate(model, episodes=4, num_envs=2)
+    assert result["episodes"] == 4
+    model.save(tmp_path / "m.pt")
+    loaded = load_model(tmp_path / "m.pt")
+    assert (loaded.env_kwargs, loaded.hybrid.n_actions) == ({"n": 6}, 2**6)

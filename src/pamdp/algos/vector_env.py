@@ -109,6 +109,10 @@ def check_env_kwargs(env_id: str, env_kwargs: dict) -> None:
             raise ValueError(f"env {env_id!r} argument {name} = {value!r}; expected {type_name(hint)}")
 
 
+MAKE_VEC_ARGUMENTS = frozenset({"num_envs", "vectorization_mode", "vector_kwargs", "wrappers"})
+"""What ``gymnasium.make_vec`` adds to a vector env's ``spec.kwargs``: none of them is the env's own argument."""
+
+
 def describe_env(env, env_kwargs: dict | None = None) -> tuple[str | None, dict, spaces.Space, spaces.Space]:
     """``(env_id, env_kwargs, single observation space, single action space)`` of what a user passed."""
     if isinstance(env, str):
@@ -126,7 +130,10 @@ def describe_env(env, env_kwargs: dict | None = None) -> tuple[str | None, dict,
     else:
         raise ValueError(f"env must be a registered env id, a gymnasium.Env or a VectorEnv; got {env!r}")
     spec = env.spec
-    return (spec.id if spec else None), dict(spec.kwargs if spec else {}), *spaces_of
+    kwargs = dict(spec.kwargs if spec else {})
+    if isinstance(env, gymnasium.vector.VectorEnv):  # make_vec records its own arguments beside the env's
+        kwargs = {key: value for key, value in kwargs.items() if key not in MAKE_VEC_ARGUMENTS}
+    return (spec.id if spec else None), kwargs, *spaces_of
 
 
 def info_action_masks(infos: dict, num_envs: int, n_actions: int) -> np.ndarray:
