@@ -213,9 +213,14 @@ def test_relabelling_replaces_exactly_the_stale_latents():
     assert m_none.relabel(batch) == (stored, 0.0)
 
 
-def test_td3_critic_loss_by_hand_and_the_policy_delay():
-    m = model(target_noise=0.0, policy_delay=2)
+@pytest.mark.parametrize("beta", [0.0, 0.4])
+def test_td3_critic_loss_by_hand_and_the_policy_delay(beta):
+    """TD3's target by hand; with ``beta`` > 0, Hausknecht & Stone's mix of it with the Monte-Carlo return where an
+    episode's end made that known (NaN where not)."""
+    m = model(target_noise=0.0, policy_delay=2, beta=beta)
     m.learn(200, progress_bar=False)  # warm-up done and a few updates
+    mc = m.replay.data["mc"][: len(m.replay)] if beta else None  # the returns of the episodes that ended
+    assert not beta or (torch.isfinite(mc).any() and torch.isnan(mc).any())
     gen = torch.Generator().manual_seed(1)
     b = {
         "obs": torch.rand(16, 9, generator=gen),
@@ -226,6 +231,9 @@ def test_td3_critic_loss_by_hand_and_the_policy_delay():
         "terminated": torch.rand(16, generator=gen) < 0.3,
         "latent": torch.zeros(16, m.latent_size),
     }
+    if beta:
+        mc = torch.rand(16, generator=gen) * 3
+        b["mc"] = torch.where(torch.arange(16) % 3 == 0, torch.nan, mc)
     m.replay.sample = lambda n, rng, first=0: b
     m.config = dataclasses.replace(m.config, vae_updates=0)  # no representation round inside these updates
     m.n_updates = 10  # the next update (11) is odd: critics only
@@ -234,6 +242,8 @@ def test_td3_critic_loss_by_hand_and_the_policy_delay():
         latent_next = m.actor_target.to_latent(m.actor_target(b["next_obs"]))
         q1n, q2n = (q.squeeze(-1) for q in m.critic_target(b["next_obs"], latent_next))
         y = b["reward"] + m.config.gamma * (~b["terminated"]).float() * torch.minimum(q1n, q2n)
+        if beta:
+            y = torch.tensor([t if i % 3 == 0 else beta * b["mc"][i] + (1 - beta) * t for i, t in enumerate(y)])
         q1, q2 = (q.squeeze(-1) for q in m.critic(b["obs"], latent))
         expected = ((q1 - y) ** 2).mean() + ((q2 - y) ** 2).mean()
     actor_before = [p.clone() for p in m.actor.parameters()]

@@ -124,6 +124,7 @@ class HyARConfig(OffPolicyConfig, AlgoConfig):
     epsilon_steps: int = setting(
         50_000, "Samples over which the embedding's epsilon falls to epsilon_end.", at_least(1)
     )
+    beta: float = OffPolicyConfig.shared_setting("beta", 0.0, "not in HyAR: 0, TD3's target")
     target_noise: float = setting(
         0.2, "Std of the target policy smoothing noise, [-1, 1] units (TD3: 0.2).", NON_NEGATIVE
     )
@@ -295,7 +296,7 @@ class HyAR(EpsilonSchedule, Algorithm):
         self.critic_optimizer = torch.optim.Adam(self._critic_params, lr=cfg.critic_lr, fused=True)
         self._soft_update = soft_updater([(self.critic_target, self.critic), (self.actor_target.net, self.actor.net)])
         # the latent action that was decoded and executed
-        self.loop = OffPolicyLoop(self, latent=((self.latent_size,), np.float32))
+        self.loop = OffPolicyLoop(self, mc_returns=cfg.beta > 0, latent=((self.latent_size,), np.float32))
         self.replay = self.loop.buffer
         self.pretrained = False  # the warm-up round of representation training is done
         self.n_updates = 0  # TD3 updates so far (the policy delay and the representation rounds count them)
