@@ -189,6 +189,21 @@ def test_the_statistics_tables_hold_the_hand_computed_cells():
     # B's one evaluation, 0.0 at the end of its budget: never reached, so censored there
     assert efficiency[("| Goal", "B")] == ["2", "- / - / - / 0.00", "> 400 (0 of 2 reached)", "0.00 |"]
     assert ("| Platform", "A") not in efficiency  # no curve logged
+    standing = _cells(results.standing_table(runs))
+    # Goal: the best published is CHDP's 0.809; A (IQM 0.667) beats B (-1.4 over 2 runs: too few to stand). A's
+    # interval [0, 1] holds 0.809: neither above nor below; its curve first reaches 0.809 at 300 samples.
+    assert standing[("| Goal", "0.809 (CHDP)")] == ["A", "3", "0.667 [0.000, 1.000]", "within the interval", "300 (3 of 3)", "400 |"]
+    # Platform: A (IQM 0.75) beats B (0.3 - 2). A redrawn set of A's four runs has an IQM of 1.0 (its middle two
+    # both 1.0) when three or four draws are the 1.0: 4 (1/4)^3 (3/4) + (1/4)^4 = 5.1 % > 2.5 %, so the interval
+    # reaches 1.0 and holds CHDP's 0.997; no curves logged
+    platform = standing[("| Platform", "0.997 (CHDP)")]
+    assert platform[:2] == ["A", "4"] and platform[3:] == ["within the interval", "- (no curves)", "400 |"]
+    # runs that all score 0.5 and 0.95 on Platform: an interval of one point, below and above 0.997 and 0.942 (Hard Move)
+    low = [_summary("C on Platform", "pamdp/Platform-v0", seed, 0.5) for seed in range(3)]
+    high = [_summary("C on Hard Move n=4", "pamdp/HardMove-v0", seed, 0.95, env_kwargs={"n": 4}) for seed in range(3)]
+    standing = _cells(results.standing_table(low + high))
+    assert standing[("| Platform", "0.997 (CHDP)")][2:4] == ["0.500 [0.500, 0.500]", "below"]
+    assert standing[("| Hard Move n=4", "0.942 (CHDP)")][2:4] == ["0.950 [0.950, 0.950]", "above"]
 
 
 def test_the_figures_are_drawn_where_there_is_something_to_draw(tmp_path):
