@@ -56,8 +56,8 @@ seeds() {  # issue 44: 5 seeds a cell, 10 where a run costs under 10 CPU minutes
     local patrpo="PATRPO_on_Platform,PATRPO_on_Goal,PATRPO_on_Hard_Goal,PATRPO_on_Catch_Point"
     patrpo="$patrpo,PATRPO_on_Hard_Move_n=4,PATRPO_on_Hard_Move_n=6,PATRPO_on_Hard_Move_n=8,PATRPO_on_Hard_Move_n=10"
     $s --seeds 3,4 --runs "$patrpo"                           # 0.5-3 CPU minutes a run (2026-12-04)
-    $s --seeds 3,4 --runs "Hybrid_SAC_on_Catch_Point,HyAR-TD3_on_Platform,MP-DQN_on_Platform,Hybrid_SAC_on_Platform"
     $s --seeds 5,6,7,8,9 --runs "$patrpo"
+    $s --seeds 3,4 --runs "Hybrid_SAC_on_Catch_Point,HyAR-TD3_on_Platform,MP-DQN_on_Platform,Hybrid_SAC_on_Platform"
     $s --seeds 3,4 --runs "HyAR-TD3_on_Goal,MP-DQN_on_Goal,HyAR-TD3_on_Hard_Goal,MP-DQN_on_Hard_Goal"
     $s --seeds 3,4 --runs "HyAR-TD3_on_Catch_Point,MP-DQN_on_Catch_Point"
     $s --seeds 5,6,7,8,9 --runs "HyAR-TD3_on_Platform,Hybrid_SAC_on_Platform,HyAR-TD3_on_Goal,HyAR-TD3_on_Hard_Goal"
