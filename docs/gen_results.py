@@ -46,6 +46,7 @@ def tables() -> dict[str, str]:
         "suite-improvement": results.improvement_table(suite) + "\n",
         "suite-efficiency": results.efficiency_table(suite) + "\n",
         "suite-standing": results.standing_table(suite) + "\n",
+        "one-preset": results.one_preset_table(summaries("one-preset"), suite) + "\n",
         "readme-suite": "Benchmark suite, generated from the committed summaries ([how](docs/results.md"
         "#intervals-profiles-and-sample-efficiency-issue-44)): " + results.aggregate_line(suite) + "\n",
     }

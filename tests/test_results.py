@@ -206,6 +206,22 @@ def test_the_statistics_tables_hold_the_hand_computed_cells():
     assert standing[("| Hard Move n=4", "0.942 (CHDP)")][2:4] == ["0.950 [0.950, 0.950]", "above"]
 
 
+def test_the_one_preset_table_judges_each_domain_against_hyars_figure_and_counts_them():
+    one = [_summary("C on Platform", "pamdp/Platform-v0", seed, v) for seed, v in enumerate((0.99, 1.0, 0.97))]
+    one += [_summary("C on Goal", "pamdp/Goal-v0", seed, 0.5) for seed in range(3)]
+    one += [_summary("C on Moving", "pamdp/Moving-v0", seed, 0.7) for seed in range(2)]
+    table = results.one_preset_table(one, _synthetic())
+    rows = _cells(table.split("\n\n")[0])
+    # Platform: three runs, none dropped from the IQM: their mean 0.987 >= HyAR-TD3's 0.98; the suite's best cell is
+    # A's (the IQM of 0.2 0.6 0.9 1.0: 0.75)
+    assert rows[("| Platform", "3")][0] == "0: 0.990, 1: 1.000, 2: 0.970"
+    assert rows[("| Platform", "3")][1].startswith(f"{np.mean([0.99, 1.0, 0.97]):.3f} [0.970, 1.000]")
+    assert rows[("| Platform", "3")][2:] == ["0.98 +- 0.01", "yes", "A, 0.750 |"]
+    assert rows[("| Goal", "3")][2:] == ["0.78 +- 0.03", "no (-0.28)", "A, 0.667 |"]
+    assert rows[("| pamdp/Moving-v0", "2")][2:] == ["- (none published)", "-", "- |"]
+    assert table.endswith("on 1 of the 2 domains it has one for.")
+
+
 def test_the_figures_are_drawn_where_there_is_something_to_draw(tmp_path):
     runs = _synthetic()
     profiles = results.plot_profiles(runs, tmp_path / "profiles")

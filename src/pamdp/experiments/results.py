@@ -109,6 +109,39 @@ def standing_table(summaries: list[dict]) -> str:
     return "\n".join(lines)
 
 
+def one_preset_table(summaries: list[dict], suite: list[dict]) -> str:
+    """One method with one setting on many domains (the runs ``summaries``): per domain its runs' scores, their IQM
+    with the 95 % interval, HyAR-TD3's published figure and whether the IQM is at or above it, beside the best main
+    cell of the benchmark suite's runs ``suite`` (the domains' own presets). A last line counts the domains met."""
+    lines = [
+        "| domain | runs | score per seed | IQM [95 % CI] | HyAR-TD3 published | at or above it | the suite's best "
+        "cell (its own preset) |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    best = {}
+    for method, domains in _main_cells(suite).items():
+        for domain, scores in domains.items():
+            if len(scores) >= MIN_RUNS and stats.iqm(scores) > best.get(domain, ("", -np.inf))[1]:
+                best[domain] = (method, stats.iqm(scores))
+    met = judged = 0
+    for (row, _), runs in cells(summaries).items():
+        domain, scores = _domain(runs[0]), np.array([score(s)[0] for s in runs])
+        published = HYAR_TABLE["HyAR-TD3"].get(domain)
+        figure = float(published.split()[0]) if published else None
+        value = stats.iqm(scores)
+        verdict = "-" if figure is None else "yes" if value >= figure else f"no ({value - figure:+.2f})"
+        judged += figure is not None
+        met += figure is not None and value >= figure
+        mine = best.get(domain)
+        per_seed = ", ".join(f"{s.get('seed')}: {v:.3f}" for s, v in zip(runs, scores))
+        lines.append(
+            f"| {row} | {len(runs)} | {per_seed} "
+            f"| {_estimate([scores], stats.iqm)} | {published or '- (none published)'} | {verdict} "
+            f"| {'-' if mine is None else f'{mine[0]}, {mine[1]:.3f}'} |"
+        )
+    return "\n".join(lines) + f"\n\nAt or above HyAR-TD3's published rate on {met} of the {judged} domains it has one for."
+
+
 def published_best(domain: str) -> float | None:
     """The best figure HyAR's Table 2 gives on a suite domain (of any method: HyAR-TD3's on all eight)."""
     found = [float(column[domain].split()[0]) for column in HYAR_TABLE.values() if column.get(domain)]
