@@ -124,6 +124,21 @@ def test_an_update_without_a_direction_is_logged_as_skipped_not_as_a_failed_line
     assert model._update_policy(obs, a, x, adv)["train/update_skipped"] == 0.0
 
 
+def test_the_discrete_entropy_bonus_moves_pi_d_alone_towards_uniform():
+    """Zero advantages and entropy_coef_d alone: the surrogate is pi_d's entropy, whose gradient has no part in
+    pi_c's network or the log-stds; the chain-rule KL's Fisher matrix has no block between pi_d's parameters and
+    pi_c's at the old policy, so the natural step leaves pi_c exactly as it was and raises pi_d's entropy."""
+    model = PATRPO("pamdp/Platform-v0", PATRPOConfig.from_dict({"entropy_coef": 0.0, "entropy_coef_d": 0.5}, base=SMALL))
+    obs, a, x, adv = float64_batch(model, 200)[:4]
+    with torch.no_grad():  # a pi_d far from uniform, so that there is entropy to gain
+        model.policy.pi_d[-1].bias.copy_(torch.tensor([2.0, -1.0, 0.0], dtype=torch.float64))
+    entropy = lambda: model.policy(obs).entropy_d().mean().item()  # noqa: E731
+    before, pi_c = entropy(), {k: v.clone() for k, v in model.policy.state_dict().items() if not k.startswith("pi_d")}
+    stats = model._update_policy(obs, a, x, torch.zeros_like(adv))
+    assert stats["train/update_skipped"] == 0.0 and entropy() > before
+    assert all(torch.equal(v, model.policy.state_dict()[k]) for k, v in pi_c.items())
+
+
 def test_load_errors_are_clear(tmp_path):
     with pytest.raises(FileNotFoundError, match="no pamdp model at"):
         PATRPO.load(tmp_path / "missing.pt")

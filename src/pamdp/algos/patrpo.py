@@ -86,6 +86,12 @@ class PATRPOConfig(OnPolicyConfig, AlgoConfig):
         "Weight of the policy entropy added to the surrogate (not in the paper); keeps exploring longer.",
         NON_NEGATIVE,
     )
+    entropy_coef_d: float = setting(
+        0.0,
+        "Weight of pi_d's entropy alone added to the surrogate, beside entropy_coef's joint one (not in the paper): "
+        "keeps every discrete action tried without widening the parameter noise (Goal from a random start).",
+        NON_NEGATIVE,
+    )
     baseline: str = setting(
         "mlp",
         "Baseline: mlp (a value network, the modern choice) or linear (rllab's linear-feature baseline).",
@@ -164,7 +170,8 @@ class PATRPO(OnPolicy, Algorithm):
 
         def surrogate(new) -> torch.Tensor:
             gain = (torch.exp(new.log_prob(a, x) - old_logp) * adv).mean()
-            return gain + cfg.entropy_coef * new.entropy().mean() if cfg.entropy_coef else gain
+            gain = gain + cfg.entropy_coef * new.entropy().mean() if cfg.entropy_coef else gain
+            return gain + cfg.entropy_coef_d * new.entropy_d().mean() if cfg.entropy_coef_d else gain
 
         tried = []  # the line search's last policy distribution: the accepted one's, for the KL after the step
 
