@@ -9,8 +9,8 @@ from loop_stub import stub_algorithm
 from torch import nn
 
 from pamdp.algos.offpolicy import discounted_returns, linear_epsilon, mixed_target, soft_update
-from pamdp.algos.optim import descend
 from pamdp.algos.replay import ReplayBuffer
+from pamdp.nn.optim import descend
 
 FIELDS = {"obs": ((2,), np.float32), "a": ((), np.int64), "eta": ((3,), np.float32)}
 

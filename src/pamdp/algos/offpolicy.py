@@ -14,12 +14,12 @@ import numpy as np
 import torch
 from torch import nn
 
-from pamdp.algos.optim import apply_gradients
 from pamdp.algos.replay import ReplayBuffer, transition_fields
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, at_least, interval, one_of, redeclared, setting
-from pamdp.algos.subnormals import subnormals_flushed
 from pamdp.algos.vector_env import Step, VectorStepper
 from pamdp.distributions import masked_logits
+from pamdp.nn.optim import apply_gradients
+from pamdp.nn.subnormals import subnormals_flushed
 from pamdp.policies import ACTIVATIONS
 
 __all__ = [
@@ -310,7 +310,7 @@ def backprop_actor(
     params: Sequence[torch.Tensor],
 ) -> tuple[torch.Tensor, torch.Tensor, tuple[torch.Tensor, ...]]:
     """Back-propagate ``-mean_s Q(s, mu(s))`` into the actor's ``params``, with ``dQ/dmu`` edited by ``bound`` on
-    the way (for :func:`~pamdp.algos.optim.apply_gradients`).
+    the way (for :func:`~pamdp.nn.optim.apply_gradients`).
 
     ``Q`` is summed over its last axis if it has one (P-DQN's K values). The critic's weights get no gradient.
     Returns the actor's outputs and ``Q(s, mu(s))``, detached, and the gradients in ``params``.

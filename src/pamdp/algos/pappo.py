@@ -15,9 +15,9 @@ import torch
 
 from pamdp.algos.base import Algorithm
 from pamdp.algos.onpolicy import OnPolicy, OnPolicyConfig, Rollout, hybrid_policy
-from pamdp.algos.optim import descend
 from pamdp.algos.settings import NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, setting
 from pamdp.distributions import HybridDistribution, kl_divergence
+from pamdp.nn.optim import descend
 from pamdp.policies import ValueNetwork
 
 __all__ = ["PAPPO", "PAPPOConfig", "clipped_surrogate", "ppo_loss"]

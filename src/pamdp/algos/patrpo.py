@@ -16,7 +16,6 @@ import torch
 
 from pamdp.algos.base import Algorithm
 from pamdp.algos.onpolicy import LinearFeatureBaseline, OnPolicy, OnPolicyConfig, Rollout, hybrid_policy
-from pamdp.algos.optim import descend
 from pamdp.algos.settings import NON_NEGATIVE, POSITIVE, AlgoConfig, at_least, interval, one_of, redeclared, setting
 from pamdp.algos.trpo import (
     FisherVectorProduct,
@@ -26,6 +25,7 @@ from pamdp.algos.trpo import (
     hybrid_gauss_newton_fvp,
 )
 from pamdp.distributions import KL_ESTIMATORS, kl_divergence
+from pamdp.nn.optim import descend
 from pamdp.policies import ValueNetwork
 
 __all__ = ["PATRPO", "PATRPOConfig"]

@@ -2,7 +2,7 @@
 
 P-DQN (Xiong et al. 2018, arXiv 1810.06394) acts by ``argmax_k Q_k(s, x(s))`` with an actor ``x(s)`` of every
 action's parameters; MP-DQN (Bester, James & Konidaris 2019, arXiv 1905.04388; ``multi_pass = True``) reads
-``Q_k`` from a pass that sees only ``x_k``. The update is back-propagated by hand (:mod:`pamdp.algos.dense`;
+``Q_k`` from a pass that sees only ``x_k``. The update is back-propagated by hand (:mod:`pamdp.nn.dense`;
 ``tests/test_pdqn.py`` holds the autograd form it must equal). The maths: docs/algorithms.md, "P-DQN and MP-DQN".
 """
 
@@ -18,7 +18,6 @@ import torch.nn.functional as F
 from torch import nn
 
 from pamdp.algos.base import Algorithm
-from pamdp.algos.dense import Dense, MultiPassDense
 from pamdp.algos.offpolicy import (
     DeterministicActorConfig,
     EpsilonSchedule,
@@ -29,9 +28,10 @@ from pamdp.algos.offpolicy import (
     soft_updater,
     uniform_actions,
 )
-from pamdp.algos.optim import apply_gradients
 from pamdp.algos.settings import POSITIVE, AlgoConfig, Check, setting
 from pamdp.distributions import masked_logits
+from pamdp.nn.dense import Dense, MultiPassDense
+from pamdp.nn.optim import apply_gradients
 from pamdp.policies import DeterministicActor, in_chunks, mlp
 from pamdp.spaces import HybridActionSpace
 
@@ -126,7 +126,7 @@ class QNetwork(nn.Module):
     With ``multi_pass`` (MP-DQN), ``Q_k`` is read from a pass that sees only ``x_k``. The passes' input rows are
     never built: pass ``k``'s first layer is ``W_s s + W_k x_k + b`` and its output layer computes ``Q_k`` alone,
     the same function at ``K`` times fewer operations; the passes are one flat batch of ``K * B`` rows, pass
-    ``k``'s a contiguous block (a strided layout walked memory slowly; :class:`~pamdp.algos.dense.MultiPassDense`
+    ``k``'s a contiguous block (a strided layout walked memory slowly; :class:`~pamdp.nn.dense.MultiPassDense`
     differentiates it by hand).
     """
 
@@ -151,7 +151,7 @@ class QNetwork(nn.Module):
         return self.forward_cached(obs, params)[0]
 
     def forward_cached(self, obs: torch.Tensor, params: torch.Tensor) -> tuple[torch.Tensor, tuple]:
-        """The ``(B, K)`` values by the hand-written passes of :mod:`pamdp.algos.dense` (differentiable by autograd
+        """The ``(B, K)`` values by the hand-written passes of :mod:`pamdp.nn.dense` (differentiable by autograd
         too), with what :meth:`backward` needs."""
         if not self.multi_pass:
             net = Dense.of(self.net)
@@ -241,7 +241,7 @@ class PDQN(EpsilonSchedule, Algorithm):
 
     # -- learning --------------------------------------------------------------------------------
     def _bind_networks(self) -> None:
-        """The actor's hand-written passes (:mod:`pamdp.algos.dense`) over its own tensors, and the soft updates;
+        """The actor's hand-written passes (:mod:`pamdp.nn.dense`) over its own tensors, and the soft updates;
         called again by whoever replaces a module."""
         self._dense_actor = Dense.of(self.actor.net)
         self._soft_update_q = soft_updater([(self.q_target, self.q_net)])
@@ -249,7 +249,7 @@ class PDQN(EpsilonSchedule, Algorithm):
 
     def _update(self) -> dict[str, torch.Tensor]:
         """One TD step of the Q-network, one actor step along the bounded ``d sum_k Q_k / dx``, soft target updates;
-        back-propagated by hand through the :mod:`~pamdp.algos.dense` views of the networks. The figures stay
+        back-propagated by hand through the :mod:`~pamdp.nn.dense` views of the networks. The figures stay
         tensors, read once an epoch."""
         cfg = self.config
         b = self.replay.sample(cfg.batch_size, self.np_rng)

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import torch
 from torch import nn
 
-from pamdp.algos.optim import apply_gradients
+from pamdp.nn.optim import apply_gradients
 
 __all__ = ["Dense", "MultiPassDense"]
 
