@@ -13,7 +13,7 @@ import numpy as np
 from gymnasium import spaces
 
 from pamdp.algos.logger import EpisodeTracker
-from pamdp.algos.settings import type_name, type_ok
+from pamdp.hints import type_name, type_ok
 
 __all__ = [
     "env_spec",
