@@ -10,11 +10,11 @@ from gymnasium import spaces
 from loop_stub import stub_algorithm
 
 from pamdp import PATRPO
-from pamdp.algos.logger import EpisodeTracker
 from pamdp.algos.offpolicy import OffPolicyLoop
 from pamdp.algos.paddpg import PADDPGConfig
 from pamdp.algos.patrpo import PATRPOConfig
 from pamdp.evaluation import evaluate
+from pamdp.logger import EpisodeTracker
 
 
 def test_tracker_by_hand_with_successes_and_an_autoreset_step():

@@ -410,7 +410,7 @@ def test_ctrl_c_before_the_first_checkpoint_says_there_is_nothing_to_resume(tmp_
 def test_a_log_resumed_from_a_checkpoint_keeps_the_checkpoints_epoch_in_tensorboard(tmp_path):
     from tensorboard.backend.event_processing.event_accumulator import EventAccumulator
 
-    from pamdp.algos.logger import Logger
+    from pamdp.logger import Logger
 
     logger = Logger(tmp_path)
     for step in (100, 200, 300):  # a run killed after logging epoch 300, whose last checkpoint was at 200

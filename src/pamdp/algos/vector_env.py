@@ -12,8 +12,8 @@ import gymnasium
 import numpy as np
 from gymnasium import spaces
 
-from pamdp.algos.logger import EpisodeTracker
 from pamdp.hints import type_name, type_ok
+from pamdp.logger import EpisodeTracker
 
 __all__ = [
     "env_spec",

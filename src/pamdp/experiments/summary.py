@@ -25,7 +25,7 @@ import re
 import subprocess
 from pathlib import Path
 
-from pamdp.algos.logger import RENAMED, success_of
+from pamdp.logger import RENAMED, success_of
 
 __all__ = ["FORMAT", "SUMMARY", "git_commit", "summarize", "write_summary", "load", "save"]
 
