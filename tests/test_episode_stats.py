@@ -13,8 +13,8 @@ from pamdp import PATRPO
 from pamdp.algos.offpolicy import OffPolicyLoop
 from pamdp.algos.paddpg import PADDPGConfig
 from pamdp.algos.patrpo import PATRPOConfig
+from pamdp.envs.stepping import EpisodeTracker
 from pamdp.evaluation import evaluate
-from pamdp.logger import EpisodeTracker
 
 
 def test_tracker_by_hand_with_successes_and_an_autoreset_step():

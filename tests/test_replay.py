@@ -154,7 +154,7 @@ def test_epoch_stats_average_each_figure_over_the_updates_that_computed_it():
     """A figure computed every third update (a delayed actor step) is the mean of those steps, not diluted."""
     from pamdp.algos.offpolicy import OffPolicyLoop
     from pamdp.algos.paddpg import PADDPGConfig
-    from pamdp.algos.vector_env import make_vector_env
+    from pamdp.envs.backends import make_vector_env
     from pamdp.spaces import HybridActionSpace
 
     env = make_vector_env("pamdp/Platform-v0", 4)
@@ -182,7 +182,7 @@ def test_reward_scale_scales_what_the_critics_learn_from_and_nothing_the_user_se
     Monte-Carlo returns are the other's times 1/50, its logged episode returns the same."""
     from pamdp.algos.offpolicy import OffPolicyLoop
     from pamdp.algos.paddpg import PADDPGConfig
-    from pamdp.algos.vector_env import make_vector_env
+    from pamdp.envs.backends import make_vector_env
     from pamdp.spaces import HybridActionSpace
 
     def run(scale):

@@ -246,7 +246,7 @@ class EvalCallback(BaseCallback):
         callback_after_eval: BaseCallback | None = None,
     ):
         super().__init__()
-        from pamdp.algos.vector_env import check_env_kwargs
+        from pamdp.envs.backends import check_env_kwargs
 
         if eval_env is not None and not isinstance(eval_env, str):
             raise ValueError(f"eval_env = {eval_env!r:.80}; expected a registered env id (a str) or None")

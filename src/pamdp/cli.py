@@ -552,7 +552,7 @@ def cmd_render(args) -> int:
 
     import pamdp  # noqa: F401  (registers the envs)
     from pamdp.algos import load_model
-    from pamdp.algos.vector_env import env_creator
+    from pamdp.envs.backends import env_creator
     from pamdp.envs.rendering import record_episode
     from pamdp.spaces import HybridActionSpace
 

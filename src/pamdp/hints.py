@@ -1,6 +1,6 @@
 """Values checked against type hints as plain data (JSON, TOML, a command line) gives them: the one check of an
-algorithm's settings (:mod:`pamdp.algos.settings`) and of an env's arguments (``check_env_kwargs``), below both: it
-imports nothing of pamdp.
+algorithm's settings (:mod:`pamdp.algos.settings`) and of an env's arguments
+(:func:`pamdp.envs.backends.check_env_kwargs`), below both: it imports nothing of pamdp.
 """
 
 from __future__ import annotations

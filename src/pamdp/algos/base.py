@@ -28,8 +28,8 @@ from gymnasium.vector import AutoresetMode
 from pamdp._version import __version__
 from pamdp.algos.checkpoints import CHECKPOINT, FORMAT, atomic_save, read_checkpoint
 from pamdp.algos.settings import AlgoConfig
-from pamdp.algos.vector_env import describe_env, make_vector_env
 from pamdp.callbacks import BaseCallback, _count, _eval_figures, as_callback
+from pamdp.envs.backends import describe_env, make_vector_env
 from pamdp.evaluation import evaluate
 from pamdp.logger import Logger
 from pamdp.spaces import HybridActionSpace

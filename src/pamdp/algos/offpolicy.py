@@ -16,8 +16,8 @@ from torch import nn
 
 from pamdp.algos.replay import ReplayBuffer, transition_fields
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, at_least, interval, one_of, redeclared, setting
-from pamdp.algos.vector_env import Step, VectorStepper
 from pamdp.distributions import masked_logits
+from pamdp.envs.stepping import Step, VectorStepper
 from pamdp.nn.optim import apply_gradients
 from pamdp.nn.subnormals import subnormals_flushed
 from pamdp.policies import ACTIVATIONS

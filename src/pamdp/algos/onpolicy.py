@@ -12,7 +12,7 @@ import numpy as np
 import torch
 
 from pamdp.algos.settings import LAYERS, at_least, interval, one_of, setting
-from pamdp.algos.vector_env import VectorStepper
+from pamdp.envs.stepping import VectorStepper
 from pamdp.nn.subnormals import subnormals_flushed
 from pamdp.policies import ACTIVATIONS, PI_C_INPUTS, HybridPolicy
 

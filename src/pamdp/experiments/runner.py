@@ -31,7 +31,7 @@ import filelock
 
 from pamdp._version import __version__
 from pamdp.algos import algorithm_class
-from pamdp.algos.vector_env import check_env_kwargs
+from pamdp.envs.backends import check_env_kwargs
 from pamdp.experiments.summary import SUMMARY, git_commit, write_summary
 from pamdp.presets import choose
 
@@ -172,7 +172,7 @@ def env_defaults(env: str) -> dict:
     unregistered env or a constructor without a signature)."""
     import inspect
 
-    from pamdp.algos.vector_env import env_creator
+    from pamdp.envs.backends import env_creator
 
     try:
         params = inspect.signature(env_creator(env)).parameters.values()
