@@ -8,7 +8,7 @@ import torch
 from loop_stub import stub_algorithm
 from torch import nn
 
-from pamdp.algos.offpolicy import discounted_returns, linear_epsilon, mixed_target, soft_update
+from pamdp.algos.offpolicy import discounted_returns, linear_epsilon, mixed_target, soft_updater
 from pamdp.algos.replay import ReplayBuffer
 from pamdp.nn.optim import descend
 
@@ -127,7 +127,7 @@ def test_discounted_returns_by_hand():
 def test_soft_update_is_polyak_averaging():
     target, source = nn.Linear(2, 1), nn.Linear(2, 1)
     before = target.weight.detach().clone()
-    soft_update(target, source, 0.25)
+    soft_updater([(target, source)])(0.25)
     torch.testing.assert_close(target.weight.detach(), 0.75 * before + 0.25 * source.weight.detach())
 
 

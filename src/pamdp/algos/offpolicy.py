@@ -29,7 +29,6 @@ __all__ = [
     "Temperatures",
     "temperature_gradient",
     "OUNoise",
-    "soft_update",
     "soft_updater",
     "linear_epsilon",
     "EpsilonSchedule",
@@ -195,11 +194,6 @@ def temperature_gradient(entropy: torch.Tensor, target: torch.Tensor | float) ->
     """The gradient in ``log alpha`` of SAC's temperature loss ``mean(log alpha * (H - target))``, the entropy
     estimates ``H`` held fixed: ``mean(H - target)`` (why: docs/algorithms.md, "The off-policy family")."""
     return (entropy - target).mean()
-
-
-def soft_update(target: nn.Module, source: nn.Module, tau: float) -> None:
-    """One :func:`soft_updater` step of one pair."""
-    soft_updater([(target, source)])(tau)
 
 
 class OUNoise:
