@@ -247,4 +247,3 @@ def _coerce(name: str, value: Any, hint: Any) -> Any:
     if not type_ok(value, hint):
         raise ValueError(f"setting {name!r} = {value!r}; expected {type_name(hint)}")
     return int(value) if hint is int else value  # plain data: an np.int64 is no JSON
-
