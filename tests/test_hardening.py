@@ -337,12 +337,12 @@ def test_an_output_directory_under_a_file_is_refused_in_one_line(command, traine
 
 
 def test_a_full_disk_is_one_line_naming_the_file(tmp_path, monkeypatch, capsys):
-    import pamdp.algos.checkpoints as checkpoints
+    import pamdp.atomic
 
     def full(path, text):
         raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(path))
 
-    monkeypatch.setattr(checkpoints, "atomic_write_text", full)
+    monkeypatch.setattr(pamdp.atomic, "atomic_write_text", full)
     out = tmp_path / "run"
     message = refusal(["train", "patrpo", "--total-steps", "300", "--out", str(out), *TINY], capsys)
     assert f"{out / 'run.json'}: No space left on device" in message

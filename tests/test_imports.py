@@ -106,6 +106,7 @@ BELOW_THE_ALGORITHMS = {
     "pamdp.spaces": (),
     "pamdp.hints": (),
     "pamdp.logger": (),
+    "pamdp.atomic": (),
 }
 """Each layer below the algorithms (a module, or a package with its modules) and the pamdp modules it may import
 (with theirs)."""

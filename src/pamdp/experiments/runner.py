@@ -245,7 +245,8 @@ def _prepare(
 ) -> tuple[Any, dict | None]:
     """The model to train for ``spec`` in ``out`` (new or resumed) and ``None``, or ``None`` and the evaluation of
     a run already finished. The caller holds ``out``'s :func:`run_lock`."""
-    from pamdp.algos.checkpoints import CHECKPOINT, FINAL_MODEL, atomic_write_text
+    from pamdp.algos.checkpoints import CHECKPOINT, FINAL_MODEL
+    from pamdp.atomic import atomic_write_text
 
     cls, preset, config, warning = run_config or spec.check()
     out = Path(out)
@@ -364,7 +365,8 @@ def _train(model, spec: RunSpec, out: str | os.PathLike, progress_bar: bool, log
 
     ``callback``: ``learn``'s, called after every epoch (and its checkpoint).
     """
-    from pamdp.algos.checkpoints import FINAL_MODEL, atomic_write_text
+    from pamdp.algos.checkpoints import FINAL_MODEL
+    from pamdp.atomic import atomic_write_text
     from pamdp.evaluation import evaluate
 
     out = Path(out)
