@@ -312,7 +312,7 @@ class Algorithm:
                 )
                 stop = False
                 if eval_every > 0 and self.epoch % eval_every == 0:
-                    result = self._greedy_evaluation(eval_episodes)
+                    result = evaluate(self, episodes=eval_episodes, seed=10_000 + self.config.seed)
                     stats.update(_eval_figures(result))
                     stop = callback.on_evaluation(result) is False
                 logger.record(stats, self.num_timesteps)
@@ -332,9 +332,6 @@ class Algorithm:
             bar.close()
             logger.close()
         return self
-
-    def _greedy_evaluation(self, episodes: int) -> dict[str, float]:
-        return evaluate(self, episodes=episodes, seed=10_000 + self.config.seed)
 
     def _shapes(self) -> dict[str, list[int]]:
         """What the networks' sizes follow from: the observation's shape and each action's parameter count."""
