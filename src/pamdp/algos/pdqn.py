@@ -112,12 +112,8 @@ class PDQNConfig(DeterministicActorConfig, OffPolicyConfig, AlgoConfig):
 
 def param_blocks(hybrid: HybridActionSpace) -> np.ndarray:
     """Boolean ``(K, sum_a m_a)``: row ``k`` marks action ``k``'s block of the all-actions parameter vector."""
-    blocks = np.zeros((hybrid.n_actions, hybrid.total_param_size), dtype=bool)
-    start = 0
-    for k, m in enumerate(hybrid.param_sizes):
-        blocks[k, start : start + m] = True
-        start += m
-    return blocks
+    column, start = np.arange(hybrid.total_param_size), hybrid.param_offsets[:, None]
+    return (column >= start) & (column < start + np.array(hybrid.param_sizes)[:, None])
 
 
 class QNetwork(nn.Module):
@@ -145,10 +141,7 @@ class QNetwork(nn.Module):
     def forward(self, obs: torch.Tensor, params: torch.Tensor) -> torch.Tensor:
         if not self.multi_pass:
             return self.net(torch.cat([obs, params], dim=-1))
-        return in_chunks(self._passes, self.n_actions, obs, params)
-
-    def _passes(self, obs: torch.Tensor, params: torch.Tensor) -> torch.Tensor:
-        return self.forward_cached(obs, params)[0]
+        return in_chunks(lambda o, p: self.forward_cached(o, p)[0], self.n_actions, obs, params)
 
     def forward_cached(self, obs: torch.Tensor, params: torch.Tensor) -> tuple[torch.Tensor, tuple]:
         """The ``(B, K)`` values by the hand-written passes of :mod:`pamdp.nn.dense` (differentiable by autograd
