@@ -60,15 +60,6 @@ def resolve_device(name: str) -> torch.device:
     return device
 
 
-def _available(name: str) -> bool:
-    """Whether a ``device`` setting can be had on this machine."""
-    try:
-        resolve_device(name)
-    except ValueError:
-        return False
-    return True
-
-
 def _shown(shapes: dict[str, list[int]]) -> str:
     """An env's shapes (:meth:`Algorithm._shapes`) in a few words, however many actions it has."""
     params = shapes["parameters"]
@@ -385,8 +376,12 @@ class Algorithm:
     @classmethod
     def _from_payload(cls, payload: dict, env=None, device: str | None = None) -> Self:
         config = cls.config_class.from_dict(payload["config"])
-        if device is None:
-            device = config.device if _available(config.device) else "cpu"
+        if device is None:  # the saved setting where this machine has it, else the CPU
+            device = config.device
+            try:
+                resolve_device(device)
+            except ValueError:
+                device = "cpu"
         config = cls.config_class.from_dict({"device": device}, base=config)
         if env is None:
             if payload["env_id"] is None:
