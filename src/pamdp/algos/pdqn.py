@@ -35,7 +35,7 @@ from pamdp.nn.optim import apply_gradients
 from pamdp.policies import DeterministicActor, in_chunks, mlp
 from pamdp.spaces import HybridActionSpace
 
-__all__ = ["PDQN", "PDQNConfig", "QNetwork", "param_blocks"]
+__all__ = ["PDQN", "PDQNConfig", "QNetwork"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -108,12 +108,6 @@ class PDQNConfig(DeterministicActorConfig, OffPolicyConfig, AlgoConfig):
             buffer_size=20_000,
         ),
     }
-
-
-def param_blocks(hybrid: HybridActionSpace) -> np.ndarray:
-    """Boolean ``(K, sum_a m_a)``: row ``k`` marks action ``k``'s block of the all-actions parameter vector."""
-    column, start = np.arange(hybrid.total_param_size), hybrid.param_offsets[:, None]
-    return (column >= start) & (column < start + np.array(hybrid.param_sizes)[:, None])
 
 
 class QNetwork(nn.Module):
@@ -189,7 +183,7 @@ class PDQN(EpsilonSchedule, Algorithm):
         self.actor_optimizer = torch.optim.Adam(self.actor.parameters(), lr=cfg.actor_lr, fused=True)
         self.q_optimizer = torch.optim.Adam(self.q_net.parameters(), lr=cfg.q_lr, fused=True)
         self._bind_networks()
-        self.blocks = torch.as_tensor(param_blocks(h), device=self.device)
+        self.blocks = torch.tensor(h.param_blocks, device=self.device)
         self.loop = OffPolicyLoop(
             self,
             mc_returns=cfg.beta > 0,
