@@ -10,8 +10,7 @@ import torch.nn.functional as F
 
 from pamdp import policies
 from pamdp.algos.pasvg import every_action_q
-from pamdp.algos.pdqn import QNetwork
-from pamdp.policies import GumbelHybridPolicy, HybridPolicy, TwinQ, every_action_linear
+from pamdp.policies import GumbelHybridPolicy, HybridPolicy, QNetwork, TwinQ, every_action_linear
 from pamdp.spaces import HybridActionSpace
 
 SIZES = (2, 0, 1, 3, 1)  # unequal boxes, one without parameters

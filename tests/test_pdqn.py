@@ -15,8 +15,8 @@ from torch import nn
 
 from pamdp import PDQN
 from pamdp.algos.offpolicy import OUNoise, backprop_actor, invert_gradients, mixed_target
-from pamdp.algos.pdqn import PDQNConfig, QNetwork
-from pamdp.policies import DeterministicActor
+from pamdp.algos.pdqn import PDQNConfig
+from pamdp.policies import DeterministicActor, QNetwork
 from pamdp.spaces import HybridActionSpace
 
 SMALL = PDQNConfig(hidden_sizes=(16,), epsilon_steps=300, **OFF_POLICY_SMALL)
