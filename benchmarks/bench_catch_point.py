@@ -19,10 +19,10 @@ import json
 import numpy as np
 from _record import HERE, kept_rows, progress_rows, record_head, seed_by_seed_main, where_unfinished, write_record
 
-from pamdp.algos.logger import success_of
 from pamdp.experiments import Experiment
 from pamdp.experiments.runner import is_finished
 from pamdp.experiments.status import epoch_seconds
+from pamdp.logger import success_of
 
 RECORD = HERE / "catch_point.md"
 ENV = "pamdp/CatchPoint-v0"

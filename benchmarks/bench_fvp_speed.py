@@ -49,7 +49,7 @@ def measure(env_id: str, settings: dict, repeats: int, batch_scale: float) -> di
         model.vec_env, model.policy, model.hybrid, cfg.batch_size, model.np_rng, model.torch_gen
     )
     tensors = update_tensors(advantage_batch(batch, model._values, cfg.gamma, cfg.gae_lambda, True)[0])
-    obs, a, x, _ = tensors
+    obs, a, x, *_ = tensors
     start = {k: v.clone() for k, v in model.policy.state_dict().items()}
     update, product, end = {m: [] for m in METHODS}, {m: [] for m in METHODS}, {}
     for _ in range(repeats):

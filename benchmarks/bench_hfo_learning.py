@@ -27,9 +27,9 @@ from _record import (
     write_record,
 )
 
-from pamdp.algos.logger import success_of
 from pamdp.experiments import load_experiment
 from pamdp.experiments.report import write_report
+from pamdp.logger import success_of
 
 RECORD = HERE / "hfo_learning.md"
 

@@ -64,7 +64,7 @@ def build(label: str):
 
 def updates(model, n: int) -> None:
     """``n`` updates as the training loop makes them (subnormals flushed with the ``flush_denormal`` setting)."""
-    from pamdp.algos.subnormals import subnormals_flushed
+    from pamdp.nn.subnormals import subnormals_flushed
 
     with subnormals_flushed(model.config.flush_denormal):
         for _ in range(n):
@@ -90,7 +90,7 @@ def split(model, n_updates: int) -> dict[str, float]:
     import torch
     from torch.profiler import profile
 
-    from pamdp.algos.optim import clip_grads, optimizer_step
+    from pamdp.nn.optim import clip_grads, optimizer_step
 
     total = cpu_ms(lambda: updates(model, 1), n_updates)
     with profile(record_shapes=True) as prof:

@@ -5,7 +5,8 @@ import os
 import pytest
 import torch
 
-from pamdp.algos.checkpoints import atomic_save, atomic_write_text
+from pamdp.algos.checkpoints import atomic_save
+from pamdp.atomic import atomic_write_text
 
 
 class Interrupted(Exception):

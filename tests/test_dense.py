@@ -1,4 +1,4 @@
-"""The hand-written passes of pamdp.algos.dense against autograd, and PADDPG's update built on them against
+"""The hand-written passes of pamdp.nn.dense against autograd, and PADDPG's update built on them against
 the autograd update it replaced."""
 
 import copy
@@ -11,11 +11,11 @@ from test_hybrid_plumbing import MaskedLine
 from torch import nn
 
 from pamdp import PADDPG, PASVG0
-from pamdp.algos.dense import Dense
 from pamdp.algos.offpolicy import backprop_actor
-from pamdp.algos.optim import clip_grads, optimizer_step
 from pamdp.algos.paddpg import PADDPGConfig
 from pamdp.algos.pasvg import PASVG0Config
+from pamdp.nn.dense import Dense
+from pamdp.nn.optim import clip_grads, optimizer_step
 from pamdp.policies import mlp
 
 

@@ -10,10 +10,10 @@ from gymnasium import spaces
 from loop_stub import stub_algorithm
 
 from pamdp import PATRPO
-from pamdp.algos.logger import EpisodeTracker
 from pamdp.algos.offpolicy import OffPolicyLoop
 from pamdp.algos.paddpg import PADDPGConfig
 from pamdp.algos.patrpo import PATRPOConfig
+from pamdp.envs.stepping import EpisodeTracker
 from pamdp.evaluation import evaluate
 
 

@@ -337,12 +337,12 @@ def test_an_output_directory_under_a_file_is_refused_in_one_line(command, traine
 
 
 def test_a_full_disk_is_one_line_naming_the_file(tmp_path, monkeypatch, capsys):
-    import pamdp.algos.checkpoints as checkpoints
+    import pamdp.atomic
 
     def full(path, text):
         raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(path))
 
-    monkeypatch.setattr(checkpoints, "atomic_write_text", full)
+    monkeypatch.setattr(pamdp.atomic, "atomic_write_text", full)
     out = tmp_path / "run"
     message = refusal(["train", "patrpo", "--total-steps", "300", "--out", str(out), *TINY], capsys)
     assert f"{out / 'run.json'}: No space left on device" in message
@@ -410,7 +410,7 @@ def test_ctrl_c_before_the_first_checkpoint_says_there_is_nothing_to_resume(tmp_
 def test_a_log_resumed_from_a_checkpoint_keeps_the_checkpoints_epoch_in_tensorboard(tmp_path):
     from tensorboard.backend.event_processing.event_accumulator import EventAccumulator
 
-    from pamdp.algos.logger import Logger
+    from pamdp.logger import Logger
 
     logger = Logger(tmp_path)
     for step in (100, 200, 300):  # a run killed after logging epoch 300, whose last checkpoint was at 200

@@ -14,8 +14,8 @@ from gymnasium import spaces
 
 from pamdp.algos import ALGORITHMS, algorithm_class
 from pamdp.algos.offpolicy import uniform_actions
-from pamdp.algos.vector_env import info_action_masks
 from pamdp.distributions import MASKED, HybridDistribution, kl_divergence, masked_logits
+from pamdp.envs.stepping import info_action_masks
 from pamdp.policies import HybridPolicy
 from pamdp.spaces import HybridActionSpace
 from pamdp.wrappers import DiscretizeHybridAction, FlattenHybridAction

@@ -1,5 +1,7 @@
 """The package's layers, read from its source: imports without a circle, algorithms that import family modules and
-never each other, and an algorithms' package that knows no env (the env presets live above it, in presets/)."""
+never each other, an algorithms' package that knows no env (the env presets live above it, in presets/) but makes
+and steps its envs through envs/' backends and stepping, and the layers below the algorithms (the envs, the
+networks and the updates' building blocks, the evaluation, the logger) that import nothing above them."""
 
 from __future__ import annotations
 
@@ -80,11 +82,48 @@ def test_an_algorithm_imports_no_other_algorithm(name):
     assert GRAPH[own] & others == set()
 
 
+ENV_SERVICES = ("pamdp.envs.backends", "pamdp.envs.stepping")
+"""What the algorithms use of envs/: how an env is made, and how its copies are stepped and their episodes counted."""
+
+
 @pytest.mark.parametrize("module", ALGOS)
 def test_the_algorithms_know_no_env(module):
-    # The envs, their presets and the experiments sit above the algorithms: an algorithm trains on whatever env it
-    # is given, and a preset that needs an env's layout (Masson's start on Goal) gives it as data.
+    # The envs' domains, their presets and the experiments sit above the algorithms: an algorithm trains on whatever
+    # env it is given (made and stepped by ENV_SERVICES, which know no domain), and a preset that needs an env's
+    # layout (Masson's start on Goal) gives it as data.
     above = ("pamdp.presets", "pamdp.envs", "pamdp.experiments", "pamdp.cli")
-    assert sorted(m for m in GRAPH[module] if m == "pamdp" or m.startswith(above)) == []
+    assert sorted(m for m in GRAPH[module] if (m == "pamdp" or m.startswith(above)) and m not in ENV_SERVICES) == []
     env_ids = re.findall(r"pamdp/\w+-v\d+", module_path(module).read_text())
     assert env_ids == []
+
+
+BELOW_THE_ALGORITHMS = {
+    "pamdp.envs": ("pamdp.envs", "pamdp.spaces", "pamdp.hints"),  # a domain, and the envs' backends, know no learner
+    "pamdp.evaluation": ENV_SERVICES,
+    "pamdp.policies": ("pamdp.distributions", "pamdp.spaces", "pamdp.nn"),
+    "pamdp.nn": ("pamdp.nn",),
+    "pamdp.distributions": (),
+    "pamdp.spaces": (),
+    "pamdp.hints": (),
+    "pamdp.logger": (),
+    "pamdp.atomic": (),
+}
+"""Each layer below the algorithms (a module, or a package with its modules) and the pamdp modules it may import
+(with theirs)."""
+
+
+@pytest.mark.parametrize("layer", BELOW_THE_ALGORITHMS)
+def test_a_layer_below_the_algorithms_imports_nothing_above_it(layer):
+    allowed = BELOW_THE_ALGORITHMS[layer]
+    modules = [m for m in GRAPH if m == layer or m.startswith(layer + ".")]
+    assert modules, f"no module {layer}"
+    outside = sorted(
+        f"{m} -> {i}" for m in modules for i in GRAPH[m] if not any(i == a or i.startswith(a + ".") for a in allowed)
+    )
+    assert outside == []
+
+
+def test_the_layer_rule_finds_an_env_module_that_imports_the_algorithms(monkeypatch):
+    monkeypatch.setitem(GRAPH, "pamdp.envs.backends", GRAPH["pamdp.envs.backends"] | {"pamdp.algos.settings"})
+    with pytest.raises(AssertionError, match=r"pamdp\.envs\.backends -> pamdp\.algos\.settings"):
+        test_a_layer_below_the_algorithms_imports_nothing_above_it("pamdp.envs")

@@ -10,8 +10,7 @@ import torch.nn.functional as F
 
 from pamdp import policies
 from pamdp.algos.pasvg import every_action_q
-from pamdp.algos.pdqn import QNetwork, param_blocks
-from pamdp.policies import GumbelHybridPolicy, HybridPolicy, TwinQ, every_action_linear
+from pamdp.policies import GumbelHybridPolicy, HybridPolicy, QNetwork, TwinQ, every_action_linear
 from pamdp.spaces import HybridActionSpace
 
 SIZES = (2, 0, 1, 3, 1)  # unequal boxes, one without parameters
@@ -50,7 +49,7 @@ def assert_same_function(module, fast, explicit, *args):
 @pytest.mark.parametrize("activation", ["leaky_relu", "tanh"])
 def test_multi_pass_q_is_the_explicit_b_times_k_passes(activation):
     q_net = randomised(QNetwork(D, HYBRID, (7, 5), activation, multi_pass=True))
-    blocks = torch.as_tensor(param_blocks(HYBRID), dtype=torch.float64)  # pass k keeps block k only
+    blocks = torch.tensor(HYBRID.param_blocks, dtype=torch.float64)  # pass k keeps block k only
 
     def explicit(obs, params):  # Bester et al.'s construction: B * K inputs, K outputs each, Q_k of pass k
         passes = torch.cat([obs.unsqueeze(1).expand(B, K, D), params.unsqueeze(1) * blocks], -1)
@@ -61,7 +60,7 @@ def test_multi_pass_q_is_the_explicit_b_times_k_passes(activation):
 
 def test_multi_pass_q_loads_a_model_saved_with_the_block_table():
     q_net = QNetwork(D, HYBRID, (7,), "relu", multi_pass=True)
-    saved = {**q_net.state_dict(), "blocks": torch.as_tensor(param_blocks(HYBRID), dtype=torch.float32)}
+    saved = {**q_net.state_dict(), "blocks": torch.tensor(HYBRID.param_blocks, dtype=torch.float32)}
     fresh = QNetwork(D, HYBRID, (7,), "relu", multi_pass=True)
     fresh.load_state_dict(saved)
     for name, tensor in q_net.state_dict().items():

@@ -88,7 +88,7 @@ def float64_batch(model: PATRPO, n: int) -> tuple[torch.Tensor, ...]:
     batch = model.loop.collect(n)
     model.policy.double()
     data, _ = advantage_batch(batch, model._values, cfg.gamma, cfg.gae_lambda, True)
-    return tuple(t.double() if t.is_floating_point() else t for t in update_tensors(data))
+    return tuple(t.double() if t is not None and t.is_floating_point() else t for t in update_tensors(data))
 
 
 @pytest.mark.parametrize("estimator", ["chain_analytic", "chain_sample"])
@@ -116,7 +116,7 @@ def test_an_update_without_a_direction_is_logged_as_skipped_not_as_a_failed_line
     """Zero advantages and no entropy bonus: the surrogate's gradient is exactly zero, conjugate gradients return
     the zero direction, and the policy stays as it is without a line search (catch_point.md: a collapsed pi_d)."""
     model = PATRPO("pamdp/Platform-v0", PATRPOConfig.from_dict({"entropy_coef": 0.0}, base=SMALL))
-    obs, a, x, adv = float64_batch(model, 200)[:4]
+    obs, a, x, adv, _ = float64_batch(model, 200)
     before = flat_params(list(model.policy.parameters()))
     stats = model._update_policy(obs, a, x, torch.zeros_like(adv))
     assert stats["train/update_skipped"] == 1.0 and stats["train/backtracks"] == 0.0 and stats["train/kl"] == 0.0
@@ -205,7 +205,7 @@ def test_an_update_takes_the_natural_step_of_its_kl_estimators_explicit_hessian(
     settings = {"hidden_sizes": [6], "kl_estimator": estimator, "delta": 1e-3, "cg_iters": 200, "cg_damping": 1e-2}
     cfg = PATRPOConfig.from_dict(settings, SMALL)
     model = PATRPO("pamdp/Platform-v0", cfg)
-    obs, a, x, adv = float64_batch(model, 300)
+    obs, a, x, adv, _ = float64_batch(model, 300)
     params = [p for p in model.policy.parameters() if p.requires_grad]
     with torch.no_grad():
         old = model.policy(obs).detach()

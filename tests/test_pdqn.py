@@ -15,8 +15,8 @@ from torch import nn
 
 from pamdp import PDQN
 from pamdp.algos.offpolicy import OUNoise, backprop_actor, invert_gradients, mixed_target
-from pamdp.algos.pdqn import PDQNConfig, QNetwork, param_blocks
-from pamdp.policies import DeterministicActor
+from pamdp.algos.pdqn import PDQNConfig
+from pamdp.policies import DeterministicActor, QNetwork
 from pamdp.spaces import HybridActionSpace
 
 SMALL = PDQNConfig(hidden_sizes=(16,), epsilon_steps=300, **OFF_POLICY_SMALL)
@@ -25,7 +25,7 @@ BLOCKS = [slice(0, 1), slice(1, 3), slice(3, 4)]
 
 
 def test_parameter_blocks_and_selection_by_hand():
-    np.testing.assert_array_equal(param_blocks(HYBRID), [[1, 0, 0, 0], [0, 1, 1, 0], [0, 0, 0, 1]])
+    np.testing.assert_array_equal(HYBRID.param_blocks, [[1, 0, 0, 0], [0, 1, 1, 0], [0, 0, 0, 1]])
     actor = DeterministicActor(5, 4, (8,), "relu", False, HYBRID)
     params = torch.tensor([[0.1, 0.2, 0.3, 0.4]] * 3)
     x = actor.select(params, torch.tensor([0, 1, 2]))
@@ -198,7 +198,7 @@ def test_explore_params_redraws_only_the_random_actions_parameters():
         clean = model.actor(obs).clamp(-1, 1)
         a, x, extras = model._explore(obs, 0, np.zeros(2000, dtype=bool), None)
     params = torch.from_numpy(extras["params"])
-    chosen = torch.from_numpy(param_blocks(model.hybrid))[a]
+    chosen = torch.tensor(model.hybrid.param_blocks)[a]
     torch.testing.assert_close(params[~chosen], clean[~chosen])  # the other actions keep the actor's
     drawn = params[chosen].numpy()
     assert drawn.min() < -0.9 and drawn.max() > 0.9 and abs(drawn.mean()) < 0.05  # uniform in [-1, 1]

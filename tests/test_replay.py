@@ -8,9 +8,9 @@ import torch
 from loop_stub import stub_algorithm
 from torch import nn
 
-from pamdp.algos.offpolicy import discounted_returns, linear_epsilon, mixed_target, soft_update
-from pamdp.algos.optim import descend
+from pamdp.algos.offpolicy import discounted_returns, linear_epsilon, mixed_target, soft_updater
 from pamdp.algos.replay import ReplayBuffer
+from pamdp.nn.optim import descend
 
 FIELDS = {"obs": ((2,), np.float32), "a": ((), np.int64), "eta": ((3,), np.float32)}
 
@@ -127,7 +127,7 @@ def test_discounted_returns_by_hand():
 def test_soft_update_is_polyak_averaging():
     target, source = nn.Linear(2, 1), nn.Linear(2, 1)
     before = target.weight.detach().clone()
-    soft_update(target, source, 0.25)
+    soft_updater([(target, source)])(0.25)
     torch.testing.assert_close(target.weight.detach(), 0.75 * before + 0.25 * source.weight.detach())
 
 
@@ -154,7 +154,7 @@ def test_epoch_stats_average_each_figure_over_the_updates_that_computed_it():
     """A figure computed every third update (a delayed actor step) is the mean of those steps, not diluted."""
     from pamdp.algos.offpolicy import OffPolicyLoop
     from pamdp.algos.paddpg import PADDPGConfig
-    from pamdp.algos.vector_env import make_vector_env
+    from pamdp.envs.backends import make_vector_env
     from pamdp.spaces import HybridActionSpace
 
     env = make_vector_env("pamdp/Platform-v0", 4)
@@ -182,7 +182,7 @@ def test_reward_scale_scales_what_the_critics_learn_from_and_nothing_the_user_se
     Monte-Carlo returns are the other's times 1/50, its logged episode returns the same."""
     from pamdp.algos.offpolicy import OffPolicyLoop
     from pamdp.algos.paddpg import PADDPGConfig
-    from pamdp.algos.vector_env import make_vector_env
+    from pamdp.envs.backends import make_vector_env
     from pamdp.spaces import HybridActionSpace
 
     def run(scale):

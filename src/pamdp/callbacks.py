@@ -29,7 +29,7 @@ import numpy as np
 from pamdp.evaluation import evaluate
 
 if TYPE_CHECKING:
-    from pamdp.algos.logger import Logger
+    from pamdp.logger import Logger
 
 Algorithm = Any
 """A model, any :class:`~pamdp.algos.base.Algorithm` (the learn loop in ``pamdp.algos.base`` imports this module,
@@ -77,7 +77,7 @@ class BaseCallback:
         self.model: Algorithm | None = None
         """The model being trained."""
         self.logger: Logger | None = None
-        """The run's logger: :meth:`Logger.record <pamdp.algos.logger.Logger.record>` at :attr:`num_timesteps`
+        """The run's logger: :meth:`Logger.record <pamdp.logger.Logger.record>` at :attr:`num_timesteps`
         adds figures to the epoch's row of ``progress.csv``, its TensorBoard scalars and every tracker."""
 
     def init_callback(self, model: Algorithm, logger: Logger) -> None:
@@ -246,7 +246,7 @@ class EvalCallback(BaseCallback):
         callback_after_eval: BaseCallback | None = None,
     ):
         super().__init__()
-        from pamdp.algos.vector_env import check_env_kwargs
+        from pamdp.envs.backends import check_env_kwargs
 
         if eval_env is not None and not isinstance(eval_env, str):
             raise ValueError(f"eval_env = {eval_env!r:.80}; expected a registered env id (a str) or None")

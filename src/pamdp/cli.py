@@ -520,7 +520,7 @@ SUCCESS_WORDS = {
 def _format_evaluation(result: dict, policy: str = "greedy", env_id: str | None = None) -> str:
     """One line: ``policy`` (greedy, or stochastic) return, length, and, where the env reports success, the
     success rate (the goal rate on the soccer envs) and the mean steps of the successful episodes."""
-    from pamdp.algos.logger import success_of
+    from pamdp.logger import success_of
 
     text = (
         f"{policy} return over {result['episodes']} episodes: {result['mean_return']:.4f} +- {result['std_return']:.4f}"
@@ -552,7 +552,7 @@ def cmd_render(args) -> int:
 
     import pamdp  # noqa: F401  (registers the envs)
     from pamdp.algos import load_model
-    from pamdp.algos.vector_env import env_creator
+    from pamdp.envs.backends import env_creator
     from pamdp.envs.rendering import record_episode
     from pamdp.spaces import HybridActionSpace
 

@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from pamdp.algos.logger import success_summary
-from pamdp.algos.vector_env import VectorStepper, make_vector_env
+from pamdp.envs.backends import make_vector_env
+from pamdp.envs.stepping import VectorStepper, success_summary
 
 __all__ = ["evaluate"]
 

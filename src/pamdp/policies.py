@@ -31,6 +31,7 @@ from pamdp.distributions import (
     gumbel_softmax_sample,
     masked_logits,
 )
+from pamdp.nn.dense import Dense, MultiPassDense
 from pamdp.spaces import HybridActionSpace
 
 __all__ = [
@@ -50,6 +51,7 @@ __all__ = [
     "HybridSACActor",
     "ValueNetwork",
     "TwinQ",
+    "QNetwork",
     "DeterministicActor",
 ]
 
@@ -432,6 +434,58 @@ class TwinQ(nn.Module):
     def smaller(self, obs: torch.Tensor, *inputs: torch.Tensor) -> torch.Tensor:
         q1, q2 = self(obs, *inputs)
         return q1 if q2 is None else torch.minimum(q1, q2)
+
+
+class QNetwork(nn.Module):
+    """``Q(s, x)``: K action values from the state and every action's parameters.
+
+    With ``multi_pass`` (MP-DQN), ``Q_k`` is read from a pass that sees only ``x_k``. The passes' input rows are
+    never built: pass ``k``'s first layer is ``W_s s + W_k x_k + b`` and its output layer computes ``Q_k`` alone,
+    the same function at ``K`` times fewer operations; the passes are one flat batch of ``K * B`` rows, pass
+    ``k``'s a contiguous block (a strided layout walked memory slowly; :class:`~pamdp.nn.dense.MultiPassDense`
+    differentiates it by hand).
+    """
+
+    def __init__(self, obs_dim: int, hybrid: HybridActionSpace, hidden_sizes, activation: str, multi_pass: bool):
+        super().__init__()
+        self.n_actions = hybrid.n_actions
+        self.multi_pass = multi_pass
+        self.net = mlp(obs_dim + hybrid.total_param_size, hidden_sizes, hybrid.n_actions, activation)
+        index = torch.tensor(hybrid.param_index, dtype=torch.long)
+        mask = torch.tensor(hybrid.param_mask, dtype=torch.float32)
+        self.obs_dim = obs_dim
+        self.register_buffer("param_index", index, persistent=False)
+        self.register_buffer("param_mask", mask, persistent=False)
+        self.register_buffer("param_order", MultiPassDense.block_order(index, mask), persistent=False)
+
+    def forward(self, obs: torch.Tensor, params: torch.Tensor) -> torch.Tensor:
+        if not self.multi_pass:
+            return self.net(torch.cat([obs, params], dim=-1))
+        return in_chunks(lambda o, p: self.forward_cached(o, p)[0], self.n_actions, obs, params)
+
+    def forward_cached(self, obs: torch.Tensor, params: torch.Tensor) -> tuple[torch.Tensor, tuple]:
+        """The ``(B, K)`` values by the hand-written passes of :mod:`pamdp.nn.dense` (differentiable by autograd
+        too), with what :meth:`backward` needs."""
+        if not self.multi_pass:
+            net = Dense.of(self.net)
+            q, cache = net.forward_cached(torch.cat([obs, params], dim=-1))
+        else:
+            net = MultiPassDense.of(self.net, self.obs_dim, self.param_index, self.param_mask, self.param_order)
+            q, cache = net.forward_cached(obs, params)
+        return q, (net, cache)
+
+    def backward(self, cached: tuple, grad: torch.Tensor, weights: bool = True) -> list[torch.Tensor] | torch.Tensor:
+        """From :meth:`forward_cached`'s cache and d loss / d Q ``(B, K)``: the gradients in the order of
+        ``parameters()`` if ``weights``, else d loss / d params ``(B, sum_a m_a)``."""
+        net, cache = cached
+        if weights:
+            return net.backward(cache, grad)[0]
+        d_in = net.backward(cache, grad, weights=False, inputs=True)[1]
+        return d_in if self.multi_pass else d_in[:, self.obs_dim :]
+
+    def _load_from_state_dict(self, state_dict, prefix, *args, **kwargs):
+        state_dict.pop(prefix + "blocks", None)  # models saved before the block table was dropped hold it
+        super()._load_from_state_dict(state_dict, prefix, *args, **kwargs)
 
 
 class DeterministicActor(nn.Module):

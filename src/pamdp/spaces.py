@@ -118,6 +118,12 @@ class HybridActionSpace:
         return _frozen(np.where(self.param_mask, self.param_offsets[:, None] + np.arange(self.max_param_size), 0))
 
     @cached_property
+    def param_blocks(self) -> np.ndarray:
+        """Boolean ``(K, sum_a m_a)``: row ``a`` marks action ``a``'s block of the all-parameters vector."""
+        column, start = np.arange(self.total_param_size), self.param_offsets[:, None]
+        return _frozen((column >= start) & (column < start + np.array(self.param_sizes)[:, None]))
+
+    @cached_property
     def padded_low(self) -> np.ndarray:
         """``(K, m)`` lower bounds, padded with -1 (unused entries map identically)."""
         return self._padded(self.lows, -1.0)

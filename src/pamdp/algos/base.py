@@ -27,11 +27,11 @@ from gymnasium.vector import AutoresetMode
 
 from pamdp._version import __version__
 from pamdp.algos.checkpoints import CHECKPOINT, FORMAT, atomic_save, read_checkpoint
-from pamdp.algos.logger import Logger
 from pamdp.algos.settings import AlgoConfig
-from pamdp.algos.vector_env import describe_env, make_vector_env
 from pamdp.callbacks import BaseCallback, _count, _eval_figures, as_callback
+from pamdp.envs.backends import describe_env, make_vector_env
 from pamdp.evaluation import evaluate
+from pamdp.logger import Logger
 from pamdp.spaces import HybridActionSpace
 
 if TYPE_CHECKING:
@@ -58,15 +58,6 @@ def resolve_device(name: str) -> torch.device:
                 f"expected 'cuda' or 'cuda:N' with N < {torch.cuda.device_count()}"
             )
     return device
-
-
-def _available(name: str) -> bool:
-    """Whether a ``device`` setting can be had on this machine."""
-    try:
-        resolve_device(name)
-    except ValueError:
-        return False
-    return True
 
 
 def _shown(shapes: dict[str, list[int]]) -> str:
@@ -312,7 +303,7 @@ class Algorithm:
                 )
                 stop = False
                 if eval_every > 0 and self.epoch % eval_every == 0:
-                    result = self._greedy_evaluation(eval_episodes)
+                    result = evaluate(self, episodes=eval_episodes, seed=10_000 + self.config.seed)
                     stats.update(_eval_figures(result))
                     stop = callback.on_evaluation(result) is False
                 logger.record(stats, self.num_timesteps)
@@ -332,9 +323,6 @@ class Algorithm:
             bar.close()
             logger.close()
         return self
-
-    def _greedy_evaluation(self, episodes: int) -> dict[str, float]:
-        return evaluate(self, episodes=episodes, seed=10_000 + self.config.seed)
 
     def _shapes(self) -> dict[str, list[int]]:
         """What the networks' sizes follow from: the observation's shape and each action's parameter count."""
@@ -388,8 +376,12 @@ class Algorithm:
     @classmethod
     def _from_payload(cls, payload: dict, env=None, device: str | None = None) -> Self:
         config = cls.config_class.from_dict(payload["config"])
-        if device is None:
-            device = config.device if _available(config.device) else "cpu"
+        if device is None:  # the saved setting where this machine has it, else the CPU
+            device = config.device
+            try:
+                resolve_device(device)
+            except ValueError:
+                device = "cpu"
         config = cls.config_class.from_dict({"device": device}, base=config)
         if env is None:
             if payload["env_id"] is None:

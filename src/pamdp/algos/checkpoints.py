@@ -1,6 +1,6 @@
-"""Checkpoints and atomic writes.
+"""Checkpoints: reading and writing them, and starting a model's networks from another's.
 
-A checkpoint is one file written atomically (a temporary file, fsync, rename) holding tensors and plain data
+A checkpoint is one file written atomically (:func:`pamdp.atomic.atomic_write`) holding tensors and plain data
 only; it is read back with ``torch.load(weights_only=True)``, so loading never executes code. Loading a model whichever
 algorithm wrote it is the registry's :func:`pamdp.algos.load_model`.
 """
@@ -8,19 +8,17 @@ algorithm wrote it is the registry's :func:`pamdp.algos.load_model`.
 from __future__ import annotations
 
 import os
-import tempfile
-from collections.abc import Callable
 from pathlib import Path
-from typing import IO
 
 import torch
+
+from pamdp.atomic import atomic_write
 
 __all__ = [
     "FINAL_MODEL",
     "CHECKPOINT",
     "FORMAT",
     "atomic_save",
-    "atomic_write_text",
     "read_checkpoint",
     "transfer_weights",
 ]
@@ -44,41 +42,9 @@ RENAMED = {
 ``network.key``: :func:`read_checkpoint` moves them, so that files written before still load."""
 
 
-def _umask() -> int:
-    mask = os.umask(0)  # the only way to read it is to set it
-    os.umask(mask)
-    return mask
-
-
-def _atomic_write(path: str | os.PathLike, write: Callable[[IO[bytes]], object], example: str) -> None:
-    """``write`` into a temporary file beside ``path``, fsync, then rename it over ``path``: a reader (or a run
-    killed mid-write) sees the old file or the new one, never a part."""
-    path = Path(path)
-    if path.is_dir():
-        raise ValueError(f"cannot save to {path}: it is a directory; expected a file path such as {path / example}")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp's file is private (0600); the file gets what open() would give
-        with os.fdopen(fd, "wb") as f:
-            write(f)
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.remove(tmp)
-        raise
-
-
 def atomic_save(payload: dict, path: str | os.PathLike) -> None:
     """``torch.save`` to a temporary file beside ``path``, fsync, then rename over it."""
-    _atomic_write(path, lambda f: torch.save(payload, f), "model.pt")
-
-
-def atomic_write_text(path: str | os.PathLike, text: str) -> None:
-    """Write ``text`` (UTF-8) to ``path`` atomically, as :func:`atomic_save` does a checkpoint."""
-    _atomic_write(path, lambda f: f.write(text.encode()), "run.json")
+    atomic_write(path, lambda f: torch.save(payload, f), "model.pt")
 
 
 def _resolve_model_path(path: str | os.PathLike) -> Path:

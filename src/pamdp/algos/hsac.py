@@ -15,9 +15,9 @@ import torch.nn.functional as F
 
 from pamdp.algos.base import Algorithm
 from pamdp.algos.offpolicy import OffPolicyConfig, OffPolicyLoop, Temperatures, soft_updater
-from pamdp.algos.optim import descend
 from pamdp.algos.settings import NON_NEGATIVE, POSITIVE, AlgoConfig, Check, interval, one_of, setting
 from pamdp.distributions import MASKED, SquashedHybrid
+from pamdp.nn.optim import descend
 from pamdp.policies import FORMS, HybridSACActor, TwinQ
 
 __all__ = ["HybridSAC", "HybridSACConfig"]

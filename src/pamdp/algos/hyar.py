@@ -26,9 +26,9 @@ from pamdp.algos.offpolicy import (
     soft_updater,
     uniform_actions,
 )
-from pamdp.algos.optim import apply_gradients, descend
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, AlgoConfig, at_least, interval, one_of, setting
 from pamdp.distributions import LOG_STD_MAX, LOG_STD_MIN, masked_logits
+from pamdp.nn.optim import apply_gradients, descend
 from pamdp.policies import ACTIVATIONS, DeterministicActor, TwinQ, mlp
 from pamdp.spaces import HybridActionSpace
 

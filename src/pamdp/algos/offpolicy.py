@@ -14,12 +14,12 @@ import numpy as np
 import torch
 from torch import nn
 
-from pamdp.algos.optim import apply_gradients
 from pamdp.algos.replay import ReplayBuffer, transition_fields
 from pamdp.algos.settings import LAYERS, NON_NEGATIVE, POSITIVE, at_least, interval, one_of, redeclared, setting
-from pamdp.algos.subnormals import subnormals_flushed
-from pamdp.algos.vector_env import Step, VectorStepper
 from pamdp.distributions import masked_logits
+from pamdp.envs.stepping import Step, VectorStepper
+from pamdp.nn.optim import apply_gradients
+from pamdp.nn.subnormals import subnormals_flushed
 from pamdp.policies import ACTIVATIONS
 
 __all__ = [
@@ -29,7 +29,6 @@ __all__ = [
     "Temperatures",
     "temperature_gradient",
     "OUNoise",
-    "soft_update",
     "soft_updater",
     "linear_epsilon",
     "EpsilonSchedule",
@@ -197,11 +196,6 @@ def temperature_gradient(entropy: torch.Tensor, target: torch.Tensor | float) ->
     return (entropy - target).mean()
 
 
-def soft_update(target: nn.Module, source: nn.Module, tau: float) -> None:
-    """One :func:`soft_updater` step of one pair."""
-    soft_updater([(target, source)])(tau)
-
-
 class OUNoise:
     """Ornstein-Uhlenbeck exploration noise, one process per env copy: ``n <- n - theta n + sigma N(0, 1)``.
 
@@ -310,7 +304,7 @@ def backprop_actor(
     params: Sequence[torch.Tensor],
 ) -> tuple[torch.Tensor, torch.Tensor, tuple[torch.Tensor, ...]]:
     """Back-propagate ``-mean_s Q(s, mu(s))`` into the actor's ``params``, with ``dQ/dmu`` edited by ``bound`` on
-    the way (for :func:`~pamdp.algos.optim.apply_gradients`).
+    the way (for :func:`~pamdp.nn.optim.apply_gradients`).
 
     ``Q`` is summed over its last axis if it has one (P-DQN's K values). The critic's weights get no gradient.
     Returns the actor's outputs and ``Q(s, mu(s))``, detached, and the gradients in ``params``.

@@ -12,8 +12,8 @@ import numpy as np
 import torch
 
 from pamdp.algos.settings import LAYERS, at_least, interval, one_of, setting
-from pamdp.algos.subnormals import subnormals_flushed
-from pamdp.algos.vector_env import VectorStepper
+from pamdp.envs.stepping import VectorStepper
+from pamdp.nn.subnormals import subnormals_flushed
 from pamdp.policies import ACTIVATIONS, PI_C_INPUTS, HybridPolicy
 
 __all__ = [
@@ -63,7 +63,7 @@ class OnPolicyConfig:
 class OnPolicy:
     """What PATRPO and PAPPO do alike as algorithms, a base beside :class:`~pamdp.algos.base.Algorithm` (as
     :class:`~pamdp.algos.offpolicy.EpsilonSchedule` is for off-policy ones): their hierarchical ``policy`` acts,
-    their ``value`` network is the baseline, and their updates read an :func:`advantage_batch` alike."""
+    their ``value`` network is the baseline, and ``train/param_std`` is their parameter noise's."""
 
     def _act(self, obs, deterministic, mask=None):
         return self.policy.act(obs, mask, deterministic, self.torch_gen)
@@ -73,12 +73,6 @@ class OnPolicy:
         for GAE."""
         with torch.no_grad():
             return self.value(self._obs_tensor(obs)).double().cpu().numpy()
-
-    def _update_tensors(self, data: dict[str, np.ndarray]) -> tuple[torch.Tensor, ...]:
-        """``(obs, a, x, adv, mask)`` of an :func:`advantage_batch` on the algorithm's device: :func:`update_tensors`
-        and the samples' allowed actions ``(B, K)`` (``None`` without masks)."""
-        mask = torch.as_tensor(data["mask"], device=self.device) if "mask" in data else None
-        return (*update_tensors(data, self.device), mask)
 
     def _param_std(self) -> float:
         """``train/param_std``: the parameter noise's std, averaged over the parameters the actions have."""
@@ -226,16 +220,16 @@ def advantage_batch(
     return data, explained_var
 
 
-def update_tensors(
-    data: dict[str, np.ndarray], device: torch.device | str = "cpu"
-) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
-    """The policy update's tensors ``(obs, a, x, adv)`` of an :func:`advantage_batch` on ``device`` (observations
-    and advantages in float32, the networks' precision)."""
+def update_tensors(data: dict[str, np.ndarray], device: torch.device | str = "cpu") -> tuple[torch.Tensor, ...]:
+    """The policy update's tensors ``(obs, a, x, adv, mask)`` of an :func:`advantage_batch` on ``device``
+    (observations and advantages in float32, the networks' precision; ``mask``, the samples' allowed actions
+    ``(B, K)``, ``None`` without masks)."""
     return (
         torch.as_tensor(np.asarray(data["obs"], dtype=np.float32), device=device),
         torch.as_tensor(data["a"], device=device),
         torch.as_tensor(data["x"], device=device),
         torch.as_tensor(data["adv"], dtype=torch.float32, device=device),
+        torch.as_tensor(data["mask"], device=device) if "mask" in data else None,
     )
 
 

@@ -2,7 +2,7 @@
 
 The actor outputs K action scores and every action's parameters in one vector, kept in ``[-1, 1]`` by ``bound``
 (:func:`~pamdp.algos.offpolicy.invert_gradients` by default); the critic sees the whole vector. The update is
-back-propagated by hand (:mod:`pamdp.algos.dense`; ``tests/test_dense.py`` holds the autograd form it must
+back-propagated by hand (:mod:`pamdp.nn.dense`; ``tests/test_dense.py`` holds the autograd form it must
 equal). The maths: docs/algorithms.md, "PADDPG".
 """
 
@@ -15,7 +15,6 @@ import numpy as np
 import torch
 
 from pamdp.algos.base import Algorithm
-from pamdp.algos.dense import Dense
 from pamdp.algos.offpolicy import (
     DeterministicActorConfig,
     EpsilonSchedule,
@@ -25,8 +24,9 @@ from pamdp.algos.offpolicy import (
     bounded,
     soft_updater,
 )
-from pamdp.algos.optim import apply_gradients
 from pamdp.algos.settings import POSITIVE, AlgoConfig, interval, setting
+from pamdp.nn.dense import Dense
+from pamdp.nn.optim import apply_gradients
 from pamdp.policies import DeterministicActor, TwinQ
 
 __all__ = ["PADDPG", "PADDPGConfig"]
@@ -94,7 +94,7 @@ class PADDPG(EpsilonSchedule, Algorithm):
         self._ou = OUNoise(cfg.ou_theta, cfg.ou_sigma)
 
     def _bind_networks(self) -> None:
-        """The update's hand-written passes (:mod:`pamdp.algos.dense`) over the modules' own tensors; called
+        """The update's hand-written passes (:mod:`pamdp.nn.dense`) over the modules' own tensors; called
         again by whoever replaces a module."""
         self._dense = {name: Dense.of(getattr(self, name).net) for name in ("actor", "actor_target")}
         self._dense.update({name: Dense.of(getattr(self, name).q1) for name in ("critic", "critic_target")})
@@ -136,7 +136,7 @@ class PADDPG(EpsilonSchedule, Algorithm):
 
     def _update(self) -> dict[str, torch.Tensor]:
         """One critic step on the mixed target and one actor step along the bounded ``dQ/dmu``, back-propagated
-        by hand through the :mod:`~pamdp.algos.dense` views of the networks."""
+        by hand through the :mod:`~pamdp.nn.dense` views of the networks."""
         cfg = self.config
         b = self.replay.sample(cfg.batch_size, self.np_rng)
         obs, next_obs = b["obs"], b["next_obs"]

@@ -14,10 +14,10 @@ import numpy as np
 import torch
 
 from pamdp.algos.base import Algorithm
-from pamdp.algos.onpolicy import OnPolicy, OnPolicyConfig, Rollout, hybrid_policy
-from pamdp.algos.optim import descend
+from pamdp.algos.onpolicy import OnPolicy, OnPolicyConfig, Rollout, hybrid_policy, update_tensors
 from pamdp.algos.settings import NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, setting
 from pamdp.distributions import HybridDistribution, kl_divergence
+from pamdp.nn.optim import descend
 from pamdp.policies import ValueNetwork
 
 __all__ = ["PAPPO", "PAPPOConfig", "clipped_surrogate", "ppo_loss"]
@@ -136,7 +136,7 @@ class PAPPO(OnPolicy, Algorithm):
     def _learn(self, data: dict[str, np.ndarray]) -> dict[str, float]:
         """:meth:`_update` on an :func:`~pamdp.algos.onpolicy.advantage_batch` (the epoch: Rollout.run_epoch)."""
         returns = torch.as_tensor(data["returns"], dtype=torch.float32, device=self.device)
-        obs, a, x, adv, mask = self._update_tensors(data)
+        obs, a, x, adv, mask = update_tensors(data, self.device)
         return self._update(obs, a, x, adv, returns, mask)
 
     def _update(self, obs, a, x, adv, returns, mask=None) -> dict[str, float]:

@@ -18,11 +18,11 @@ import torch
 import torch.nn.functional as F
 
 from pamdp.algos.base import Algorithm
-from pamdp.algos.dense import Dense
 from pamdp.algos.offpolicy import OffPolicyConfig, OffPolicyLoop, Temperatures, soft_updater, uniform_actions
-from pamdp.algos.optim import apply_gradients, descend
 from pamdp.algos.settings import NON_NEGATIVE, POSITIVE, AlgoConfig, Check, at_least, interval, one_of, setting
 from pamdp.distributions import LOG_STD_MAX, LOG_STD_MIN, gumbel_noise, masked_logits
+from pamdp.nn.dense import Dense
+from pamdp.nn.optim import apply_gradients, descend
 from pamdp.policies import GumbelHybridPolicy, TwinQ, every_action_linear
 
 __all__ = ["PASVG0", "PASVG0Config", "expected_q", "every_action_q"]
@@ -203,7 +203,7 @@ class PASVG0(Algorithm):
 
     def _bind_networks(self) -> None:
         """The soft target update over the modules' own tensors and, with the paper's settings, the hand-written
-        update's views of the networks (:mod:`pamdp.algos.dense`). Called again by whoever replaces a module."""
+        update's views of the networks (:mod:`pamdp.nn.dense`). Called again by whoever replaces a module."""
         self._soft_update = soft_updater([(self.critic_target, self.critic), (self.policy_target, self.policy)])
         cfg = self.config
         self._dense = None

@@ -15,8 +15,7 @@ import numpy as np
 import torch
 
 from pamdp.algos.base import Algorithm
-from pamdp.algos.onpolicy import LinearFeatureBaseline, OnPolicy, OnPolicyConfig, Rollout, hybrid_policy
-from pamdp.algos.optim import descend
+from pamdp.algos.onpolicy import LinearFeatureBaseline, OnPolicy, OnPolicyConfig, Rollout, hybrid_policy, update_tensors
 from pamdp.algos.settings import NON_NEGATIVE, POSITIVE, AlgoConfig, at_least, interval, one_of, redeclared, setting
 from pamdp.algos.trpo import (
     FisherVectorProduct,
@@ -26,6 +25,7 @@ from pamdp.algos.trpo import (
     hybrid_gauss_newton_fvp,
 )
 from pamdp.distributions import KL_ESTIMATORS, kl_divergence
+from pamdp.nn.optim import descend
 from pamdp.policies import ValueNetwork
 
 __all__ = ["PATRPO", "PATRPOConfig"]
@@ -154,7 +154,7 @@ class PATRPO(OnPolicy, Algorithm):
     # -- one epoch (the rollout and the advantages: Rollout.run_epoch) ------------------------------
     def _learn(self, data: dict[str, np.ndarray]) -> dict[str, float]:
         """The policy's step on an :func:`~pamdp.algos.onpolicy.advantage_batch`, then the baseline's fit."""
-        stats = self._update_policy(*self._update_tensors(data))
+        stats = self._update_policy(*update_tensors(data, self.device))
         stats["train/updates"] = 1.0 - stats.get("train/update_skipped", 0.0)  # one natural-gradient step a batch
         stats["losses/value_loss"] = self._fit_baseline(data["obs"], data["t"], data["returns"])
         return stats

@@ -2,7 +2,7 @@
 
 P-DQN (Xiong et al. 2018, arXiv 1810.06394) acts by ``argmax_k Q_k(s, x(s))`` with an actor ``x(s)`` of every
 action's parameters; MP-DQN (Bester, James & Konidaris 2019, arXiv 1905.04388; ``multi_pass = True``) reads
-``Q_k`` from a pass that sees only ``x_k``. The update is back-propagated by hand (:mod:`pamdp.algos.dense`;
+``Q_k`` from a pass that sees only ``x_k``. The update is back-propagated by hand (:mod:`pamdp.nn.dense`;
 ``tests/test_pdqn.py`` holds the autograd form it must equal). The maths: docs/algorithms.md, "P-DQN and MP-DQN".
 """
 
@@ -15,10 +15,8 @@ import math
 import numpy as np
 import torch
 import torch.nn.functional as F
-from torch import nn
 
 from pamdp.algos.base import Algorithm
-from pamdp.algos.dense import Dense, MultiPassDense
 from pamdp.algos.offpolicy import (
     DeterministicActorConfig,
     EpsilonSchedule,
@@ -29,13 +27,13 @@ from pamdp.algos.offpolicy import (
     soft_updater,
     uniform_actions,
 )
-from pamdp.algos.optim import apply_gradients
 from pamdp.algos.settings import POSITIVE, AlgoConfig, Check, setting
 from pamdp.distributions import masked_logits
-from pamdp.policies import DeterministicActor, in_chunks, mlp
-from pamdp.spaces import HybridActionSpace
+from pamdp.nn.dense import Dense
+from pamdp.nn.optim import apply_gradients
+from pamdp.policies import DeterministicActor, QNetwork
 
-__all__ = ["PDQN", "PDQNConfig", "QNetwork", "param_blocks"]
+__all__ = ["PDQN", "PDQNConfig"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -110,71 +108,6 @@ class PDQNConfig(DeterministicActorConfig, OffPolicyConfig, AlgoConfig):
     }
 
 
-def param_blocks(hybrid: HybridActionSpace) -> np.ndarray:
-    """Boolean ``(K, sum_a m_a)``: row ``k`` marks action ``k``'s block of the all-actions parameter vector."""
-    blocks = np.zeros((hybrid.n_actions, hybrid.total_param_size), dtype=bool)
-    start = 0
-    for k, m in enumerate(hybrid.param_sizes):
-        blocks[k, start : start + m] = True
-        start += m
-    return blocks
-
-
-class QNetwork(nn.Module):
-    """``Q(s, x)``: K action values from the state and every action's parameters.
-
-    With ``multi_pass`` (MP-DQN), ``Q_k`` is read from a pass that sees only ``x_k``. The passes' input rows are
-    never built: pass ``k``'s first layer is ``W_s s + W_k x_k + b`` and its output layer computes ``Q_k`` alone,
-    the same function at ``K`` times fewer operations; the passes are one flat batch of ``K * B`` rows, pass
-    ``k``'s a contiguous block (a strided layout walked memory slowly; :class:`~pamdp.algos.dense.MultiPassDense`
-    differentiates it by hand).
-    """
-
-    def __init__(self, obs_dim: int, hybrid: HybridActionSpace, hidden_sizes, activation: str, multi_pass: bool):
-        super().__init__()
-        self.n_actions = hybrid.n_actions
-        self.multi_pass = multi_pass
-        self.net = mlp(obs_dim + hybrid.total_param_size, hidden_sizes, hybrid.n_actions, activation)
-        index = torch.tensor(hybrid.param_index, dtype=torch.long)
-        mask = torch.tensor(hybrid.param_mask, dtype=torch.float32)
-        self.obs_dim = obs_dim
-        self.register_buffer("param_index", index, persistent=False)
-        self.register_buffer("param_mask", mask, persistent=False)
-        self.register_buffer("param_order", MultiPassDense.block_order(index, mask), persistent=False)
-
-    def forward(self, obs: torch.Tensor, params: torch.Tensor) -> torch.Tensor:
-        if not self.multi_pass:
-            return self.net(torch.cat([obs, params], dim=-1))
-        return in_chunks(self._passes, self.n_actions, obs, params)
-
-    def _passes(self, obs: torch.Tensor, params: torch.Tensor) -> torch.Tensor:
-        return self.forward_cached(obs, params)[0]
-
-    def forward_cached(self, obs: torch.Tensor, params: torch.Tensor) -> tuple[torch.Tensor, tuple]:
-        """The ``(B, K)`` values by the hand-written passes of :mod:`pamdp.algos.dense` (differentiable by autograd
-        too), with what :meth:`backward` needs."""
-        if not self.multi_pass:
-            net = Dense.of(self.net)
-            q, cache = net.forward_cached(torch.cat([obs, params], dim=-1))
-        else:
-            net = MultiPassDense.of(self.net, self.obs_dim, self.param_index, self.param_mask, self.param_order)
-            q, cache = net.forward_cached(obs, params)
-        return q, (net, cache)
-
-    def backward(self, cached: tuple, grad: torch.Tensor, weights: bool = True) -> list[torch.Tensor] | torch.Tensor:
-        """From :meth:`forward_cached`'s cache and d loss / d Q ``(B, K)``: the gradients in the order of
-        ``parameters()`` if ``weights``, else d loss / d params ``(B, sum_a m_a)``."""
-        net, cache = cached
-        if weights:
-            return net.backward(cache, grad)[0]
-        d_in = net.backward(cache, grad, weights=False, inputs=True)[1]
-        return d_in if self.multi_pass else d_in[:, self.obs_dim :]
-
-    def _load_from_state_dict(self, state_dict, prefix, *args, **kwargs):
-        state_dict.pop(prefix + "blocks", None)  # models saved before the block table was dropped hold it
-        super()._load_from_state_dict(state_dict, prefix, *args, **kwargs)
-
-
 class PDQN(EpsilonSchedule, Algorithm):
     """P-DQN (Xiong et al. 2018) and, with ``multi_pass``, MP-DQN (Bester et al. 2019). See :class:`PDQNConfig`."""
 
@@ -196,7 +129,7 @@ class PDQN(EpsilonSchedule, Algorithm):
         self.actor_optimizer = torch.optim.Adam(self.actor.parameters(), lr=cfg.actor_lr, fused=True)
         self.q_optimizer = torch.optim.Adam(self.q_net.parameters(), lr=cfg.q_lr, fused=True)
         self._bind_networks()
-        self.blocks = torch.as_tensor(param_blocks(h), device=self.device)
+        self.blocks = torch.tensor(h.param_blocks, device=self.device)
         self.loop = OffPolicyLoop(
             self,
             mc_returns=cfg.beta > 0,
@@ -241,7 +174,7 @@ class PDQN(EpsilonSchedule, Algorithm):
 
     # -- learning --------------------------------------------------------------------------------
     def _bind_networks(self) -> None:
-        """The actor's hand-written passes (:mod:`pamdp.algos.dense`) over its own tensors, and the soft updates;
+        """The actor's hand-written passes (:mod:`pamdp.nn.dense`) over its own tensors, and the soft updates;
         called again by whoever replaces a module."""
         self._dense_actor = Dense.of(self.actor.net)
         self._soft_update_q = soft_updater([(self.q_target, self.q_net)])
@@ -249,7 +182,7 @@ class PDQN(EpsilonSchedule, Algorithm):
 
     def _update(self) -> dict[str, torch.Tensor]:
         """One TD step of the Q-network, one actor step along the bounded ``d sum_k Q_k / dx``, soft target updates;
-        back-propagated by hand through the :mod:`~pamdp.algos.dense` views of the networks. The figures stay
+        back-propagated by hand through the :mod:`~pamdp.nn.dense` views of the networks. The figures stay
         tensors, read once an epoch."""
         cfg = self.config
         b = self.replay.sample(cfg.batch_size, self.np_rng)

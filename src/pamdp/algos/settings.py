@@ -14,13 +14,14 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import numbers
 import re
 import types
 import typing
 import warnings
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
+
+from pamdp.hints import type_name, type_ok
 
 if TYPE_CHECKING:
     from typing_extensions import Self  # typing.Self from Python 3.11
@@ -246,35 +247,3 @@ def _coerce(name: str, value: Any, hint: Any) -> Any:
     if not type_ok(value, hint):
         raise ValueError(f"setting {name!r} = {value!r}; expected {type_name(hint)}")
     return int(value) if hint is int else value  # plain data: an np.int64 is no JSON
-
-
-def type_ok(value: Any, hint: Any) -> bool:
-    """Whether ``value`` has type ``hint`` as plain data (JSON, TOML) gives it: a bool is no number, an int is a
-    float, a list is a tuple."""
-    origin = typing.get_origin(hint)
-    if origin in (typing.Union, types.UnionType):
-        return any(type_ok(value, option) for option in typing.get_args(hint))
-    if origin is typing.Literal:
-        return value in typing.get_args(hint)
-    if origin in (tuple, list):
-        items = [a for a in typing.get_args(hint) if a is not Ellipsis]
-        return isinstance(value, (list, tuple)) and (len(items) != 1 or all(type_ok(v, items[0]) for v in value))
-    if hint is type(None):
-        return value is None
-    if hint is bool:
-        return isinstance(value, bool)
-    if hint in (int, float):  # NumPy's scalars too (a size computed with NumPy is an np.int64)
-        kind = numbers.Integral if hint is int else numbers.Real
-        return isinstance(value, kind) and not isinstance(value, bool)
-    return not isinstance(hint, type) or isinstance(value, hint)
-
-
-def type_name(hint: Any) -> str:
-    """``hint`` in words, for an error's "expected ...": ``float``, ``str or None``, ``a list of int``."""
-    origin = typing.get_origin(hint)
-    if origin in (typing.Union, types.UnionType):
-        return " or ".join(type_name(option) for option in typing.get_args(hint))
-    if origin in (tuple, list):
-        items = [a for a in typing.get_args(hint) if a is not Ellipsis]
-        return f"a list of {type_name(items[0])}" if len(items) == 1 else "a list"
-    return "None" if hint is type(None) else getattr(hint, "__name__", str(hint))

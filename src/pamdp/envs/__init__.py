@@ -11,7 +11,10 @@
 Each domain's folder holds its dynamics (compiled by Numba), its scalar ``gymnasium.Env`` and its batched
 ``gymnasium.vector.VectorEnv``, registered as its ``vector_entry_point``, so ``gymnasium.make_vec(id,
 num_envs=N, vectorization_mode="vector_entry_point")`` returns the batched version. What the batched envs
-share is ``vector.py``; ``rendering.py`` has the drawing primitives and episode-to-GIF recording.
+share is ``vector.py``; ``rendering.py`` has the drawing primitives and episode-to-GIF recording. What the
+algorithms and the evaluation use of this package knows no domain: ``backends.py`` makes an env from its id (checked
+against Gymnasium's registry and its constructor), batched or stepped in turn, and ``stepping.py`` steps its copies
+(autoreset, action masks) and counts their episodes.
 
 Numba caches the compiled dynamics on disk, each function keyed by its own file only; importing this package first
 deletes those caches if any source under ``envs/`` changed since they were written (``_numba_cache.py``), so an

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pamdp.algos.logger import RENAMED, success_of
+from pamdp.logger import RENAMED, success_of
 
 __all__ = [
     "find_groups",

@@ -21,7 +21,7 @@ import time
 import traceback
 from pathlib import Path
 
-from pamdp.algos.checkpoints import _atomic_write
+from pamdp.atomic import atomic_write
 from pamdp.experiments.runner import RunOutcome, RunSpec, _describe, _worker, run_lock
 from pamdp.experiments.summary import SUMMARY, write_summary
 
@@ -57,7 +57,7 @@ def _pack(directory: Path) -> dict[str, bytes]:
 def _write(target: Path, offset: int, data: bytes) -> None:
     """Put ``data`` at ``offset`` of ``target``: a whole new file (atomically) at 0, an appended tail past it."""
     if offset == 0:
-        _atomic_write(target, lambda f: f.write(data), target.name)
+        atomic_write(target, lambda f: f.write(data), target.name)
         return
     size = target.stat().st_size if target.exists() else 0
     if size < offset:

@@ -31,7 +31,7 @@ import filelock
 
 from pamdp._version import __version__
 from pamdp.algos import algorithm_class
-from pamdp.algos.vector_env import check_env_kwargs
+from pamdp.envs.backends import check_env_kwargs
 from pamdp.experiments.summary import SUMMARY, git_commit, write_summary
 from pamdp.presets import choose
 
@@ -172,7 +172,7 @@ def env_defaults(env: str) -> dict:
     unregistered env or a constructor without a signature)."""
     import inspect
 
-    from pamdp.algos.vector_env import env_creator
+    from pamdp.envs.backends import env_creator
 
     try:
         params = inspect.signature(env_creator(env)).parameters.values()
@@ -245,7 +245,8 @@ def _prepare(
 ) -> tuple[Any, dict | None]:
     """The model to train for ``spec`` in ``out`` (new or resumed) and ``None``, or ``None`` and the evaluation of
     a run already finished. The caller holds ``out``'s :func:`run_lock`."""
-    from pamdp.algos.checkpoints import CHECKPOINT, FINAL_MODEL, atomic_write_text
+    from pamdp.algos.checkpoints import CHECKPOINT, FINAL_MODEL
+    from pamdp.atomic import atomic_write_text
 
     cls, preset, config, warning = run_config or spec.check()
     out = Path(out)
@@ -364,7 +365,8 @@ def _train(model, spec: RunSpec, out: str | os.PathLike, progress_bar: bool, log
 
     ``callback``: ``learn``'s, called after every epoch (and its checkpoint).
     """
-    from pamdp.algos.checkpoints import FINAL_MODEL, atomic_write_text
+    from pamdp.algos.checkpoints import FINAL_MODEL
+    from pamdp.atomic import atomic_write_text
     from pamdp.evaluation import evaluate
 
     out = Path(out)

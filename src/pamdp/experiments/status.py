@@ -17,8 +17,8 @@ import statistics
 import time
 from pathlib import Path
 
-from pamdp.algos.logger import success_of
 from pamdp.experiments.runner import RunSpec, is_finished
+from pamdp.logger import success_of
 
 __all__ = ["RunStatus", "run_status", "format_status", "remaining_seconds"]
 

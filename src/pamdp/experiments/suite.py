@@ -21,9 +21,9 @@ from pathlib import Path
 
 import numpy as np
 
-from pamdp.algos.logger import success_of
 from pamdp.experiments.plots import run_setting
 from pamdp.experiments.runner import env_defaults
+from pamdp.logger import success_of
 
 __all__ = [
     "DOMAINS",

@@ -25,7 +25,7 @@ import re
 import subprocess
 from pathlib import Path
 
-from pamdp.algos.logger import RENAMED, success_of
+from pamdp.logger import RENAMED, success_of
 
 __all__ = ["FORMAT", "SUMMARY", "git_commit", "summarize", "write_summary", "load", "save"]
 
@@ -148,7 +148,7 @@ def summarize(run: str | os.PathLike) -> dict:
 
 def write_summary(run: str | os.PathLike) -> Path:
     """:func:`summarize` ``run`` into its own ``summary.json``, atomically (a kill leaves the old one or none)."""
-    from pamdp.algos.checkpoints import atomic_write_text
+    from pamdp.atomic import atomic_write_text
 
     path = Path(run) / SUMMARY
     atomic_write_text(path, json.dumps(summarize(run), indent=1) + "\n")

@@ -523,7 +523,7 @@ def _toml(value) -> str:
 def write_preset(study, out: str | os.PathLike) -> dict:
     """Write the best trial's settings as a config file ``pamdp train ALGO --config OUT`` reads (its ``preset`` the
     search's base), and the :func:`summary` as JSON beside it (``OUT`` with ``.json``); returns the summary."""
-    from pamdp.algos.checkpoints import atomic_write_text
+    from pamdp.atomic import atomic_write_text
 
     info = summary(study)
     if info["best_settings"] is None:

@@ -393,7 +393,7 @@ def _env_arguments(env_id: str, env_kwargs: dict, names: set[str]) -> dict[str, 
         return {}
     import inspect
 
-    from pamdp.algos.vector_env import check_env_kwargs, env_creator, env_spec
+    from pamdp.envs.backends import check_env_kwargs, env_creator, env_spec
 
     check_env_kwargs(env_id, env_kwargs)
     params = inspect.signature(env_creator(env_id)).parameters

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import torch
 from torch import nn
 
-from pamdp.algos.optim import apply_gradients
+from pamdp.nn.optim import apply_gradients
 
 __all__ = ["Dense", "MultiPassDense"]
 
@@ -151,7 +151,7 @@ class Dense:
 
 @dataclass(frozen=True)
 class MultiPassDense:
-    """MP-DQN's multi-pass Q-network (:class:`~pamdp.algos.pdqn.QNetwork` with ``multi_pass``) applied and
+    """MP-DQN's multi-pass Q-network (:class:`~pamdp.policies.QNetwork` with ``multi_pass``) applied and
     differentiated by hand, the same function as the module's own passes.
 
     Pass ``k`` sees the state and action ``k``'s parameters only and gives ``Q_k`` alone, so its first layer is

@@ -1,30 +1,20 @@
-"""How an algorithm gets its environments: an env id checked against Gymnasium's registry, its copies
-batched or stepped in turn, and the spaces of whatever a user passed (an id, an env or a vector env)."""
+"""How an env is made: an env id checked against Gymnasium's registry (its module imported for ``module:Name-v0``),
+its arguments checked against its constructor, its copies batched or stepped in turn, and the spaces of whatever a
+user passed (an id, an env or a vector env). The algorithms, the evaluation, the callbacks, the presets and the
+runner make their envs here; how the copies are then stepped is :mod:`pamdp.envs.stepping`'s."""
 
 from __future__ import annotations
 
-import dataclasses
 import importlib
 import inspect
 import typing
 
 import gymnasium
-import numpy as np
 from gymnasium import spaces
 
-from pamdp.algos.logger import EpisodeTracker
-from pamdp.algos.settings import type_name, type_ok
+from pamdp.hints import type_name, type_ok
 
-__all__ = [
-    "env_spec",
-    "env_creator",
-    "check_env_kwargs",
-    "make_vector_env",
-    "describe_env",
-    "info_action_masks",
-    "Step",
-    "VectorStepper",
-]
+__all__ = ["env_spec", "env_creator", "check_env_kwargs", "make_vector_env", "describe_env"]
 
 
 def env_spec(env_id: str) -> gymnasium.envs.registration.EnvSpec:
@@ -135,85 +125,3 @@ def describe_env(env, env_kwargs: dict | None = None) -> tuple[str | None, dict,
         kwargs = {key: value for key, value in kwargs.items() if key not in MAKE_VEC_ARGUMENTS}
     return (spec.id if spec else None), kwargs, *spaces_of
 
-
-def info_action_masks(infos: dict, num_envs: int, n_actions: int) -> np.ndarray:
-    """The discrete actions allowed in each copy's current state, bool ``(num_envs, n_actions)``, from a vector
-    env's infos (Gymnasium's dict of arrays: ``infos["action_mask"]`` ``(N, K)`` beside ``infos["_action_mask"]``,
-    which copies report one).
-
-    True means the action has an effect now. A copy that reports no mask, or a mask allowing nothing, gets all
-    actions allowed; a mask of another shape is a ``ValueError``.
-    """
-    masks = np.ones((num_envs, n_actions), dtype=bool)
-    if "action_mask" not in infos:
-        return masks
-    reported = np.asarray(infos["action_mask"])
-    if reported.shape != (num_envs, n_actions):
-        raise ValueError(
-            f"info['action_mask'] of shape {reported.shape}; expected ({num_envs}, {n_actions}) (one bool per "
-            "env copy and discrete action)"
-        )
-    has = np.asarray(infos.get("_action_mask", np.ones(num_envs, dtype=bool)), dtype=bool)
-    has &= reported.any(axis=1)
-    masks[has] = reported[has].astype(bool)
-    return masks
-
-
-@dataclasses.dataclass
-class Step:
-    """One step of every copy of a vector env, as :meth:`VectorStepper.step` returns it: ``(N, ...)`` arrays.
-
-    ``obs`` and ``masks`` are the copies' states before the step (``masks``: their allowed actions, ``None``
-    without action masks), ``next_obs`` and ``next_masks`` after it. ``valid`` is false on the autoreset steps
-    (see :class:`VectorStepper`); ``terminated`` and ``done`` (terminated or truncated) are true only where valid.
-    ``ended`` lists the copies whose episode ended, ``flatnonzero(done)``, and ``returns``, ``lengths`` and
-    ``successes`` those episodes' (a success ``None`` where the env did not report one).
-    """
-
-    obs: np.ndarray
-    masks: np.ndarray | None
-    reward: np.ndarray
-    terminated: np.ndarray
-    done: np.ndarray
-    valid: np.ndarray
-    next_obs: np.ndarray
-    next_masks: np.ndarray | None
-    info: dict
-    returns: np.ndarray
-    lengths: np.ndarray
-    successes: list[bool | None]
-
-    @property
-    def ended(self) -> np.ndarray:
-        return np.flatnonzero(self.done)
-
-
-class VectorStepper:
-    """Steps a vector env with Gymnasium's next-step autoreset, keeping the episodes' accounts.
-
-    Such an env resets a finished copy on the *next* step and ignores that step's action: the step is marked
-    invalid (no sample, no reward counted). The stepper holds each copy's current observation and allowed actions
-    (``masked``: from ``info["action_mask"]``, :func:`info_action_masks`); its :attr:`episodes` keep the running
-    and finished episodes' returns and lengths. Training (the on- and off-policy loops) and evaluation step their
-    envs through it.
-    """
-
-    def __init__(self, env: gymnasium.vector.VectorEnv, n_actions: int, masked: bool, seed: int):
-        self.env, self.n_actions, self.masked = env, n_actions, masked
-        self.obs, info = env.reset(seed=seed)
-        self.masks = self._masks(info)
-        self.prev_done = np.zeros(env.num_envs, dtype=bool)
-        self.episodes = EpisodeTracker(env.num_envs)
-
-    def _masks(self, info: dict) -> np.ndarray | None:
-        return info_action_masks(info, self.env.num_envs, self.n_actions) if self.masked else None
-
-    def step(self, action) -> Step:
-        """Step every copy with the env's ``action`` and move on to the new observations."""
-        obs, masks = self.obs, self.masks
-        next_obs, reward, terminated, truncated, info = self.env.step(action)
-        valid = ~self.prev_done
-        done = (terminated | truncated) & valid
-        ended = self.episodes.step(np.asarray(reward, dtype=np.float64), done, valid, info)
-        self.obs, self.masks, self.prev_done = next_obs, self._masks(info), done
-        return Step(obs, masks, reward, terminated & valid, done, valid, next_obs, self.masks, info, *ended)

@@ -1,5 +1,5 @@
 """One way to step an optimizer, for every update: gradients in a network's parameters (``torch.autograd.grad``, or
-computed by hand in :mod:`pamdp.algos.dense`), their norm clipped, then the optimizer's step.
+computed by hand in :mod:`pamdp.nn.dense`), their norm clipped, then the optimizer's step.
 
 PyTorch's own idiom, ``zero_grad(); loss.backward(); clip_grad_norm_(...); step()``, computes gradients for every
 parameter the loss reaches (the critic's, inside an actor's loss) and spends more time in Python bookkeeping than
@@ -76,7 +76,7 @@ def apply_gradients(
 ) -> torch.Tensor | None:
     """A step of ``optimizer`` on gradients in the order of its one parameter group: their total norm clipped to
     ``max_norm`` (0: none), then :func:`optimizer_step`; returns the norm before clipping (``None`` without).
-    The step of the hand-written updates (:mod:`pamdp.algos.dense`), which compute their gradients themselves."""
+    The step of the hand-written updates (:mod:`pamdp.nn.dense`), which compute their gradients themselves."""
     total = clip_grads(grads, max_norm)
     optimizer_step(optimizer, grads)
     return total
