@@ -128,7 +128,9 @@ def test_the_discrete_entropy_bonus_moves_pi_d_alone_towards_uniform():
     """Zero advantages and entropy_coef_d alone: the surrogate is pi_d's entropy, whose gradient has no part in
     pi_c's network or the log-stds; the chain-rule KL's Fisher matrix has no block between pi_d's parameters and
     pi_c's at the old policy, so the natural step leaves pi_c exactly as it was and raises pi_d's entropy."""
-    model = PATRPO("pamdp/Platform-v0", PATRPOConfig.from_dict({"entropy_coef": 0.0, "entropy_coef_d": 0.5}, base=SMALL))
+    model = PATRPO(
+        "pamdp/Platform-v0", PATRPOConfig.from_dict({"entropy_coef": 0.0, "entropy_coef_d": 0.5}, base=SMALL)
+    )
     obs, a, x, adv = float64_batch(model, 200)[:4]
     with torch.no_grad():  # a pi_d far from uniform, so that there is entropy to gain
         model.policy.pi_d[-1].bias.copy_(torch.tensor([2.0, -1.0, 0.0], dtype=torch.float64))

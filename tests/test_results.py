@@ -192,13 +192,20 @@ def test_the_statistics_tables_hold_the_hand_computed_cells():
     standing = _cells(results.standing_table(runs))
     # Goal: the best published is CHDP's 0.809; A (IQM 0.667) beats B (-1.4 over 2 runs: too few to stand). A's
     # interval [0, 1] holds 0.809: neither above nor below; its curve first reaches 0.809 at 300 samples.
-    assert standing[("| Goal", "0.809 (CHDP)")] == ["A", "3", "0.667 [0.000, 1.000]", "within the interval", "300 (3 of 3)", "400 |"]
+    assert standing[("| Goal", "0.809 (CHDP)")] == [
+        "A",
+        "3",
+        "0.667 [0.000, 1.000]",
+        "within the interval",
+        "300 (3 of 3)",
+        "400 |",
+    ]
     # Platform: A (IQM 0.75) beats B (0.3 - 2). A redrawn set of A's four runs has an IQM of 1.0 (its middle two
     # both 1.0) when three or four draws are the 1.0: 4 (1/4)^3 (3/4) + (1/4)^4 = 5.1 % > 2.5 %, so the interval
     # reaches 1.0 and holds CHDP's 0.997; no curves logged
     platform = standing[("| Platform", "0.997 (CHDP)")]
     assert platform[:2] == ["A", "4"] and platform[3:] == ["within the interval", "- (no curves)", "400 |"]
-    # runs that all score 0.5 and 0.95 on Platform: an interval of one point, below and above 0.997 and 0.942 (Hard Move)
+    # runs that all score 0.5 on Platform and 0.95 on Hard Move n=4: intervals of one point, below 0.997 and above 0.942
     low = [_summary("C on Platform", "pamdp/Platform-v0", seed, 0.5) for seed in range(3)]
     high = [_summary("C on Hard Move n=4", "pamdp/HardMove-v0", seed, 0.95, env_kwargs={"n": 4}) for seed in range(3)]
     standing = _cells(results.standing_table(low + high))

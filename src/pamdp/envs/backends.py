@@ -124,4 +124,3 @@ def describe_env(env, env_kwargs: dict | None = None) -> tuple[str | None, dict,
     if isinstance(env, gymnasium.vector.VectorEnv):  # make_vec records its own arguments beside the env's
         kwargs = {key: value for key, value in kwargs.items() if key not in MAKE_VEC_ARGUMENTS}
     return (spec.id if spec else None), kwargs, *spaces_of
-

@@ -100,7 +100,9 @@ def standing_table(summaries: list[dict]) -> str:
         if curves:
             times = [stats.samples_to_reach(*c, target=best[1], budget=b) for c, b in curves]
             median = stats.median_reached(times)
-            reach = f"{'' if median.reached else '> '}{median.step:,.0f} ({sum(t.reached for t in times)} of {len(times)})"
+            reach = (
+                f"{'' if median.reached else '> '}{median.step:,.0f} ({sum(t.reached for t in times)} of {len(times)})"
+            )
         budget = next((b for s in runs if (b := _budget(s)) is not None), None)
         lines.append(
             f"| {domain} | {best[1]:.3f} ({best[0]}) | {method} | {len(runs)} | {est.value:.3f} [{est.low:.3f}, "
@@ -139,7 +141,9 @@ def one_preset_table(summaries: list[dict], suite: list[dict]) -> str:
             f"| {_estimate([scores], stats.iqm)} | {published or '- (none published)'} | {verdict} "
             f"| {'-' if mine is None else f'{mine[0]}, {mine[1]:.3f}'} |"
         )
-    return "\n".join(lines) + f"\n\nAt or above HyAR-TD3's published rate on {met} of the {judged} domains it has one for."
+    return (
+        "\n".join(lines) + f"\n\nAt or above HyAR-TD3's published rate on {met} of the {judged} domains it has one for."
+    )
 
 
 def published_best(domain: str) -> float | None:
