@@ -2,6 +2,7 @@
 
 import csv
 import dataclasses
+import hashlib
 import json
 import os
 import re
@@ -641,6 +642,11 @@ def test_a_run_recorded_before_a_setting_existed_is_a_seed_of_one_recorded_after
     run = {"algo": "patrpo", "total_steps": 1000, "preset": "tuned"}
     assert setting_of({**run, "config": before}) == setting_of({**run, "config": {**now, "seed": 2}})
     assert setting_of({**run, "config": before}) != setting_of({**run, "config": {**now, "delta": 0.5}})
+    # the digest is made of the settings that differ from the defaults, the tuned preset's here, so that adding a
+    # setting later leaves every recorded digest as it was
+    tuned = {"delta": 0.02, "gae_lambda": 0.97, "batch_size": 5000, "init_log_std": -0.5, "entropy_coef": 0.01}
+    text = json.dumps(["patrpo", {**tuned, "fvp_subsample": 0.2}], sort_keys=True)
+    assert setting_of({**run, "config": now})["settings"] == hashlib.sha256(text.encode()).hexdigest()[:8]
 
 
 def test_the_report_table_counts_each_seeds_gradient_updates_and_flags_an_untrained_arm(tmp_path, capsys):

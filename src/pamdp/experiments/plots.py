@@ -110,15 +110,19 @@ def _run_dirs(root: Path) -> list[Path]:
     return sorted(runs)
 
 
-def _with_defaults(algo, config: dict) -> dict:
-    """A recorded config with the settings added since it was written at their defaults (as a resume counts them),
-    so that a run recorded before a setting existed is a seed of one recorded after; as recorded where the
-    algorithm is unknown or the config no longer loads."""
+def _changed_settings(algo, config: dict) -> dict:
+    """The settings of a recorded config that differ from the algorithm's defaults, so that a run recorded before a
+    setting existed is a seed of one recorded after (the new setting at its default, as a resume counts it), and a
+    digest made of them stays the same when a setting is added; the config as recorded where the algorithm is
+    unknown or the config no longer loads."""
     from pamdp.algos import algorithm_class
 
     try:
         cls = algorithm_class(algo) if isinstance(algo, str) else None
-        return config if cls is None else cls.config_class.from_dict(config).to_dict()
+        if cls is None:
+            return config
+        defaults = cls.config_class().to_dict()
+        return {k: v for k, v in cls.config_class.from_dict(config).to_dict().items() if v != defaults[k]}
     except (ValueError, TypeError):  # an unknown algorithm, or settings it no longer takes
         return config
 
@@ -131,7 +135,7 @@ def setting_of(recorded: dict) -> dict:
     config = recorded.get("config")
     digest = None
     if isinstance(config, dict):
-        config = _with_defaults(recorded.get("algo"), config)
+        config = _changed_settings(recorded.get("algo"), config)
         text = json.dumps([recorded.get("algo"), {k: v for k, v in config.items() if k != "seed"}], sort_keys=True)
         digest = hashlib.sha256(text.encode()).hexdigest()[:8]
     steps = recorded.get("total_steps")
