@@ -17,7 +17,7 @@ CONFIGS = [PASVG0Config, PADDPGConfig, PDQNConfig, HyARConfig]
 # (commit 763e0d8), so that checkpoints and config files of earlier runs mean what they meant; with the settings
 # added since at values that change nothing: device (issue 31) at "auto", which on a machine without CUDA is the CPU
 # those runs had, action_mask off (issue 27), P-DQN's param_passthrough empty and reward_scale 1, HyAR's td3_replay
-# 0 (issue 26).
+# 0 (issue 26) and beta 0 (issue 45).
 RECORDED = json.loads((Path(__file__).parent / "data" / "offpolicy_presets.json").read_text())
 
 
