@@ -68,6 +68,23 @@ LATER_RESULTS: dict[str, dict[str, float]] = {
 """Published success rates beyond :data:`HYAR_TABLE`, by method and domain (DLPA reports returns, not rates)."""
 
 
+def _curves(runs: list[dict]) -> list[tuple[tuple[np.ndarray, np.ndarray], float]]:
+    """``[((samples, figures), budget), ...]`` of the runs that logged greedy evaluations and recorded their budget."""
+    curves = [(curve(s), _budget(s)) for s in runs]
+    return [(c, b) for c, b in curves if b is not None and np.isfinite(c[1]).any()]
+
+
+def _best_cells(summaries: list[dict]) -> dict[str, tuple[str, np.ndarray]]:
+    """``{domain: (method, scores)}``: on each domain, the main cell of at least :data:`MIN_RUNS` runs with the highest
+    IQM."""
+    best: dict[str, tuple[str, np.ndarray]] = {}
+    for method, domains in _main_cells(summaries).items():
+        for domain, scores in domains.items():
+            if len(scores) >= MIN_RUNS and (domain not in best or stats.iqm(scores) > stats.iqm(best[domain][1])):
+                best[domain] = (method, scores)
+    return best
+
+
 def literature_best(domain: str) -> tuple[str, float] | None:
     """``(method, figure)``: the best success rate published on a suite domain, HyAR's table and the later papers'."""
     found = [(m, float(t[domain].split()[0])) for m, t in HYAR_TABLE.items() if t.get(domain)]
@@ -84,18 +101,16 @@ def standing_table(summaries: list[dict]) -> str:
         "it (median) | pamdp's budget |",
         "|---|---|---|---|---|---|---|---|",
     ]
-    main = _main_cells(summaries)
+    best_cells = _best_cells(summaries)
     for domain, _, _ in DOMAINS:
         best = literature_best(domain)
-        candidates = {m: v[domain] for m, v in main.items() if len(v.get(domain, ())) >= MIN_RUNS}
-        if best is None or not candidates:
+        if best is None or domain not in best_cells:
             continue
-        method = max(candidates, key=lambda m: stats.iqm(candidates[m]))
-        est = stats.interval([candidates[method]], stats.iqm)
+        method, scores = best_cells[domain]
+        est = stats.interval([scores], stats.iqm)
         verdict = "above" if est.low > best[1] else "below" if est.high < best[1] else "within the interval"
         runs = cells(summaries)[(domain, method)]
-        curves = [(curve(s), _budget(s)) for s in runs]
-        curves = [(c, b) for c, b in curves if b is not None and np.isfinite(c[1]).any()]
+        curves = _curves(runs)
         reach = "- (no curves)"
         if curves:
             times = [stats.samples_to_reach(*c, target=best[1], budget=b) for c, b in curves]
@@ -120,11 +135,7 @@ def one_preset_table(summaries: list[dict], suite: list[dict]) -> str:
         "cell (its own preset) |",
         "|---|---|---|---|---|---|---|",
     ]
-    best = {}
-    for method, domains in _main_cells(suite).items():
-        for domain, scores in domains.items():
-            if len(scores) >= MIN_RUNS and stats.iqm(scores) > best.get(domain, ("", -np.inf))[1]:
-                best[domain] = (method, stats.iqm(scores))
+    best = _best_cells(suite)
     met = judged = 0
     for (row, _), runs in cells(summaries).items():
         domain, scores = _domain(runs[0]), np.array([score(s)[0] for s in runs])
@@ -139,7 +150,7 @@ def one_preset_table(summaries: list[dict], suite: list[dict]) -> str:
         lines.append(
             f"| {row} | {len(runs)} | {per_seed} "
             f"| {_estimate([scores], stats.iqm)} | {published or '- (none published)'} | {verdict} "
-            f"| {'-' if mine is None else f'{mine[0]}, {mine[1]:.3f}'} |"
+            f"| {'-' if mine is None else f'{mine[0]}, {stats.iqm(mine[1]):.3f}'} |"
         )
     return (
         "\n".join(lines) + f"\n\nAt or above HyAR-TD3's published rate on {met} of the {judged} domains it has one for."
@@ -199,16 +210,17 @@ def finals(summaries: list[dict]) -> list[dict]:
 
     entries = []
     suite = {d[0] for d in DOMAINS}
-    for runs in cells(summaries).values():
-        if _domain(runs[0]) not in suite:
+    for (_, method), runs in cells(summaries).items():
+        domain = _domain(runs[0])
+        if domain not in suite:
             continue
         cell = next((r for r in runs if r.get("total_steps") or r.get("settings_hash")), runs[0])  # its setting
         for s in runs:
             figure = score(s)
             entries.append(
                 dict(
-                    domain=_domain(s),
-                    method=method_of(s["label"], _domain(s)),
+                    domain=domain,
+                    method=method,
                     seed=s.get("seed"),
                     value=figure[0],
                     final=figure[1],
@@ -382,8 +394,7 @@ def efficiency_table(summaries: list[dict]) -> str:
         "|---|---|---|---|---|---|",
     ]
     for (row, method), runs in cells(summaries).items():
-        curves = [(curve(s), _budget(s)) for s in runs]
-        curves = [(c, b) for c, b in curves if b is not None and np.isfinite(c[1]).any()]
+        curves = _curves(runs)
         if not curves:
             continue
         with np.errstate(all="ignore"):
@@ -450,8 +461,7 @@ def plot_efficiency(summaries: list[dict], path: str | os.PathLike) -> list[Path
     samples to; ``path`` with ``.png`` and ``.svg`` suffixes (nothing where no run logged a curve)."""
     by_domain: dict[str, dict[str, list]] = {}
     for (row, method), runs in cells(summaries).items():
-        curves = [(curve(s), _budget(s)) for s in runs]
-        curves = [(c, b) for c, b in curves if b is not None and np.isfinite(c[1]).any()]
+        curves = _curves(runs)
         if curves and row == _domain(runs[0]):
             by_domain.setdefault(row, {})[method] = curves
     if not by_domain:
