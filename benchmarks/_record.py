@@ -92,6 +92,16 @@ def arm_runs(jobs, metric: str, digits: int = 2, unit: str = "") -> tuple[list, 
     return done, partial
 
 
+def per_seed(pairs) -> str:
+    """``0: 0.999, 1: 0.893``: a figure per seed from ``(seed, figure)`` pairs, ``-`` where there are none."""
+    return ", ".join(f"{seed}: {value:.3f}" for seed, value in pairs) or "-"
+
+
+def median_minutes(runs, total_steps: int) -> str:
+    """The median CPU minutes of training a run of ``total_steps`` samples, over :func:`arm_runs`' finished runs."""
+    return f"{np.median([cost * total_steps / 6e4 for _, _, cost in runs]):.1f}" if runs else "-"
+
+
 def run_together(commands: list[list[str]]) -> list[dict]:
     """Start the worker processes ``commands`` and let them time together: each prints ``ready`` once built and
     warmed up, starts on a line ``go`` on its stdin, and ends by printing its result as one JSON line."""

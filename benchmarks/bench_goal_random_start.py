@@ -13,7 +13,7 @@ benchmarks/goal_random_start.toml --out DIR``) are read the same way with ``--re
 from __future__ import annotations
 
 import numpy as np
-from _record import HERE, arm_runs, record_head, seed_by_seed_main, write_record
+from _record import HERE, arm_runs, median_minutes, per_seed, record_head, seed_by_seed_main, write_record
 
 from pamdp.experiments import load_experiment
 
@@ -26,16 +26,15 @@ def arm_row(label: str, jobs) -> str:
     runs, partial = arm_runs(jobs, "eval/success_rate")
     rates = [evaluation["success_rate"] for _, evaluation, _ in runs]
     steps = [evaluation.get("mean_steps_to_success") for _, evaluation, _ in runs]
-    minutes = [cost * spec.total_steps / 6e4 for _, _, cost in runs]
     env = spec.env.removeprefix("pamdp/").removesuffix("-v0")
     median = np.median(rates) if rates else None
     short = "-" if median is None else f"{median - AIM[spec.env]:+.2f}"
     return (
         f"| {label} | {env} | {spec.algo} | {len(runs)} of {len(jobs)} "
-        f"| {', '.join(f'{seed}: {r:.3f}' for (seed, _, _), r in zip(runs, rates)) or '-'} "
+        f"| {per_seed((seed, r) for (seed, _, _), r in zip(runs, rates))} "
         f"| {'-' if median is None else f'{median:.3f}'} | {short} "
         f"| {', '.join('-' if s is None else f'{s:.1f}' for s in steps) or '-'} "
-        f"| {f'{np.median(minutes):.1f}' if minutes else '-'} | {'; '.join(partial) or '-'} |"
+        f"| {median_minutes(runs, spec.total_steps)} | {'; '.join(partial) or '-'} |"
     )
 
 

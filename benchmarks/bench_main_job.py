@@ -14,6 +14,8 @@ import numpy as np
 from _record import (
     HERE,
     arm_runs,
+    median_minutes,
+    per_seed,
     record_head,
     seed_by_seed_main,
     write_record,
@@ -28,14 +30,13 @@ SOLVED = 0.99  # the issue's bar: Platform's greedy return, 1.0 for crossing eve
 def arm_row(label: str, jobs) -> str:
     runs, partial = arm_runs(jobs, "eval/mean_return")
     done = [(seed, evaluation["mean_return"]) for seed, evaluation, _ in runs]
-    minutes = [cost * jobs[0][0].total_steps / 6e4 for _, _, cost in runs]
     returns = [r for _, r in done]
     solved = sum(r >= SOLVED for r in returns)
     return (
         f"| {label} | {jobs[0][0].total_steps:,} | {len(done)} of {len(jobs)} "
-        f"| {', '.join(f'{s}: {r:.3f}' for s, r in done) or '-'} | {f'{solved} of {len(done)}' if done else '-'} "
+        f"| {per_seed(done)} | {f'{solved} of {len(done)}' if done else '-'} "
         f"| {f'{np.median(returns):.3f}' if returns else '-'} | {f'{min(returns):.3f}' if returns else '-'} "
-        f"| {f'{np.median(minutes):.1f}' if minutes else '-'} | {'; '.join(partial) or '-'} |"
+        f"| {median_minutes(runs, jobs[0][0].total_steps)} | {'; '.join(partial) or '-'} |"
     )
 
 

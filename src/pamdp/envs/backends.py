@@ -115,12 +115,11 @@ def describe_env(env, env_kwargs: dict | None = None) -> tuple[str | None, dict,
         return (env if ":" in env else spec.id), {}, obs_space, act_space
     if isinstance(env, gymnasium.vector.VectorEnv):
         spaces_of = (env.single_observation_space, env.single_action_space)
+        not_the_envs = MAKE_VEC_ARGUMENTS  # make_vec records its own arguments beside the env's
     elif isinstance(env, gymnasium.Env):
-        spaces_of = (env.observation_space, env.action_space)
+        spaces_of, not_the_envs = (env.observation_space, env.action_space), frozenset()
     else:
         raise ValueError(f"env must be a registered env id, a gymnasium.Env or a VectorEnv; got {env!r}")
     spec = env.spec
-    kwargs = dict(spec.kwargs if spec else {})
-    if isinstance(env, gymnasium.vector.VectorEnv):  # make_vec records its own arguments beside the env's
-        kwargs = {key: value for key, value in kwargs.items() if key not in MAKE_VEC_ARGUMENTS}
+    kwargs = {key: value for key, value in (spec.kwargs if spec else {}).items() if key not in not_the_envs}
     return (spec.id if spec else None), kwargs, *spaces_of
