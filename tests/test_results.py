@@ -71,8 +71,9 @@ def test_the_summary_of_a_real_run_is_what_its_logs_say_and_follows_a_resume(tmp
     assert stats_md in capsys.readouterr().out
 
 
-def _summary(label, env, seed, value, curve=None, budget=400, env_kwargs=None):
-    """A hand-made summary of a finished run: its final figure and, optionally, greedy evaluations (samples, figure)."""
+def _summary(label, env, seed, value, curve=None, budget=400, env_kwargs=None, cpu=None):
+    """A hand-made summary of a finished run: its final figure and, optionally, greedy evaluations (samples, figure)
+    and its CPU seconds."""
     key = "mean_return" if env == "pamdp/Platform-v0" else "success_rate"
     samples, values = zip(*curve) if curve else ((), ())
     return {
@@ -89,6 +90,7 @@ def _summary(label, env, seed, value, curve=None, budget=400, env_kwargs=None):
         "settings_hash": "abc",
         "config": {},
         "finished": True,
+        "cpu_seconds": cpu,
         "evaluations": {"samples": list(samples), key: list(values)},
         "final": {key: value, "mean_return": value},
     }
@@ -155,8 +157,14 @@ def test_an_archived_suite_entry_becomes_a_summary_of_its_final_figure_only():
 def _synthetic():
     """Two methods on Platform and Goal: A with runs 0, 1, 1 on Goal (curves) and four on Platform, B below A."""
     curve = [(100, 0.1), (200, 0.5), (300, 0.9), (400, 1.0)]
-    runs = [_summary("A on Goal", "pamdp/Goal-v0", s, v, curve) for s, v in enumerate((0.0, 1.0, 1.0))]
-    runs += [_summary("A on Platform", "pamdp/Platform-v0", s, v) for s, v in enumerate((0.9, 0.2, 0.6, 1.0))]
+    runs = [
+        _summary("A on Goal", "pamdp/Goal-v0", s, v, curve, cpu=c)
+        for s, v, c in zip(range(3), (0, 1, 1), (60, 900, 1500))
+    ]
+    runs += [
+        _summary("A on Platform", "pamdp/Platform-v0", s, v, cpu=c)
+        for s, v, c in zip(range(4), (0.9, 0.2, 0.6, 1.0), (300, 540, None, 720))
+    ]
     runs += [_summary("B on Goal", "pamdp/Goal-v0", s, v - 2.0, [(400, 0.0)]) for s, v in enumerate((0.5, 0.7))]
     runs += [_summary("B on Platform", "pamdp/Platform-v0", s, v - 2.0) for s, v in enumerate((0.1, 0.3, 0.5))]
     return runs
@@ -171,11 +179,14 @@ def test_the_statistics_tables_hold_the_hand_computed_cells():
     cells = _cells(results.stats_table(runs))
     # Goal, A: runs 0, 1, 1. The mean of three draws is 0 with probability (1/3)^3 = 1/27 > 2.5 % and 1 with
     # (2/3)^3 > 2.5 %: the 95 % percentile interval is [0, 1]; three runs drop none from the IQM.
-    assert cells[("| Goal", "A")] == ["3", "0.667 [0.000, 1.000]", "0.667 [0.000, 1.000]", "0.78 |"]
+    # A run of 1, 15 or 25 CPU minutes: the median 15 is not cheap, so the cell is to have 5 runs and owes 2
+    assert cells[("| Goal", "A")] == ["3", "0.667 [0.000, 1.000]", "0.667 [0.000, 1.000]", "0.78", "15.0", "2 |"]
     # Platform, A: sorted 0.2 0.6 0.9 1.0, the IQM their middle two
     platform = cells[("| Platform", "A")]
     assert platform[0] == "4" and platform[1].startswith(f"{np.mean([0.9, 0.2, 0.6, 1.0]):.3f} [")
     assert platform[2].startswith(f"{(0.6 + 0.9) / 2:.3f} [")
+    assert platform[4:] == ["9.0", "6 |"]  # the median of 5, 9 and 12 minutes (one run unrecorded): cheap, 10 wanted
+    assert cells[("| Goal", "B")][4:] == ["-", "3 |"]  # no cost recorded: 5 wanted
     assert cells[("| Goal", "B")][1:3] == ["-1.400 (no interval: n < 3)"] * 2  # two runs: no interval
     aggregate = _cells(results.aggregate_table(runs).split("\n\n")[0])
     pooled = np.sort([0.0, 1.0, 1.0, 0.9, 0.2, 0.6, 1.0])  # 7 runs: one dropped at each end
@@ -244,3 +255,7 @@ def test_the_figures_are_drawn_where_there_is_something_to_draw(tmp_path):
     platform_only = [s for s in runs if s["env"] == "pamdp/Platform-v0"]  # no curves
     assert results.plot_efficiency(platform_only, tmp_path / "none") == []
     assert results.plot_profiles([runs[0]], tmp_path / "one") == []  # one run: no domain with 2 runs to resample
+    # the committed figures are checked against redrawn ones: the same runs must give the same bytes
+    (tmp_path / "again").mkdir()
+    again = results.plot_profiles(runs, tmp_path / "again" / "profiles")
+    assert [p.read_bytes() for p in again] == [p.read_bytes() for p in profiles]

@@ -40,6 +40,7 @@ __all__ = [
     "finals",
     "cells",
     "stats_table",
+    "seeds_wanted",
     "aggregate_table",
     "aggregate_line",
     "improvement_table",
@@ -55,6 +56,8 @@ FRACTIONS = (0.1, 0.25, 0.5, 1.0)
 """The fractions of the budget at which the greedy curve is read."""
 TARGET = 0.9
 """Samples to reach this fraction of the best published rate are counted."""
+SEEDS, CHEAP_SEEDS, CHEAP_MINUTES = 5, 10, 10.0
+"""Runs a cell is to have (issue 44): 5 (HyAR ran 5), 10 where a run costs under 10 CPU minutes."""
 
 
 LATER_RESULTS: dict[str, dict[str, float]] = {
@@ -284,12 +287,25 @@ def _estimate(tasks: list[np.ndarray], statistic) -> str:
     return f"{est.value:.3f} [{est.low:.3f}, {est.high:.3f}]"
 
 
+def _cpu_minutes(runs: list[dict]) -> float | None:
+    """The median CPU minutes a run of the runs that recorded their cost (archived figures did not)."""
+    costs = [s["cpu_seconds"] / 60 for s in runs if isinstance(s.get("cpu_seconds"), (int, float))]
+    return float(np.median(costs)) if costs else None
+
+
+def seeds_wanted(cpu_minutes: float | None) -> int:
+    """The runs a cell is to have: :data:`CHEAP_SEEDS` where a run costs under :data:`CHEAP_MINUTES` of CPU,
+    :data:`SEEDS` otherwise (or where no run recorded its cost)."""
+    return CHEAP_SEEDS if cpu_minutes is not None and cpu_minutes < CHEAP_MINUTES else SEEDS
+
+
 def stats_table(summaries: list[dict]) -> str:
-    """Per cell: its runs, the mean and the IQM of their scores with 95 % bootstrap intervals, and how many are
-    still training (counted with their last greedy evaluation)."""
+    """Per cell: its runs, the mean and the IQM of their scores with 95 % bootstrap intervals, how many are still
+    training (counted with their last greedy evaluation), the median CPU minutes a run and the runs it still owes
+    (:func:`seeds_wanted`)."""
     lines = [
-        "| domain | method | runs | mean [95 % CI] | IQM [95 % CI] | published best |",
-        "|---|---|---|---|---|---|",
+        "| domain | method | runs | mean [95 % CI] | IQM [95 % CI] | published best | CPU min a run | runs owed |",
+        "|---|---|---|---|---|---|---|---|",
     ]
     for (row, method), runs in cells(summaries).items():
         scores = np.array([score(s)[0] for s in runs])
@@ -297,7 +313,13 @@ def stats_table(summaries: list[dict]) -> str:
         n = f"{len(runs)}" + (f" ({partial} partial*)" if partial else "")
         best = published_best(_domain(runs[0]))
         mean, mid = _estimate([scores], np.mean), _estimate([scores], stats.iqm)
-        lines.append(f"| {row} | {method} | {n} | {mean} | {mid} | {'' if best is None else f'{best:.2f}'} |")
+        minutes = _cpu_minutes(runs)
+        cost = "-" if minutes is None else f"{minutes:.1f}"
+        owed = max(0, seeds_wanted(minutes) - len(runs))
+        lines.append(
+            f"| {row} | {method} | {n} | {mean} | {mid} | {'' if best is None else f'{best:.2f}'} | {cost} | "
+            f"{owed or '-'} |"
+        )
     return "\n".join(lines)
 
 
@@ -442,13 +464,16 @@ def plot_profiles(summaries: list[dict], path: str | os.PathLike, title: str = "
 
 
 def _save(fig, path: str | os.PathLike) -> list[Path]:
-    """``fig`` as ``path`` with ``.png`` and ``.svg`` suffixes (the SVG without a date, so that it redraws the same)."""
+    """``fig`` as ``path`` with ``.png`` and ``.svg`` suffixes (the SVG without a date and with element ids from a
+    fixed salt, so that the same figure redraws to the same file)."""
+    import matplotlib
     import matplotlib.pyplot as plt
 
     written = []
     for suffix in (".png", ".svg"):
         target = Path(path).with_suffix(suffix)
-        fig.savefig(target, metadata={"Date": None} if suffix == ".svg" else None)
+        with matplotlib.rc_context({"svg.hashsalt": "pamdp"}):
+            fig.savefig(target, metadata={"Date": None} if suffix == ".svg" else None)
         written.append(target)
     plt.close(fig)
     return written
