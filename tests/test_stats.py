@@ -55,6 +55,19 @@ def test_interval_matches_the_exact_bootstrap_distribution_within_monte_carlo_er
     assert stats.interval(tasks, stats.iqm, confidence=confidence, resamples=resamples, seed=2) == est
 
 
+def test_an_aggregate_weighs_each_task_the_same_whatever_its_number_of_runs():
+    # Ten runs at 0 on one task, two at 1 on the other: each task is half the study, so the IQM's middle half
+    # is half zeros and half ones. Pooling the twelve runs as they are would drop three at each end and keep
+    # six zeros: the task with more runs would decide.
+    tasks = [[0.0] * 10, [1.0, 1.0]]
+    assert stats.interval(tasks, stats.iqm).value == pytest.approx(0.5)
+    assert stats.iqm(np.concatenate(tasks)) == 0.0
+    assert stats.interval(tasks, np.mean).value == pytest.approx(0.5)  # the mean of the tasks' means
+    # three runs and two: repeated to six each, so 0 1 5 twice and 7 9 three times: the middle six of twelve
+    est = stats.interval([[0.0, 1.0, 5.0], [7.0, 9.0]], stats.iqm, resamples=200)
+    assert est.value == pytest.approx(np.mean([1, 5, 5, 7, 7, 7]))
+
+
 def test_interval_needs_two_runs_per_task():
     with pytest.raises(ValueError, match=r"scores_by_task\[1\] has 1 run"):
         stats.interval([[1.0, 2.0], [3.0]])
@@ -63,13 +76,13 @@ def test_interval_needs_two_runs_per_task():
 def test_performance_profile_counts_the_runs_above_each_threshold():
     tasks = [[0.1, 0.5, 0.9], [0.5, 0.7]]
     thresholds = [0.0, 0.5, 0.8, 1.0]
-    runs = [s for t in tasks for s in t]
-    counted = [sum(1 for s in runs if s > tau) / len(runs) for tau in thresholds]  # 5/5, 2/5, 1/5, 0/5
+    # each task's share of runs above tau, averaged over the two tasks (each weighs the same)
+    counted = [np.mean([sum(1 for s in t if s > tau) / len(t) for t in tasks]) for tau in thresholds]
     profile = stats.performance_profile(tasks, thresholds, seed=3)
     np.testing.assert_allclose(profile.fraction, counted)
-    np.testing.assert_allclose(profile.fraction, [1.0, 0.4, 0.2, 0.0])
+    np.testing.assert_allclose(profile.fraction, [1.0, (1 / 3 + 1 / 2) / 2, (1 / 3 + 0) / 2, 0.0])
     assert profile.low[0] == profile.high[0] == 1.0 and profile.low[-1] == profile.high[-1] == 0.0
-    assert profile.low[1] < 0.4 < profile.high[1]
+    assert profile.low[1] < 5 / 12 < profile.high[1]
 
 
 def test_performance_profile_band_is_stratified():

@@ -21,9 +21,14 @@ its ``arch`` dependency), and it brings ``arch``, pandas, seaborn and absl along
 pandas 2 it imports, and gives the same point estimates as this module and intervals within Monte-Carlo error.
 
 Every function takes plain NumPy arrays; ``scores_by_task`` is a sequence of one array per task (domain), each
-holding that task's runs (the tasks may have different numbers of runs). Scores from different domains should
-be normalised to a common scale (e.g. the goal rate, or a return divided by the published best) before they are
-aggregated across domains.
+holding that task's runs. Scores from different domains should be normalised to a common scale (e.g. the goal
+rate, or a return divided by the published best) before they are aggregated across domains.
+
+The tasks may have different numbers of runs; each task then weighs the same in an aggregate, as in Agarwal et
+al.'s score matrices of as many runs on every task (and as :func:`probability_of_improvement` averages over
+tasks): before pooling, each task's runs are repeated to the least common multiple of the tasks' run counts.
+Pooling them as they are would let the task with most runs set the aggregate, and running more seeds of one
+domain would move a method's score across domains. With equal counts nothing is repeated.
 
 The sample-efficiency measures read one run's evaluation curve (``steps``, ``values``), e.g. the greedy rate
 logged every few epochs in ``progress.csv``; rows whose value is NaN (epochs without an evaluation) are dropped.
@@ -31,6 +36,7 @@ logged every few epochs in ``progress.csv``; rows whose value is NaN (epochs wit
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from typing import NamedTuple
 
@@ -110,6 +116,14 @@ def _strata(scores_by_task: Sequence[ArrayLike], name: str = "scores_by_task") -
     return tasks
 
 
+def _equal_weights(samples, axis: int = -1) -> np.ndarray:
+    """The tasks' runs concatenated along ``axis``, each task's runs repeated to the least common multiple of the
+    tasks' run counts, so that every task weighs the same in a statistic of the pool."""
+    counts = [x.shape[axis] for x in samples]
+    common = math.lcm(*counts)
+    return np.concatenate([np.repeat(x, common // n, axis=axis) for x, n in zip(samples, counts)], axis=axis)
+
+
 def _bootstrap(samples: list[np.ndarray], statistic, confidence: float, resamples: int, seed: int):
     if not 0 < confidence < 1:
         raise ValueError(f"confidence must lie in (0, 1), got {confidence}")
@@ -123,6 +137,7 @@ def _bootstrap(samples: list[np.ndarray], statistic, confidence: float, resample
         method="percentile",  # as Agarwal et al.; BCa is NaN where the jackknife is flat, as at a profile's ends
         paired=False,  # each task's runs resampled on their own: the stratified bootstrap
         vectorized=True,
+        batch=max(1, 1_000_000 // len(_equal_weights(samples))),  # resampled pools of 1M values at a time at most
         rng=np.random.default_rng(seed),
     )
     return result.confidence_interval.low, result.confidence_interval.high
@@ -138,7 +153,8 @@ def interval(
     """An aggregate of all runs across tasks, with its stratified percentile-bootstrap interval.
 
     Each bootstrap sample redraws, for every task independently, as many runs as it has, with replacement;
-    ``statistic`` is applied to the runs of all tasks together, and the interval runs from the
+    ``statistic`` is applied to the runs of all tasks together (each task weighing the same, see the module's
+    notes), and the interval runs from the
     ``(1 - confidence) / 2`` to the ``(1 + confidence) / 2`` quantile of the ``resamples`` values it takes.
     Stratifying keeps each sample a study of the same tasks with the same number of runs: resampling the
     pooled runs instead could draw a sample made of one task's runs, widening the interval with a variability
@@ -151,7 +167,7 @@ def interval(
     tasks = _strata(scores_by_task)
 
     def pooled(*samples, axis=-1):
-        return statistic(np.concatenate(samples, axis=axis), axis=axis)
+        return statistic(_equal_weights(samples, axis=axis), axis=axis)
 
     low, high = _bootstrap(tasks, pooled, confidence, resamples, seed)
     return Estimate(pooled(*tasks), low, high)
@@ -168,14 +184,15 @@ def performance_profile(
 
     A profile (Agarwal et al.'s "run-score distribution", after Dolan and More's profiles for optimisers)
     shows every quantile at once: one method's curve lying above another's at every tau says it is better
-    whatever summary one picks. A run scoring exactly tau does not count as above it. The band around the
-    curve is the stratified percentile bootstrap of each point, as in :func:`interval`.
+    whatever summary one picks. A run scoring exactly tau does not count as above it; each task weighs the same
+    (the share is the average over tasks of each task's share). The band around the curve is the stratified
+    percentile bootstrap of each point, as in :func:`interval`.
     """
     tasks = _strata(scores_by_task)
     tau = np.asarray(thresholds, dtype=float).ravel()
 
     def above(*samples, axis=-1):
-        x = np.concatenate(samples, axis=axis)
+        x = _equal_weights(samples, axis=axis)
         return np.mean(x > tau.reshape((-1,) + (1,) * x.ndim), axis=-1)  # thresholds first, as SciPy expects
 
     low, high = _bootstrap(tasks, above, confidence, resamples, seed)
