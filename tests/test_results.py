@@ -226,6 +226,16 @@ def test_the_statistics_tables_hold_the_hand_computed_cells():
     assert standing[("| Hard Move n=4", "0.942 (CHDP)")][2:4] == ["0.950 [0.950, 0.950]", "above"]
 
 
+def test_the_readme_line_ranks_methods_by_their_aggregate_with_each_domain_weighing_the_same():
+    # X: six runs at 0 on Goal, two at 1 on Platform: each domain half the study, an IQM of 0.5 (pooled as they
+    # are, the middle four of eight would all be Goal's zeros: 0.0). Y: 0.3 everywhere. X ranks first.
+    x = [_summary("X on Goal", "pamdp/Goal-v0", seed, 0.0) for seed in range(6)]
+    x += [_summary("X on Platform", "pamdp/Platform-v0", seed, 1.0) for seed in range(2)]
+    y = [_summary(f"Y on {d}", f"pamdp/{d}-v0", seed, 0.3) for d in ("Goal", "Platform") for seed in range(2)]
+    line = results.aggregate_line(x + y)
+    assert line.index("X **0.500 [") < line.index("Y **0.300 [0.300, 0.300]**")
+
+
 def test_the_one_preset_table_judges_each_domain_against_hyars_figure_and_counts_them():
     one = [_summary("C on Platform", "pamdp/Platform-v0", seed, v) for seed, v in enumerate((0.99, 1.0, 0.97))]
     one += [_summary("C on Goal", "pamdp/Goal-v0", seed, 0.5) for seed in range(3)]

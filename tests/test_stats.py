@@ -60,8 +60,9 @@ def test_an_aggregate_weighs_each_task_the_same_whatever_its_number_of_runs():
     # is half zeros and half ones. Pooling the twelve runs as they are would drop three at each end and keep
     # six zeros: the task with more runs would decide.
     tasks = [[0.0] * 10, [1.0, 1.0]]
-    assert stats.interval(tasks, stats.iqm).value == pytest.approx(0.5)
+    assert stats.interval(tasks, stats.iqm).value == pytest.approx(0.5) == stats.aggregate(tasks)
     assert stats.iqm(np.concatenate(tasks)) == 0.0
+    assert stats.aggregate([[0.0] * 10, [1.0]]) == pytest.approx(0.5)  # one run: no interval, the same weight
     assert stats.interval(tasks, np.mean).value == pytest.approx(0.5)  # the mean of the tasks' means
     # three runs and two: repeated to six each, so 0 1 5 twice and 7 9 three times: the middle six of twelve
     est = stats.interval([[0.0, 1.0, 5.0], [7.0, 9.0]], stats.iqm, resamples=200)

@@ -280,7 +280,7 @@ def _main_cells(summaries: list[dict]) -> dict[str, dict[str, np.ndarray]]:
 
 def _estimate(tasks: list[np.ndarray], statistic) -> str:
     """``0.950 [0.948, 0.952]``, or the point estimate alone where the runs are too few for an interval."""
-    value = statistic(np.concatenate(tasks))
+    value = stats.aggregate(tasks, statistic)
     if sum(map(len, tasks)) < MIN_RUNS or min(map(len, tasks)) < 2:
         return f"{value:.3f} (no interval: n < {MIN_RUNS})" if len(tasks) == 1 else f"{value:.3f}"
     est = stats.interval(tasks, statistic)
@@ -366,7 +366,7 @@ def aggregate_line(summaries: list[dict]) -> str:
         found = []
         for method, by_domain in by_method.items():
             tasks = [by_domain[d] for d in domains_of(by_domain)]
-            found.append((float(stats.iqm(np.concatenate(tasks))), method, tasks))
+            found.append((stats.aggregate(tasks), method, tasks))
         parts = [
             f"{method} **{_estimate(tasks, stats.iqm)}** ({len(tasks)} domains, {sum(map(len, tasks))} runs)"
             for _, method, tasks in sorted(found, key=lambda f: -f[0])

@@ -48,6 +48,7 @@ __all__ = [
     "Estimate",
     "Profile",
     "Reached",
+    "aggregate",
     "interval",
     "iqm",
     "median_reached",
@@ -141,6 +142,15 @@ def _bootstrap(samples: list[np.ndarray], statistic, confidence: float, resample
         rng=np.random.default_rng(seed),
     )
     return result.confidence_interval.low, result.confidence_interval.high
+
+
+def aggregate(scores_by_task: Sequence[ArrayLike], statistic: Callable[..., float | np.ndarray] = iqm) -> float:
+    """``statistic`` of the runs of all tasks together, each task weighing the same (the point estimate of
+    :func:`interval`, which also takes tasks of a single run)."""
+    tasks = [np.asarray(t, dtype=float).ravel() for t in scores_by_task]
+    if not tasks or not all(len(t) for t in tasks):
+        raise ValueError("aggregate needs at least one task, each with at least one run")
+    return float(statistic(_equal_weights(tasks)))
 
 
 def interval(
