@@ -218,6 +218,13 @@ def test_the_statistics_tables_hold_the_hand_computed_cells():
     # reaches 1.0 and holds CHDP's 0.997; no curves logged
     platform = standing[("| Platform", "0.997 (CHDP)")]
     assert platform[:2] == ["A", "4"] and platform[3:] == ["within the interval", "- (no curves)", "400 |"]
+    line = results.standing_line(runs)  # the README's sentence of the same rows
+    assert line.startswith("Per domain, pamdp's best method against the best published figure, IQM with its 95 % ")
+    assert "over the runs (2 within the interval): Platform: A **" in line
+    assert line.endswith(
+        "Goal: A **0.667 [0.000, 1.000]** (3 runs; CHDP 0.809: within the interval; median samples to reach it 300 "
+        "of 400, 3 of 3 runs with curves reached it)."
+    )
     # runs that all score 0.5 on Platform and 0.95 on Hard Move n=4: intervals of one point, below 0.997 and above 0.942
     low = [_summary("C on Platform", "pamdp/Platform-v0", seed, 0.5) for seed in range(3)]
     high = [_summary("C on Hard Move n=4", "pamdp/HardMove-v0", seed, 0.95, env_kwargs={"n": 4}) for seed in range(3)]

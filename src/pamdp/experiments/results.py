@@ -45,6 +45,8 @@ __all__ = [
     "aggregate_line",
     "improvement_table",
     "efficiency_table",
+    "standing_table",
+    "standing_line",
     "plot_profiles",
     "plot_efficiency",
     "report",
@@ -95,15 +97,10 @@ def literature_best(domain: str) -> tuple[str, float] | None:
     return max(found, key=lambda mv: mv[1]) if found else None
 
 
-def standing_table(summaries: list[dict]) -> str:
-    """Per suite domain, pamdp's best method (the highest IQM of a main cell of at least :data:`MIN_RUNS` runs) against
-    the best published figure: its IQM with the 95 % interval, the verdict the interval gives, and samples: the
-    median to reach that figure (the runs with greedy curves) beside its budget."""
-    lines = [
-        "| domain | best published | pamdp's best | runs | IQM [95 % CI] | against the published | samples to reach "
-        "it (median) | pamdp's budget |",
-        "|---|---|---|---|---|---|---|---|",
-    ]
+def _standing(summaries: list[dict]) -> list[dict]:
+    """Per suite domain with a published figure and a cell of :data:`MIN_RUNS` runs: pamdp's best method against
+    the best published figure (:func:`standing_table`'s row, as numbers)."""
+    rows = []
     best_cells = _best_cells(summaries)
     for domain, _, _ in DOMAINS:
         best = literature_best(domain)
@@ -114,19 +111,70 @@ def standing_table(summaries: list[dict]) -> str:
         verdict = "above" if est.low > best[1] else "below" if est.high < best[1] else "within the interval"
         runs = cells(summaries)[(domain, method)]
         curves = _curves(runs)
-        reach = "- (no curves)"
-        if curves:
-            times = [stats.samples_to_reach(*c, target=best[1], budget=b) for c, b in curves]
-            median = stats.median_reached(times)
-            reach = (
-                f"{'' if median.reached else '> '}{median.step:,.0f} ({sum(t.reached for t in times)} of {len(times)})"
+        times = [stats.samples_to_reach(*c, target=best[1], budget=b) for c, b in curves]
+        rows.append(
+            dict(
+                domain=domain,
+                published=best,
+                method=method,
+                runs=len(runs),
+                estimate=est,
+                verdict=verdict,
+                reached=stats.median_reached(times) if times else None,
+                reached_runs=(sum(t.reached for t in times), len(times)),
+                budget=next((b for s in runs if (b := _budget(s)) is not None), None),
             )
-        budget = next((b for s in runs if (b := _budget(s)) is not None), None)
+        )
+    return rows
+
+
+def _samples(row: dict) -> str:
+    median = row["reached"]
+    if median is None:
+        return "- (no curves)"
+    return f"{'' if median.reached else '> '}{median.step:,.0f} ({row['reached_runs'][0]} of {row['reached_runs'][1]})"
+
+
+def standing_table(summaries: list[dict]) -> str:
+    """Per suite domain, pamdp's best method (the highest IQM of a main cell of at least :data:`MIN_RUNS` runs) against
+    the best published figure: its IQM with the 95 % interval, the verdict the interval gives, and samples: the
+    median to reach that figure (the runs with greedy curves) beside its budget."""
+    lines = [
+        "| domain | best published | pamdp's best | runs | IQM [95 % CI] | against the published | samples to reach "
+        "it (median) | pamdp's budget |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for row in _standing(summaries):
+        (source, figure), est, budget = row["published"], row["estimate"], row["budget"]
         lines.append(
-            f"| {domain} | {best[1]:.3f} ({best[0]}) | {method} | {len(runs)} | {est.value:.3f} [{est.low:.3f}, "
-            f"{est.high:.3f}] | {verdict} | {reach} | {'-' if budget is None else f'{budget:,.0f}'} |"
+            f"| {row['domain']} | {figure:.3f} ({source}) | {row['method']} | {row['runs']} | {est.value:.3f} "
+            f"[{est.low:.3f}, {est.high:.3f}] | {row['verdict']} | {_samples(row)} | "
+            f"{'-' if budget is None else f'{budget:,.0f}'} |"
         )
     return "\n".join(lines)
+
+
+def standing_line(summaries: list[dict]) -> str:
+    """:func:`standing_table` as one sentence, for a page that has no room for the table."""
+    parts, rows = [], _standing(summaries)
+    for row in rows:
+        (source, figure), est = row["published"], row["estimate"]
+        reach, median, (k, n) = "", row["reached"], row["reached_runs"]
+        if median is not None:
+            reach = (
+                f"; median samples to reach it {'' if median.reached else '> '}{median.step:,.0f} of "
+                f"{row['budget']:,.0f}, {k} of {n} runs with curves reached it"
+            )
+        parts.append(
+            f"{row['domain']}: {row['method']} **{est.value:.3f} [{est.low:.3f}, {est.high:.3f}]** ({row['runs']} "
+            f"runs; {source} {figure:.3f}: {row['verdict']}{reach})"
+        )
+    verdicts = [row["verdict"] for row in rows]
+    counts = ", ".join(f"{verdicts.count(v)} {v}" for v in ("above", "within the interval", "below") if v in verdicts)
+    return (
+        "Per domain, pamdp's best method against the best published figure, IQM with its 95 % interval over the "
+        f"runs ({counts}): " + "; ".join(parts) + "."
+    )
 
 
 def one_preset_table(summaries: list[dict], suite: list[dict]) -> str:
