@@ -503,7 +503,7 @@ def plot_profiles(summaries: list[dict], path: str | os.PathLike, title: str = "
         line = ax.plot(tau, profile.fraction, label=f"{method} ({runs} runs)", linewidth=1.4)[0]
         ax.fill_between(tau, profile.low, profile.high, color=line.get_color(), alpha=0.2, step=None)
     ax.set_xlabel("score tau (success rate; Platform: return)")
-    ax.set_ylabel("share of runs scoring above tau")
+    ax.set_ylabel("share of runs above tau\n(each domain weighing the same)", fontsize=9)
     ax.set_title(title or f"over {', '.join(shared)}", fontsize=9)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, frameon=False)
