@@ -484,8 +484,8 @@ def efficiency_table(summaries: list[dict]) -> str:
 
 def plot_profiles(summaries: list[dict], path: str | os.PathLike, title: str = "") -> list[Path]:
     """The performance profile of each method over the domains every method has 2 runs or more on (a profile over
-    other domains would compare other tasks): the share of its runs scoring above each threshold, with the 95 %
-    stratified bootstrap band; ``path`` with ``.png`` and ``.svg`` suffixes (nothing without such a domain)."""
+    other domains would compare other tasks): the share of its runs scoring above each threshold, each domain
+    weighing the same (:func:`.stats.performance_profile`), with the 95 % stratified bootstrap band; ``path`` with ``.png`` and ``.svg`` suffixes (nothing without such a domain)."""
     by_method, shared = _comparable(summaries)
     if not shared:
         return []
