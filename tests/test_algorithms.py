@@ -167,6 +167,14 @@ def test_same_seed_same_weights_to_the_bit_other_seed_others(trained):
     assert [n for n, b in module_bytes(other).items() if b == trained.final[n]] == []
 
 
+def test_greedy_evaluations_during_training_leave_the_run_as_it_was(trained):
+    """An evaluation after epoch 1 plays its own env copies with its own seed: epoch 2 trains as without it, so a
+    run's greedy curve can be logged without changing the run it describes."""
+    case = trained.case
+    evaluated = case.cls(ENV, case.config()).learn(STEPS, progress_bar=False, eval_every=1, eval_episodes=3)
+    assert module_bytes(evaluated) == trained.final
+
+
 def test_resumed_runs_go_on_from_the_checkpoint_alike(trained, tmp_path):
     """Loading the last checkpoint and training on continues the counters and the log; two resumptions of one
     checkpoint train alike, so a resumed run is as reproducible as one from the start."""
