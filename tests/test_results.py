@@ -180,13 +180,24 @@ def test_the_statistics_tables_hold_the_hand_computed_cells():
     # Goal, A: runs 0, 1, 1. The mean of three draws is 0 with probability (1/3)^3 = 1/27 > 2.5 % and 1 with
     # (2/3)^3 > 2.5 %: the 95 % percentile interval is [0, 1]; three runs drop none from the IQM.
     # A run of 1, 15 or 25 CPU minutes: the median 15 is not cheap, so the cell is to have 5 runs and owes 2
-    assert cells[("| Goal", "A")] == ["3", "0.667 [0.000, 1.000]", "0.667 [0.000, 1.000]", "0.78", "15.0", "2 |"]
+    # (its samples to 90 % of 0.78 and its AUC: as in the efficiency table below)
+    assert cells[("| Goal", "A")] == [
+        "3",
+        "0.667 [0.000, 1.000]",
+        "0.667 [0.000, 1.000]",
+        "0.78",
+        "300 (3 of 3 reached)",
+        "0.51",
+        "15.0",
+        "2 |",
+    ]
     # Platform, A: sorted 0.2 0.6 0.9 1.0, the IQM their middle two
     platform = cells[("| Platform", "A")]
     assert platform[0] == "4" and platform[1].startswith(f"{np.mean([0.9, 0.2, 0.6, 1.0]):.3f} [")
     assert platform[2].startswith(f"{(0.6 + 0.9) / 2:.3f} [")
-    assert platform[4:] == ["9.0", "6 |"]  # the median of 5, 9 and 12 minutes (one run unrecorded): cheap, 10 wanted
-    assert cells[("| Goal", "B")][4:] == ["-", "3 |"]  # no cost recorded: 5 wanted
+    # no curves; the median of 5, 9 and 12 minutes (one run unrecorded): cheap, 10 wanted
+    assert platform[4:] == ["- (no curves)", "-", "9.0", "6 |"]
+    assert cells[("| Goal", "B")][4:] == ["> 400 (0 of 2 reached)", "0.00", "-", "3 |"]  # no cost recorded: 5 wanted
     assert cells[("| Goal", "B")][1:3] == ["-1.400 (no interval: n < 3)"] * 2  # two runs: no interval
     aggregate = _cells(results.aggregate_table(runs).split("\n\n")[0])
     # each domain weighs the same: Goal's 3 runs repeated 4 times, Platform's 4 runs 3 times; of the 24, sorted

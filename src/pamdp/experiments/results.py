@@ -349,11 +349,12 @@ def seeds_wanted(cpu_minutes: float | None) -> int:
 
 def stats_table(summaries: list[dict]) -> str:
     """Per cell: its runs, the mean and the IQM of their scores with 95 % bootstrap intervals, how many are still
-    training (counted with their last greedy evaluation), the median CPU minutes a run and the runs it still owes
-    (:func:`seeds_wanted`)."""
+    training (counted with their last greedy evaluation), the sample efficiency of its runs with greedy curves (as
+    :func:`efficiency_table`), the median CPU minutes a run and the runs it still owes (:func:`seeds_wanted`)."""
     lines = [
-        "| domain | method | runs | mean [95 % CI] | IQM [95 % CI] | published best | CPU min a run | runs owed |",
-        "|---|---|---|---|---|---|---|---|",
+        "| domain | method | runs | mean [95 % CI] | IQM [95 % CI] | published best | samples to "
+        f"{TARGET * 100:g} % of it (median) | normalised AUC | CPU min a run | runs owed |",
+        "|---|---|---|---|---|---|---|---|---|---|",
     ]
     for (row, method), runs in cells(summaries).items():
         scores = np.array([score(s)[0] for s in runs])
@@ -364,9 +365,10 @@ def stats_table(summaries: list[dict]) -> str:
         minutes = _cpu_minutes(runs)
         cost = "-" if minutes is None else f"{minutes:.1f}"
         owed = max(0, seeds_wanted(minutes) - len(runs))
+        reach, auc = _reach_and_auc(runs, _curves(runs))
         lines.append(
-            f"| {row} | {method} | {n} | {mean} | {mid} | {'' if best is None else f'{best:.2f}'} | {cost} | "
-            f"{owed or '-'} |"
+            f"| {row} | {method} | {n} | {mean} | {mid} | {'' if best is None else f'{best:.2f}'} | {reach} | {auc} | "
+            f"{cost} | {owed or '-'} |"
         )
     return "\n".join(lines)
 
@@ -451,6 +453,21 @@ def _budget(summary: dict) -> float | None:
     return float(budget) if isinstance(budget, int) and budget > 0 else None
 
 
+def _reach_and_auc(runs: list[dict], curves: list) -> tuple[str, str]:
+    """The median samples to reach :data:`TARGET` of the best figure of HyAR's table (``"> N"`` where the median run
+    was censored, with how many runs reached it) and the mean normalised AUC of a cell's runs with ``curves``."""
+    if not curves:
+        return "- (no curves)", "-"
+    auc = np.mean([stats.normalised_auc(*c, budget=b) for c, b in curves])
+    best = published_best(_domain(runs[0]))
+    if best is None:
+        return "-", f"{auc:.2f}"
+    times = [stats.samples_to_reach(*c, target=TARGET * best, budget=b) for c, b in curves]
+    median = stats.median_reached(times)
+    count = f"{sum(t.reached for t in times)} of {len(times)} reached"
+    return f"{'' if median.reached else '> '}{median.step:,.0f} ({count})", f"{auc:.2f}"
+
+
 def efficiency_table(summaries: list[dict]) -> str:
     """Per cell with greedy curves: the mean over runs of the greedy figure at 10, 25, 50 and 100 % of the budget,
     the median samples to reach 90 % of the best published figure (:func:`.stats.median_reached`: ``>`` where the
@@ -470,22 +487,16 @@ def efficiency_table(summaries: list[dict]) -> str:
         with np.errstate(all="ignore"):
             at = np.array([stats.rate_at_fractions(*c, budget=b, fractions=FRACTIONS) for c, b in curves])
             rates = " / ".join("-" if np.isnan(col).all() else f"{np.nanmean(col):.2f}" for col in at.T)
-        auc = np.mean([stats.normalised_auc(*c, budget=b) for c, b in curves])
-        best = published_best(_domain(runs[0]))
-        reach = "-"
-        if best is not None:
-            times = [stats.samples_to_reach(*c, target=TARGET * best, budget=b) for c, b in curves]
-            median = stats.median_reached(times)
-            count = f"{sum(t.reached for t in times)} of {len(times)} reached"
-            reach = f"{'' if median.reached else '> '}{median.step:,.0f} ({count})"
-        lines.append(f"| {row} | {method} | {len(curves)} | {rates} | {reach} | {auc:.2f} |")
+        reach, auc = _reach_and_auc(runs, curves)
+        lines.append(f"| {row} | {method} | {len(curves)} | {rates} | {reach} | {auc} |")
     return "\n".join(lines)
 
 
 def plot_profiles(summaries: list[dict], path: str | os.PathLike, title: str = "") -> list[Path]:
     """The performance profile of each method over the domains every method has 2 runs or more on (a profile over
     other domains would compare other tasks): the share of its runs scoring above each threshold, each domain
-    weighing the same (:func:`.stats.performance_profile`), with the 95 % stratified bootstrap band; ``path`` with ``.png`` and ``.svg`` suffixes (nothing without such a domain)."""
+    weighing the same (:func:`.stats.performance_profile`), with the 95 % stratified bootstrap band; ``path`` with
+    ``.png`` and ``.svg`` suffixes (nothing without such a domain)."""
     by_method, shared = _comparable(summaries)
     if not shared:
         return []
