@@ -511,7 +511,7 @@ def plot_profiles(summaries: list[dict], path: str | os.PathLike, title: str = "
     for method, by_domain in by_method.items():
         profile = stats.performance_profile([by_domain[d] for d in shared], tau)
         runs = sum(len(by_domain[d]) for d in shared)
-        line = ax.plot(tau, profile.fraction, label=f"{method} ({runs} runs)", linewidth=1.4)[0]
+        line = ax.plot(tau, profile.fraction, label=f"{method} ({runs} runs)", linewidth=1.4, color=_colour(method))[0]
         ax.fill_between(tau, profile.low, profile.high, color=line.get_color(), alpha=0.2, step=None)
     ax.set_xlabel("score tau (success rate; Platform: return)")
     ax.set_ylabel("share of runs above tau\n(each domain weighing the same)", fontsize=9)
@@ -520,6 +520,16 @@ def plot_profiles(summaries: list[dict], path: str | os.PathLike, title: str = "
     ax.legend(fontsize=8, frameon=False)
     fig.tight_layout()
     return _save(fig, path)
+
+
+METHOD_COLOURS = ("HyAR-TD3", "Hybrid SAC", "MP-DQN", "PATRPO", "P-DQN")
+"""The suite's methods, each drawn in its own colour of Matplotlib's cycle in every panel and figure."""
+
+
+def _colour(method: str) -> str:
+    """A method's colour: the same in every panel (the methods a panel lacks do not shift the others')."""
+    known = METHOD_COLOURS.index(method) if method in METHOD_COLOURS else None
+    return f"C{known if known is not None else len(METHOD_COLOURS) + sum(map(ord, method)) % 5}"
 
 
 def _save(fig, path: str | os.PathLike) -> list[Path]:
@@ -565,7 +575,8 @@ def plot_efficiency(summaries: list[dict], path: str | os.PathLike) -> list[Path
                 at = np.array([stats.rate_at_fractions(*c, budget=b, fractions=grid) for c, b in curves])
             seen = ~np.isnan(at).any(axis=0)  # from the first fraction every run had been evaluated by
             mean = at.mean(axis=0)
-            line = ax.plot(grid[seen], mean[seen], label=f"{method} ({len(curves)})", linewidth=1.2)[0]
+            label, colour = f"{method} ({len(curves)})", _colour(method)
+            line = ax.plot(grid[seen], mean[seen], label=label, linewidth=1.2, color=colour)[0]
             if len(curves) >= MIN_RUNS:
                 bands = [stats.interval([at[:, i]], np.mean, resamples=500) for i in np.flatnonzero(seen)]
                 low, high = np.array([b.low for b in bands]), np.array([b.high for b in bands])
@@ -580,7 +591,7 @@ def plot_efficiency(summaries: list[dict], path: str | os.PathLike) -> list[Path
         ax.axis("off")
     fig.supxlabel("fraction of the budget", fontsize=9)
     fig.supylabel("greedy figure", fontsize=9)
-    fig.suptitle(f"greedy evaluations (dashed: {TARGET * 100:g} % of the best published figure)", fontsize=9)
+    fig.suptitle(f"greedy evaluations (dashed: {TARGET * 100:g} % of the best figure of HyAR's table)", fontsize=9)
     fig.tight_layout()
     return _save(fig, path)
 
