@@ -3,6 +3,7 @@ and the tables of a small hand-made set of summaries hold the hand-computed cell
 
 import csv
 import json
+import shutil
 import subprocess
 from pathlib import Path
 
@@ -124,6 +125,16 @@ def test_pamdp_summarize_writes_each_runs_summary_where_asked(tmp_path, capsys):
     assert json.loads((run / "summary.json").read_text()) == summarize(run)
     assert main(["summarize", str(tmp_path / "kept")]) == 2
     assert "no run directories" in capsys.readouterr().err
+    # a run still training (no final evaluation yet, fewer samples than its budget) is left out with --finished
+    training = shutil.copytree(run, tmp_path / "exp" / "arm" / "seed4")
+    (training / "evaluation.json").unlink()
+    (training / "summary.json").unlink()
+    recorded = json.loads((training / "run.json").read_text())
+    (training / "run.json").write_text(json.dumps({**recorded, "seed": 4, "total_steps": 1000}))
+    assert summarize(training)["finished"] is False
+    assert main(["summarize", str(tmp_path / "exp"), "--finished", "--out", str(tmp_path / "done")]) == 0
+    assert sorted(p.name for p in (tmp_path / "done" / "arm").iterdir()) == ["seed3.json"]
+    assert main(["summarize", str(training), "--finished"]) == 0 and not (training / "summary.json").exists()
 
 
 def test_a_summary_of_a_run_cut_before_its_first_checkpoint_does_not_stop_it_starting_again(tmp_path):

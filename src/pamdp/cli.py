@@ -322,6 +322,12 @@ def build_parser() -> argparse.ArgumentParser:
         help="write OUT/ARM/seedN.json (ARM: the run's label as a directory name) instead of RUN/summary.json, "
         "e.g. docs/results/summaries/EXPERIMENT",
     )
+    sm.add_argument(
+        "--finished",
+        action="store_true",
+        help="only the runs that finished (a final evaluation, or their whole budget): to collect a queue's results "
+        "while some of its runs still train",
+    )
 
     rd = sub.add_parser("render", help="write one episode to a GIF (a trained model, or random actions in an env)")
     rd.add_argument("source", help="run directory, model file, or a registered env id (random actions)")
@@ -491,6 +497,11 @@ def cmd_summarize(args) -> int:
         runs += [root] if (root / "run.json").exists() else _run_dirs(root)
     if not runs:
         raise ValueError(f"no run directories (with run.json and progress.csv) under {', '.join(args.dirs)}")
+    if args.finished:
+        runs = [run for run in runs if summarize(run)["finished"]]
+        if not runs:
+            print(f"no finished run under {', '.join(args.dirs)}", file=sys.stderr)
+            return 0
     written = save([summarize(run) for run in runs], args.out) if args.out else [write_summary(run) for run in runs]
     print("\n".join(map(str, written)))
     return 0
