@@ -15,8 +15,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from pamdp.algos.checkpoints import CHECKPOINT
 from pamdp.cli import main
 from pamdp.experiments import available_experiments, load_experiment
+from pamdp.experiments.runner import run_lock
 
 TINY_SETTINGS = "settings = { hidden_sizes = [16], vf_hidden_sizes = [16], batch_size = 200, num_envs = 4 }"
 
@@ -234,6 +236,55 @@ def test_training_logs_the_cpu_time_of_each_epoch(tmp_path):
         assert 0 < float(r["time/epoch_cpu_seconds"]) <= float(r["time/epoch_seconds"]) + 0.05
 
 
+def _alive(pid: int) -> bool:
+    """Whether process ``pid`` still runs (a zombie, ended but not yet reaped, does not)."""
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            return f.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
+@pytest.mark.skipif(not os.path.isdir("/proc/self/fd"), reason="finds the workers through /proc")
+def test_workers_stop_when_their_runner_is_killed_leaving_their_runs_to_resume(tmp_path):
+    exp = write_experiment(tmp_path / "tiny.toml")
+    exp.write_text(exp.read_text().replace("total_steps = 600", "total_steps = 20000"))
+    out = tmp_path / "results"
+    runs = out / "tiny" / "small_delta"
+    cmd = [sys.executable, "-m", "pamdp.cli", "reproduce", str(exp), "--out", str(out), "--workers", "2"]
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    deadline, workers = time.time() + 120, {}
+    while len(workers) < 2 and time.time() < deadline:
+        time.sleep(0.1)
+        for seed in (0, 1):
+            if seed not in workers and (runs / f"seed{seed}" / "checkpoint.pt").exists():
+                pid = _writer_of(runs / f"seed{seed}" / "stdout.log")
+                if pid is not None:
+                    workers[seed] = pid
+    assert len(workers) == 2 and proc.pid not in workers.values()
+    os.kill(proc.pid, signal.SIGKILL)  # the runner alone, as `kill -9 PID` would; its workers are not signalled
+    proc.wait()
+    deadline = time.time() + 30
+    while any(map(_alive, workers.values())) and time.time() < deadline:
+        time.sleep(0.1)
+    assert not any(map(_alive, workers.values())), "a worker trained on after its runner was killed"
+    for seed in (0, 1):  # stopped, not finished, with a checkpoint to resume from and no lock left held
+        assert not (runs / f"seed{seed}" / "evaluation.json").exists() and (runs / f"seed{seed}" / CHECKPOINT).exists()
+        with run_lock(runs / f"seed{seed}"):
+            pass
+
+
+def _writer_of(log) -> int | None:
+    """The process that holds ``log`` open (a worker writing its run's log)."""
+    for fd_dir in (f"/proc/{pid}/fd" for pid in os.listdir("/proc") if pid.isdigit()):
+        try:
+            if any(os.readlink(os.path.join(fd_dir, fd)) == str(log) for fd in os.listdir(fd_dir)):
+                return int(fd_dir.split("/")[2])
+        except OSError:
+            continue
+    return None
+
+
 @pytest.mark.skipif(not os.path.isdir("/proc/self/fd"), reason="finds the worker through /proc")
 def test_a_killed_worker_fails_its_run_alone(tmp_path):
     exp = write_experiment(tmp_path / "tiny.toml")
@@ -243,20 +294,11 @@ def test_a_killed_worker_fails_its_run_alone(tmp_path):
     cmd = [sys.executable, "-m", "pamdp.cli", "reproduce", str(exp), "--out", str(out), "--workers", "2"]
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
 
-    def worker_writing(log):  # the process that holds seed 1's log open
-        for fd_dir in (f"/proc/{pid}/fd" for pid in os.listdir("/proc") if pid.isdigit()):
-            try:
-                if any(os.readlink(os.path.join(fd_dir, fd)) == str(log) for fd in os.listdir(fd_dir)):
-                    return int(fd_dir.split("/")[2])
-            except OSError:
-                continue
-        return None
-
     deadline, victim = time.time() + 120, None
     while victim is None and time.time() < deadline:
         time.sleep(0.1)
         if (runs / "seed1" / "checkpoint.pt").exists():
-            victim = worker_writing(runs / "seed1" / "stdout.log")
+            victim = _writer_of(runs / "seed1" / "stdout.log")
     assert victim is not None and victim != proc.pid
     os.kill(victim, signal.SIGKILL)
     _, err = proc.communicate(timeout=300)

@@ -410,11 +410,28 @@ def train_run(
         return done if model is None else _train(model, spec, out, progress_bar, log, callback=callback)
 
 
-def _worker(spec: RunSpec, out: str, callback=None) -> dict:
+def _stop_when_orphaned(parent: int, every: float = 1.0) -> None:
+    """End this worker process once its runner ``parent`` is gone (killed, say, with ``kill`` rather than Ctrl-C,
+    which reaches the whole process group): an orphan would train on unseen and hold its run's lock, so that the
+    runner started again could not resume the run. The run keeps its last checkpoint to resume from."""
+    import signal
+    import threading
+
+    def watch() -> None:
+        while os.getppid() == parent:
+            time.sleep(every)
+        os.kill(os.getpid(), signal.SIGTERM)
+
+    threading.Thread(target=watch, name="pamdp-orphan-watch", daemon=True).start()
+
+
+def _worker(spec: RunSpec, out: str, callback=None, parent: int | None = None) -> dict:
     import torch
 
     from pamdp._memory import keep_freed_memory
 
+    if parent is not None:
+        _stop_when_orphaned(parent)
     keep_freed_memory()  # a spawned process: the parent's allocator settings are not inherited
     torch.set_num_threads(1)
     log_file = Path(out) / "stdout.log"
@@ -472,7 +489,8 @@ def run_all(jobs: list[tuple[RunSpec, str]], workers: int = 1, log=print) -> lis
         t0 = time.time()
         try:
             with cf.ProcessPoolExecutor(max_workers=1, mp_context=ctx) as pool:
-                return RunOutcome(spec, out, pool.submit(_worker, spec, out).result(), None, time.time() - t0)
+                result = pool.submit(_worker, spec, out, None, os.getpid()).result()
+                return RunOutcome(spec, out, result, None, time.time() - t0)
         except Exception as exc:
             return RunOutcome(spec, out, None, "".join(traceback.format_exception(exc)), time.time() - t0)
 
