@@ -237,21 +237,36 @@ def test_training_logs_the_cpu_time_of_each_epoch(tmp_path):
 
 
 def _alive(pid: int) -> bool:
-    """Whether process ``pid`` still runs (a zombie, ended but not yet reaped, does not)."""
+    """Whether process ``pid`` still runs: any of its threads not a zombie (ended, not yet reaped). The main thread
+    of an ending process can be a zombie while its other threads, and the files they hold, are still being torn
+    down."""
     try:
-        with open(f"/proc/{pid}/stat") as f:
-            return f.read().rsplit(")", 1)[1].split()[0] != "Z"
+        tasks = os.listdir(f"/proc/{pid}/task")
     except OSError:
         return False
+    for task in tasks:
+        try:
+            with open(f"/proc/{pid}/task/{task}/stat") as f:
+                if f.read().rsplit(")", 1)[1].split()[0] != "Z":
+                    return True
+        except OSError:
+            continue
+    return False
 
 
 @pytest.mark.skipif(not os.path.isdir("/proc/self/fd"), reason="finds the workers through /proc")
-def test_workers_stop_when_their_runner_is_killed_leaving_their_runs_to_resume(tmp_path):
+def _two_workers(tmp_path, steps: int):
+    """The tiny experiment at ``steps`` samples a run: its seeds' run directories' parent and the command that runs
+    its two seeds side by side."""
     exp = write_experiment(tmp_path / "tiny.toml")
-    exp.write_text(exp.read_text().replace("total_steps = 600", "total_steps = 20000"))
+    exp.write_text(exp.read_text().replace("total_steps = 600", f"total_steps = {steps}"))
     out = tmp_path / "results"
-    runs = out / "tiny" / "small_delta"
     cmd = [sys.executable, "-m", "pamdp.cli", "reproduce", str(exp), "--out", str(out), "--workers", "2"]
+    return out / "tiny" / "small_delta", cmd
+
+
+def test_workers_stop_when_their_runner_is_killed_leaving_their_runs_to_resume(tmp_path):
+    runs, cmd = _two_workers(tmp_path, 20000)
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
     deadline, workers = time.time() + 120, {}
     while len(workers) < 2 and time.time() < deadline:
@@ -287,11 +302,7 @@ def _writer_of(log) -> int | None:
 
 @pytest.mark.skipif(not os.path.isdir("/proc/self/fd"), reason="finds the worker through /proc")
 def test_a_killed_worker_fails_its_run_alone(tmp_path):
-    exp = write_experiment(tmp_path / "tiny.toml")
-    exp.write_text(exp.read_text().replace("total_steps = 600", "total_steps = 3000"))
-    out = tmp_path / "results"
-    runs = out / "tiny" / "small_delta"
-    cmd = [sys.executable, "-m", "pamdp.cli", "reproduce", str(exp), "--out", str(out), "--workers", "2"]
+    runs, cmd = _two_workers(tmp_path, 3000)
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
 
     deadline, victim = time.time() + 120, None
