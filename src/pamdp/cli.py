@@ -497,12 +497,13 @@ def cmd_summarize(args) -> int:
         runs += [root] if (root / "run.json").exists() else _run_dirs(root)
     if not runs:
         raise ValueError(f"no run directories (with run.json and progress.csv) under {', '.join(args.dirs)}")
+    summaries = [summarize(run) for run in runs]
     if args.finished:
-        runs = [run for run in runs if summarize(run)["finished"]]
+        runs, summaries = [r for r, s in zip(runs, summaries) if s["finished"]], [s for s in summaries if s["finished"]]
         if not runs:
             print(f"no finished run under {', '.join(args.dirs)}", file=sys.stderr)
             return 0
-    written = save([summarize(run) for run in runs], args.out) if args.out else [write_summary(run) for run in runs]
+    written = save(summaries, args.out) if args.out else [write_summary(run) for run in runs]
     print("\n".join(map(str, written)))
     return 0
 
