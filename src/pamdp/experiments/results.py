@@ -102,6 +102,7 @@ def _standing(summaries: list[dict]) -> list[dict]:
     the best published figure (:func:`standing_table`'s row, as numbers)."""
     rows = []
     best_cells = _best_cells(summaries)
+    by_cell = cells(summaries)
     for domain, _, _ in DOMAINS:
         best = literature_best(domain)
         if best is None or domain not in best_cells:
@@ -109,7 +110,7 @@ def _standing(summaries: list[dict]) -> list[dict]:
         method, scores = best_cells[domain]
         est = stats.interval([scores], stats.iqm)
         verdict = "above" if est.low > best[1] else "below" if est.high < best[1] else "within the interval"
-        runs = cells(summaries)[(domain, method)]
+        runs = by_cell[(domain, method)]
         curves = _curves(runs)
         times = [stats.samples_to_reach(*c, target=best[1], budget=b) for c, b in curves]
         rows.append(

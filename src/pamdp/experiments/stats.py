@@ -125,6 +125,11 @@ def _equal_weights(samples, axis: int = -1) -> np.ndarray:
     return np.concatenate([np.repeat(x, common // n, axis=axis) for x, n in zip(samples, counts)], axis=axis)
 
 
+def _pool_size(samples) -> int:
+    """The length of :func:`_equal_weights`' pool, without building it."""
+    return len(samples) * math.lcm(*(len(x) for x in samples))
+
+
 def _bootstrap(samples: list[np.ndarray], statistic, confidence: float, resamples: int, seed: int):
     if not 0 < confidence < 1:
         raise ValueError(f"confidence must lie in (0, 1), got {confidence}")
@@ -138,7 +143,7 @@ def _bootstrap(samples: list[np.ndarray], statistic, confidence: float, resample
         method="percentile",  # as Agarwal et al.; BCa is NaN where the jackknife is flat, as at a profile's ends
         paired=False,  # each task's runs resampled on their own: the stratified bootstrap
         vectorized=True,
-        batch=max(1, 1_000_000 // len(_equal_weights(samples))),  # resampled pools of 1M values at a time at most
+        batch=max(1, 1_000_000 // _pool_size(samples)),  # resampled pools of 1M values at a time at most
         rng=np.random.default_rng(seed),
     )
     return result.confidence_interval.low, result.confidence_interval.high
