@@ -187,7 +187,8 @@ def _cells(table):
 
 def test_the_statistics_tables_hold_the_hand_computed_cells():
     runs = _synthetic()
-    cells = _cells(results.stats_table(runs))
+    table, backlog = results.stats_table(runs).split("\n\n")
+    cells = _cells(table)
     # Goal, A: runs 0, 1, 1. The mean of three draws is 0 with probability (1/3)^3 = 1/27 > 2.5 % and 1 with
     # (2/3)^3 > 2.5 %: the 95 % percentile interval is [0, 1]; three runs drop none from the IQM.
     # A run of 1, 15 or 25 CPU minutes: the median 15 is not cheap, so the cell is to have 5 runs and owes 2
@@ -210,6 +211,11 @@ def test_the_statistics_tables_hold_the_hand_computed_cells():
     assert platform[4:] == ["- (no curves)", "-", "9.0", "6 |"]
     assert cells[("| Goal", "B")][4:] == ["> 400 (0 of 2 reached)", "0.00", "-", "3 |"]  # no cost recorded: 5 wanted
     assert cells[("| Goal", "B")][1:3] == ["-1.400 (no interval: n < 3)"] * 2  # two runs: no interval
+    # owed: Goal A 2 at 15 min, Platform A 6 at 9 min (84 min); Goal B 3 and Platform B 2, no cost recorded
+    assert backlog == (
+        "Runs owed: 13 over 4 cells; the 8 in cells that recorded their cost, about 1.4 CPU hours at those costs; "
+        "5 in cells whose runs recorded none (archived figures)."
+    )
     aggregate = _cells(results.aggregate_table(runs).split("\n\n")[0])
     # each domain weighs the same: Goal's 3 runs repeated 4 times, Platform's 4 runs 3 times; of the 24, sorted
     # 0 x4, 0.2 x3, 0.6 x3, 0.9 x3, 1 x11, six dropped at each end leave 0.2, 0.6 x3, 0.9 x3, 1 x5

@@ -41,6 +41,7 @@ __all__ = [
     "cells",
     "stats_table",
     "seeds_wanted",
+    "backlog_line",
     "aggregate_table",
     "aggregate_line",
     "improvement_table",
@@ -351,7 +352,8 @@ def seeds_wanted(cpu_minutes: float | None) -> int:
 def stats_table(summaries: list[dict]) -> str:
     """Per cell: its runs, the mean and the IQM of their scores with 95 % bootstrap intervals, how many are still
     training (counted with their last greedy evaluation), the sample efficiency of its runs with greedy curves (as
-    :func:`efficiency_table`), the median CPU minutes a run and the runs it still owes (:func:`seeds_wanted`)."""
+    :func:`efficiency_table`), the median CPU minutes a run and the runs it still owes (:func:`seeds_wanted`); below
+    it, the backlog in all (:func:`backlog_line`)."""
     lines = [
         "| domain | method | runs | mean [95 % CI] | IQM [95 % CI] | published best | samples to "
         f"{TARGET * 100:g} % of it (median) | normalised AUC | CPU min a run | runs owed |",
@@ -371,7 +373,29 @@ def stats_table(summaries: list[dict]) -> str:
             f"| {row} | {method} | {n} | {mean} | {mid} | {'' if best is None else f'{best:.2f}'} | {reach} | {auc} | "
             f"{cost} | {owed or '-'} |"
         )
-    return "\n".join(lines)
+    return "\n".join(lines) + "\n\n" + backlog_line(summaries)
+
+
+def backlog_line(summaries: list[dict]) -> str:
+    """The runs the cells still owe in all (:func:`seeds_wanted`), and what they cost at each cell's median CPU
+    minutes a run, apart from those of cells where no run recorded its cost."""
+    owed, minutes, unpriced = {}, 0.0, 0
+    for key, runs in cells(summaries).items():
+        cost = _cpu_minutes(runs)
+        n = max(0, seeds_wanted(cost) - len(runs))
+        if n:
+            owed[key] = n
+            minutes += n * (cost or 0.0)
+            unpriced += n if cost is None else 0
+    if not owed:
+        return "Runs owed: none."
+    priced = sum(owed.values()) - unpriced
+    text = f"Runs owed: {sum(owed.values())} over {len(owed)} cells"
+    if priced:
+        text += f"; the {priced} in cells that recorded their cost, about {minutes / 60:.1f} CPU hours at those costs"
+    if unpriced:
+        text += f"; {unpriced} in cells whose runs recorded none (archived figures)"
+    return text + "."
 
 
 def _stratified(by_domain: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
