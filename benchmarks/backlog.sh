@@ -62,10 +62,10 @@ seeds() {  # issue 44: 5 seeds a cell, 10 where a run costs under 10 CPU minutes
     $s --seeds 3,4 --runs "$patrpo,$hm"                                           # 0.5-6 (done)
     $s --seeds 3,4 --runs "HyAR-TD3_on_Platform,Hybrid_SAC_on_Catch_Point"        # 4, 11 (done)
     $s --seeds 3,4 --runs "MP-DQN_on_Goal,MP-DQN_on_Hard_Goal"                    # 19, 30 (done)
-    $s --seeds 5,6,7,8,9 --runs "$hm"                                             # 1-6: PATRPO, the best on Hard Move
-    $s --seeds 3,4 --runs "HyAR-TD3_on_Goal,HyAR-TD3_on_Hard_Goal,MP-DQN_on_Platform"   # 5-6
-    $s --seeds 5,6,7,8,9 --runs "HyAR-TD3_on_Platform"                            # 4: the best on Platform
-    $s --seeds 3,4 --runs "HyAR-TD3_on_Catch_Point,MP-DQN_on_Catch_Point"         # 17, 28
+    $s --seeds 5,6,7,8,9 --runs "$hm"                                             # 1-6: PATRPO, the best on Hard Move (done)
+    $s --seeds 3,4 --runs "HyAR-TD3_on_Goal,HyAR-TD3_on_Hard_Goal,MP-DQN_on_Platform"   # 5-6, 1.5 (done)
+    $s --seeds 5,6,7,8,9 --runs "HyAR-TD3_on_Platform"                            # 4: the best on Platform (done)
+    $s --seeds 3,4 --runs "HyAR-TD3_on_Catch_Point,MP-DQN_on_Catch_Point"         # 17, 12 (MP-DQN done)
     $s --seeds 3,4 --runs "HyAR-TD3_on_Hard_Move_n=4,HyAR-TD3_on_Hard_Move_n=6"   # 20 each
     $s --seeds 3,4 --runs "HyAR-TD3_on_Hard_Move_n=8,HyAR-TD3_on_Hard_Move_n=10"  # 20 each
     $s --seeds 5,6,7,8,9 --runs "HyAR-TD3_on_Goal,HyAR-TD3_on_Hard_Goal,MP-DQN_on_Platform"

@@ -338,7 +338,8 @@ def _estimate(tasks: list[np.ndarray], statistic) -> str:
 
 
 def _cpu_minutes(runs: list[dict]) -> float | None:
-    """The median CPU minutes a run of the runs that recorded their cost (archived figures did not)."""
+    """The median CPU minutes a run of the runs that recorded their cost (archived figures did not): its training
+    epochs' CPU time (the summary's ``cpu_seconds``), greedy evaluations not counted."""
     costs = [s["cpu_seconds"] / 60 for s in runs if isinstance(s.get("cpu_seconds"), (int, float))]
     return float(np.median(costs)) if costs else None
 
