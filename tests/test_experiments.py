@@ -254,7 +254,6 @@ def _alive(pid: int) -> bool:
     return False
 
 
-@pytest.mark.skipif(not os.path.isdir("/proc/self/fd"), reason="finds the workers through /proc")
 def _two_workers(tmp_path, steps: int):
     """The tiny experiment at ``steps`` samples a run: its seeds' run directories' parent and the command that runs
     its two seeds side by side."""
@@ -265,6 +264,7 @@ def _two_workers(tmp_path, steps: int):
     return out / "tiny" / "small_delta", cmd
 
 
+@pytest.mark.skipif(not os.path.isdir("/proc/self/fd"), reason="finds the workers through /proc")
 def test_workers_stop_when_their_runner_is_killed_leaving_their_runs_to_resume(tmp_path):
     runs, cmd = _two_workers(tmp_path, 20000)
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
