@@ -497,13 +497,13 @@ def cmd_summarize(args) -> int:
         runs += [root] if (root / "run.json").exists() else _run_dirs(root)
     if not runs:
         raise ValueError(f"no run directories (with run.json and progress.csv) under {', '.join(args.dirs)}")
-    summaries = [summarize(run) for run in runs]
+    kept = [(run, summarize(run)) for run in runs]  # each run summarized once, whether filtered, saved or written
     if args.finished:
-        runs, summaries = [r for r, s in zip(runs, summaries) if s["finished"]], [s for s in summaries if s["finished"]]
-        if not runs:
+        kept = [(run, s) for run, s in kept if s["finished"]]
+        if not kept:
             print(f"no finished run under {', '.join(args.dirs)}", file=sys.stderr)
             return 0
-    written = save(summaries, args.out) if args.out else [write_summary(run) for run in runs]
+    written = save([s for _, s in kept], args.out) if args.out else [write_summary(run, s) for run, s in kept]
     print("\n".join(map(str, written)))
     return 0
 

@@ -146,12 +146,13 @@ def summarize(run: str | os.PathLike) -> dict:
     }
 
 
-def write_summary(run: str | os.PathLike) -> Path:
-    """:func:`summarize` ``run`` into its own ``summary.json``, atomically (a kill leaves the old one or none)."""
+def write_summary(run: str | os.PathLike, summary: dict | None = None) -> Path:
+    """:func:`summarize` ``run`` (or take its ``summary``, made already) into its own ``summary.json``, atomically (a
+    kill leaves the old one or none)."""
     from pamdp.atomic import atomic_write_text
 
     path = Path(run) / SUMMARY
-    atomic_write_text(path, json.dumps(summarize(run), indent=1) + "\n")
+    atomic_write_text(path, json.dumps(summarize(run) if summary is None else summary, indent=1) + "\n")
     return path
 
 
