@@ -216,6 +216,7 @@ def test_the_statistics_tables_hold_the_hand_computed_cells():
         "Runs owed: 13 over 4 cells; the 8 in cells that recorded their cost, about 1.4 CPU hours at those costs; "
         "5 in cells whose runs recorded none (archived figures)."
     )
+    assert results.backlog_line(runs) == backlog  # the line alone, as the table's foot
     aggregate = _cells(results.aggregate_table(runs).split("\n\n")[0])
     # each domain weighs the same: Goal's 3 runs repeated 4 times, Platform's 4 runs 3 times; of the 24, sorted
     # 0 x4, 0.2 x3, 0.6 x3, 0.9 x3, 1 x11, six dropped at each end leave 0.2, 0.6 x3, 0.9 x3, 1 x5

@@ -360,38 +360,45 @@ def stats_table(summaries: list[dict]) -> str:
         f"{TARGET * 100:g} % of it (median) | normalised AUC | CPU min a run | runs owed |",
         "|---|---|---|---|---|---|---|---|---|---|",
     ]
+    backlog = []
     for (row, method), runs in cells(summaries).items():
         scores = np.array([score(s)[0] for s in runs])
         partial = sum(not score(s)[1] for s in runs)
         n = f"{len(runs)}" + (f" ({partial} partial*)" if partial else "")
         best = published_best(_domain(runs[0]))
         mean, mid = _estimate([scores], np.mean), _estimate([scores], stats.iqm)
-        minutes = _cpu_minutes(runs)
+        minutes, owed = _owed(runs)
+        backlog.append((minutes, owed))
         cost = "-" if minutes is None else f"{minutes:.1f}"
-        owed = max(0, seeds_wanted(minutes) - len(runs))
         reach, auc = _reach_and_auc(runs, _curves(runs))
         lines.append(
             f"| {row} | {method} | {n} | {mean} | {mid} | {'' if best is None else f'{best:.2f}'} | {reach} | {auc} | "
             f"{cost} | {owed or '-'} |"
         )
-    return "\n".join(lines) + "\n\n" + backlog_line(summaries)
+    return "\n".join(lines) + "\n\n" + _backlog_text(backlog)
+
+
+def _owed(runs: list[dict]) -> tuple[float | None, int]:
+    """A cell's median CPU minutes a run (:func:`_cpu_minutes`) and the runs it still owes (:func:`seeds_wanted`)."""
+    minutes = _cpu_minutes(runs)
+    return minutes, max(0, seeds_wanted(minutes) - len(runs))
 
 
 def backlog_line(summaries: list[dict]) -> str:
     """The runs the cells still owe in all (:func:`seeds_wanted`), and what they cost at each cell's median CPU
     minutes a run, apart from those of cells where no run recorded its cost."""
-    owed, minutes, unpriced = {}, 0.0, 0
-    for key, runs in cells(summaries).items():
-        cost = _cpu_minutes(runs)
-        n = max(0, seeds_wanted(cost) - len(runs))
-        if n:
-            owed[key] = n
-            minutes += n * (cost or 0.0)
-            unpriced += n if cost is None else 0
+    return _backlog_text([_owed(runs) for runs in cells(summaries).values()])
+
+
+def _backlog_text(cells_owed: list[tuple[float | None, int]]) -> str:
+    """:func:`backlog_line` of the cells' ``(median CPU minutes a run, runs owed)``."""
+    owed = [(cost, n) for cost, n in cells_owed if n]
     if not owed:
         return "Runs owed: none."
-    priced = sum(owed.values()) - unpriced
-    text = f"Runs owed: {sum(owed.values())} over {len(owed)} cells"
+    unpriced = sum(n for cost, n in owed if cost is None)
+    minutes = sum(n * cost for cost, n in owed if cost is not None)
+    priced = sum(n for _, n in owed) - unpriced
+    text = f"Runs owed: {sum(n for _, n in owed)} over {len(owed)} cells"
     if priced:
         text += f"; the {priced} in cells that recorded their cost, about {minutes / 60:.1f} CPU hours at those costs"
     if unpriced:
