@@ -48,7 +48,8 @@ def tables() -> dict[str, str]:
         "suite-standing": results.standing_table(suite) + "\n",
         "one-preset": results.one_preset_table(summaries("one-preset"), suite) + "\n",
         "readme-suite": "Benchmark suite, generated from the committed summaries ([how](docs/results.md"
-        "#intervals-profiles-and-sample-efficiency-issue-44)): " + results.aggregate_line(suite) + "\n",
+        "#intervals-profiles-and-sample-efficiency-issue-44)): " + results.aggregate_line(suite) + " "
+        + results.runs_line(suite) + "\n",
         "readme-standing": results.standing_line(suite) + "\n",
     }
 

@@ -217,6 +217,8 @@ def test_the_statistics_tables_hold_the_hand_computed_cells():
         "5 in cells whose runs recorded none (archived figures)."
     )
     assert results.backlog_line(runs) == backlog  # the line alone, as the table's foot
+    # the runs a cell by method, counted above (A: Goal 3, Platform 4; B: Goal 2, Platform 3), then the same backlog
+    assert results.runs_line(runs) == f"Runs a cell: A 3 to 4 on 2 domains; B 2 to 3 on 2 domains. {backlog}"
     aggregate = _cells(results.aggregate_table(runs).split("\n\n")[0])
     # each domain weighs the same: Goal's 3 runs repeated 4 times, Platform's 4 runs 3 times; of the 24, sorted
     # 0 x4, 0.2 x3, 0.6 x3, 0.9 x3, 1 x11, six dropped at each end leave 0.2, 0.6 x3, 0.9 x3, 1 x5

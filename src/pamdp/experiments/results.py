@@ -42,6 +42,7 @@ __all__ = [
     "stats_table",
     "seeds_wanted",
     "backlog_line",
+    "runs_line",
     "aggregate_table",
     "aggregate_line",
     "improvement_table",
@@ -388,6 +389,17 @@ def backlog_line(summaries: list[dict]) -> str:
     """The runs the cells still owe in all (:func:`seeds_wanted`), and what they cost at each cell's median CPU
     minutes a run, apart from those of cells where no run recorded its cost."""
     return _backlog_text([_owed(runs) for runs in cells(summaries).values()])
+
+
+def runs_line(summaries: list[dict]) -> str:
+    """One sentence of each method's runs a cell (its main setting on each domain, as :func:`cells`), then the
+    backlog (:func:`backlog_line`): the counts a page states without a table."""
+    parts = []
+    for method, by_domain in sorted(_main_cells(summaries).items()):
+        counts = sorted(len(scores) for scores in by_domain.values())
+        spread = f"{counts[0]}" if counts[0] == counts[-1] else f"{counts[0]} to {counts[-1]}"
+        parts.append(f"{method} {spread} on {len(counts)} domain{'s' * (len(counts) > 1)}")
+    return f"Runs a cell: {'; '.join(parts)}. {backlog_line(summaries)}"
 
 
 def _backlog_text(cells_owed: list[tuple[float | None, int]]) -> str:
