@@ -69,11 +69,11 @@ seeds() {  # issue 44: 5 seeds a cell, 10 where a run costs under 10 CPU minutes
     $s --seeds 3,4 --runs "HyAR-TD3_on_Hard_Move_n=4,HyAR-TD3_on_Hard_Move_n=6"   # 20 each
     $s --seeds 3,4 --runs "HyAR-TD3_on_Hard_Move_n=8,HyAR-TD3_on_Hard_Move_n=10"  # 20 each
     $s --seeds 5,6,7,8,9 --runs "HyAR-TD3_on_Goal,HyAR-TD3_on_Hard_Goal,MP-DQN_on_Platform"
-    $s --seeds 3,4 --runs "Hybrid_SAC_on_Platform,Hybrid_SAC_on_Goal,Hybrid_SAC_on_Hard_Goal"  # 2-3
-    $s --seeds 3,4 --runs "Hybrid_SAC_on_Hard_Move_n=4"                           # 9
+    $s --seeds 3,4 --runs "Hybrid_SAC_on_Platform,Hybrid_SAC_on_Goal,Hybrid_SAC_on_Hard_Goal"  # 1.3-3 (done)
+    $s --seeds 5,6,7,8,9 --runs "PATRPO_on_Catch_Point"                           # 3.7: HPPO's column of HyAR's table
+    $s --seeds 5,6,7,8,9 --runs "Hybrid_SAC_on_Platform,Hybrid_SAC_on_Goal,Hybrid_SAC_on_Hard_Goal"
+    $s --seeds 3,4,5,6,7,8,9 --runs "Hybrid_SAC_on_Hard_Move_n=4"                 # 9
     $s --seeds 1,2,3,4 --runs "Hybrid_SAC_on_Hard_Move_n=6"                       # 11
-    $s --seeds 5,6,7,8,9 --runs "$patrpo,Hybrid_SAC_on_Platform,Hybrid_SAC_on_Goal,Hybrid_SAC_on_Hard_Goal"
-    $s --seeds 5,6,7,8,9 --runs "Hybrid_SAC_on_Hard_Move_n=4"
 }
 
 queues=("${@:-soccer}" ) && [ $# -eq 0 ] && queues=(soccer suite seeds)
