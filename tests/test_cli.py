@@ -71,6 +71,9 @@ def test_bad_values_give_clear_errors(tmp_path, capsys):
     [
         (["reproduce", "step-size", "--seeds", "0,x", "--status"], "--seeds: '0,x'; expected comma-separated seeds"),
         (["reproduce", "step-size", "--seeds", "-1", "--status"], "--seeds: '-1'; expected comma-separated seeds"),
+        (["reproduce", "step-size", "--seeds", "5-3", "--status"], "--seeds: '5-3': '5-3' is not a range first-last"),
+        (["reproduce", "step-size", "--seeds", "0-2,2", "--status"], "--seeds: '0-2,2' names seed 2 twice"),
+        (["reproduce", "step-size", "--seeds", "0-5000", "--status"], "'0-5000' names 5001 seeds; expected at most"),
         (["reproduce", "step-size", "--workers", "0", "--status"], "--workers: '0'; expected an integer >= 1"),
         (["train", "patrpo", "--env-kwargs", "{bad"], "--env-kwargs: '{bad' is not valid JSON"),
         (["train", "patrpo", "--env-kwargs", "[1]"], "--env-kwargs: '[1]'; expected a JSON object"),
@@ -80,6 +83,13 @@ def test_bad_arguments_are_refused_before_anything_runs(argv, message, capsys):
     with pytest.raises(SystemExit) as exit_info:
         main(argv)
     assert exit_info.value.code == 2 and message in capsys.readouterr().err
+
+
+def test_seeds_take_ranges_as_well_as_lists():
+    from pamdp.cli import build_parser
+
+    args = build_parser().parse_args(["reproduce", "step-size", "--seeds", "2-4,7,9-9"])
+    assert args.seeds == [2, 3, 4, 7, 9]
 
 
 @pytest.mark.parametrize(

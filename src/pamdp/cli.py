@@ -131,10 +131,30 @@ _count = _integer(0)
 _seed = _integer(0, MAX_SEED, "a seed")
 
 
+MAX_RANGE = 1000
+"""The most seeds one range of ``--seeds`` may name."""
+
+
 def _seed_list(text: str) -> list[int]:
-    seeds = [_whole(s) for s in text.split(",")]
+    """Comma-separated seeds, each a seed or an inclusive range ``first-last`` (``0-4,9``)."""
+    seeds: list[int | None] = []
+    for item in text.split(","):
+        first, dash, last = item.partition("-")
+        if first and dash:  # a range; a leading "-" is a negative seed, refused below
+            low, high = _whole(first), _whole(last)
+            if low is None or high is None or not 0 <= low <= high <= MAX_SEED:
+                raise argparse.ArgumentTypeError(f"{text!r}: {item!r} is not a range first-last; expected such as 5-9")
+            if high - low >= MAX_RANGE:  # a run a seed: a range this long is a typing slip, not an experiment
+                raise argparse.ArgumentTypeError(
+                    f"{text!r}: {item!r} names {high - low + 1} seeds; expected at most {MAX_RANGE}"
+                )
+            seeds.extend(range(low, high + 1))
+        else:
+            seeds.append(_whole(item))
     if any(s is None or not 0 <= s <= MAX_SEED for s in seeds):
-        raise argparse.ArgumentTypeError(f"{text!r}; expected comma-separated seeds >= 0, such as 0,1,2")
+        raise argparse.ArgumentTypeError(
+            f"{text!r}; expected comma-separated seeds >= 0 or ranges, such as 0,1,2 or 0-4"
+        )
     twice = sorted({s for s in seeds if seeds.count(s) > 1})
     if twice:  # two runs of one seed would write one run directory
         raise argparse.ArgumentTypeError(f"{text!r} names seed {twice[0]} twice; expected each seed once")
@@ -275,7 +295,12 @@ def build_parser() -> argparse.ArgumentParser:
         "reproduce", help="run an experiment (the paper's figures, the benchmark suite) and plot it: all runs and seeds"
     )
     rp.add_argument("name", help=f"{', '.join(available_experiments())}, or an experiment TOML file")
-    rp.add_argument("--seeds", type=_seed_list, default=None, help="comma-separated seeds (default: the experiment's)")
+    rp.add_argument(
+        "--seeds",
+        type=_seed_list,
+        default=None,
+        help="comma-separated seeds or ranges, e.g. 0-4,9 (default: the experiment's)",
+    )
     rp.add_argument(
         "--runs", type=_items, default=None, help="comma-separated run labels to run (default: all), e.g. --runs PATRPO"
     )
