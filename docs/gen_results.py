@@ -19,7 +19,7 @@ import re
 import sys
 from pathlib import Path
 
-from pamdp.experiments import results
+from pamdp.experiments import load_experiment, results
 from pamdp.experiments.suite import suite_table
 from pamdp.experiments.summary import load
 
@@ -39,9 +39,10 @@ def summaries(experiment: str) -> list[dict]:
 def tables() -> dict[str, str]:
     """Each generated table of the page by its marker's name."""
     suite = summaries("benchmark-suite")
+    planned = results.planned_cells(load_experiment("benchmark-suite").specs())  # its cells not run yet owe runs too
     return {
         "suite": suite_table(results.finals(suite)) + "\n",
-        "suite-stats": results.stats_table(suite) + "\n",
+        "suite-stats": results.stats_table(suite, planned) + "\n",
         "suite-aggregate": results.aggregate_table(suite) + "\n",
         "suite-improvement": results.improvement_table(suite) + "\n",
         "suite-efficiency": results.efficiency_table(suite) + "\n",
@@ -49,7 +50,7 @@ def tables() -> dict[str, str]:
         "one-preset": results.one_preset_table(summaries("one-preset"), suite) + "\n",
         "readme-suite": "Benchmark suite, generated from the committed summaries ([how](docs/results.md"
         "#intervals-profiles-and-sample-efficiency-issue-44)): " + results.aggregate_line(suite) + " "
-        + results.runs_line(suite) + "\n",
+        + results.runs_line(suite, planned) + "\n",
         "readme-standing": results.standing_line(suite) + "\n",
     }
 

@@ -219,6 +219,16 @@ def test_the_statistics_tables_hold_the_hand_computed_cells():
     assert results.backlog_line(runs) == backlog  # the line alone, as the table's foot
     # the runs a cell by method, counted above (A: Goal 3, Platform 4; B: Goal 2, Platform 3), then the same backlog
     assert results.runs_line(runs) == f"Runs a cell: A 3 to 4 on 2 domains; B 2 to 3 on 2 domains. {backlog}"
+    # an experiment's cell that never ran (C on Catch Point) gets a row after the runs' domains (the suite's order),
+    # owing 5 runs (no cost known), HyAR's best there 0.90 (../shared/specs/benchmarks.md); a planned cell that ran
+    # (A on Goal) changes nothing
+    planned = [("Goal", "A"), ("Catch Point", "C")]
+    table, with_unrun = results.stats_table(runs, planned).split("\n\n")
+    assert table.splitlines()[-1] == "| Catch Point | C | 0 (never run) | - | - | 0.90 | - | - | - | 5 |"
+    assert with_unrun == backlog.replace("13 over 4", "18 over 5")[:-1] + "; 5 in 1 cell never run (C on Catch Point)."
+    assert results.backlog_line(runs, planned) == with_unrun
+    line = results.runs_line(runs, planned)
+    assert line == f"Runs a cell: A 3 to 4 on 2 domains; B 2 to 3 on 2 domains; C 0 on 1 domain. {with_unrun}"
     aggregate = _cells(results.aggregate_table(runs).split("\n\n")[0])
     # each domain weighs the same: Goal's 3 runs repeated 4 times, Platform's 4 runs 3 times; of the 24, sorted
     # 0 x4, 0.2 x3, 0.6 x3, 0.9 x3, 1 x11, six dropped at each end leave 0.2, 0.6 x3, 0.9 x3, 1 x5
@@ -262,6 +272,18 @@ def test_the_statistics_tables_hold_the_hand_computed_cells():
     standing = _cells(results.standing_table(low + high))
     assert standing[("| Platform", "0.997 (CHDP)")][2:4] == ["0.500 [0.500, 0.500]", "below"]
     assert standing[("| Hard Move n=4", "0.942 (CHDP)")][2:4] == ["0.950 [0.950, 0.950]", "above"]
+
+
+def test_the_suites_planned_cells_are_its_configs_runs():
+    import tomllib
+
+    from pamdp.experiments import load_experiment
+
+    planned = results.planned_cells(load_experiment("benchmark-suite").specs())
+    path = Path(results.__file__).parent / "configs" / "benchmark-suite.toml"
+    labels = [run["label"] for run in tomllib.loads(path.read_text())["runs"]]
+    # one cell a run of the config, its label split at " on " (the suite's labels are "METHOD on DOMAIN")
+    assert sorted(planned) == sorted(tuple(reversed(label.split(" on "))) for label in labels)
 
 
 def test_the_readme_line_ranks_methods_by_their_aggregate_with_each_domain_weighing_the_same():

@@ -464,7 +464,7 @@ def _wandb_tracker(args, spec: RunSpec, preset: str, out: Path):
 
 # -- reproduce, plot --------------------------------------------------------------------------------
 def cmd_reproduce(args) -> int:
-    from pamdp.experiments import load_experiment
+    from pamdp.experiments import load_experiment, results
     from pamdp.experiments.report import write_report
 
     exp = load_experiment(args.name)
@@ -497,7 +497,10 @@ def cmd_reproduce(args) -> int:
 
         outcomes = run_all(jobs, workers=args.workers, log=lambda m: print(m, file=sys.stderr))
     failed = [o for o in outcomes if o.error is not None]
-    _print_report(write_report([Path(args.out) / exp.name], Path(args.out) / exp.name, exp.description))
+    planned = results.planned_cells(exp.specs())  # the whole experiment's cells, also those not run yet
+    _print_report(
+        write_report([Path(args.out) / exp.name], Path(args.out) / exp.name, exp.description, planned=planned)
+    )
     if failed:
         print(f"{len(failed)} of {len(outcomes)} runs failed: {', '.join(o.out for o in failed)}", file=sys.stderr)
         return 1

@@ -24,6 +24,7 @@ def write_report(
     title: str = "",
     x: str = "auto",
     suite_archive: str | os.PathLike | None = None,
+    planned=(),
 ) -> dict[str, Path]:
     """Curves (PNG, SVG), the per-epoch aggregate (CSV) and the results table (markdown) into ``out``.
 
@@ -42,7 +43,8 @@ def write_report(
     means with bootstrap intervals per method and domain, across domains, the probability of improvement between
     methods, and the sample efficiency of the greedy curves), ``profiles.png`` and ``.svg`` the performance
     profiles of the methods over the domains they all ran, and ``efficiency.png`` and ``.svg`` the greedy curves over
-    the fraction of the budget.
+    the fraction of the budget. ``planned``: the experiment's ``(domain, method)`` cells
+    (:func:`.results.planned_cells`), so that those not run yet count in the runs owed.
     """
     archived = [] if suite_archive is None else load_finals(suite_archive)  # checked before anything is written
     groups = find_groups(roots)
@@ -76,7 +78,7 @@ def write_report(
     finals = merge_finals(suite_finals(groups), archived)
     summaries = _summaries(groups, archived)
     if summaries:  # the statistics: intervals over runs, across domains, pairwise and over samples
-        (out / "stats.md").write_text(results.report(summaries))
+        (out / "stats.md").write_text(results.report(summaries, planned))
         extra["stats"] = out / "stats.md"
         extra.update({f"profiles_{p.suffix[1:]}": p for p in results.plot_profiles(summaries, out / "profiles")})
         extra.update({f"efficiency_{p.suffix[1:]}": p for p in results.plot_efficiency(summaries, out / "efficiency")})

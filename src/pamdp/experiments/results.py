@@ -43,6 +43,7 @@ __all__ = [
     "seeds_wanted",
     "backlog_line",
     "runs_line",
+    "planned_cells",
     "aggregate_table",
     "aggregate_line",
     "improvement_table",
@@ -320,6 +321,29 @@ def cells(summaries: list[dict]) -> dict[tuple[str, str], list[dict]]:
     return out
 
 
+def planned_cells(specs) -> list[tuple[str, str]]:
+    """The ``(domain, method)`` cells an experiment's runs define (its :class:`.runner.RunSpec` s), in their order:
+    what :func:`stats_table` owes runs for even before any has run."""
+    planned: list[tuple[str, str]] = []
+    for spec in specs:
+        domain = _domain({"env": spec.env, "env_kwargs": dict(spec.env_kwargs)})
+        if (domain, method_of(spec.label, domain)) not in planned:
+            planned.append((domain, method_of(spec.label, domain)))
+    return planned
+
+
+def _with_planned(summaries: list[dict], planned) -> dict[tuple[str, str], list[dict]]:
+    """:func:`cells`, with a cell of no runs for each planned ``(domain, method)`` that has none, in the same order."""
+    found = cells(summaries)
+    missing = {cell: [] for cell in planned if cell not in found}
+    if not missing:
+        return found
+    order = {d[0]: i for i, d in enumerate(DOMAINS)}
+    domains = {key: _domain(runs[0]) for key, runs in found.items()} | {key: key[0] for key in missing}
+    keys = sorted([*found, *missing], key=lambda k: (order.get(domains[k], len(order)), domains[k], k[1]))
+    return {key: found.get(key, []) for key in keys}
+
+
 def _main_cells(summaries: list[dict]) -> dict[str, dict[str, np.ndarray]]:
     """``{method: {domain: scores}}`` of each method's main setting on each domain."""
     by_method: dict[str, dict[str, np.ndarray]] = {}
@@ -351,25 +375,33 @@ def seeds_wanted(cpu_minutes: float | None) -> int:
     return CHEAP_SEEDS if cpu_minutes is not None and cpu_minutes < CHEAP_MINUTES else SEEDS
 
 
-def stats_table(summaries: list[dict]) -> str:
+def stats_table(summaries: list[dict], planned=()) -> str:
     """Per cell: its runs, the mean and the IQM of their scores with 95 % bootstrap intervals, how many are still
     training (counted with their last greedy evaluation), the sample efficiency of its runs with greedy curves (as
     :func:`efficiency_table`), the median CPU minutes a run and the runs it still owes (:func:`seeds_wanted`); below
-    it, the backlog in all (:func:`backlog_line`)."""
+    it, the backlog in all (:func:`backlog_line`). ``planned``: the experiment's ``(domain, method)`` cells
+    (:func:`planned_cells`); one with no runs yet gets a row of its own, owing them all."""
     lines = [
         "| domain | method | runs | mean [95 % CI] | IQM [95 % CI] | published best | samples to "
         f"{TARGET * 100:g} % of it (median) | normalised AUC | CPU min a run | runs owed |",
         "|---|---|---|---|---|---|---|---|---|---|",
     ]
     backlog = []
-    for (row, method), runs in cells(summaries).items():
+    for (row, method), runs in _with_planned(summaries, planned).items():
+        minutes, owed = _owed(runs)
+        backlog.append((minutes, owed, len(runs), f"{method} on {row}"))
+        if not runs:
+            best = published_best(row)
+            lines.append(
+                f"| {row} | {method} | 0 (never run) | - | - | {'' if best is None else f'{best:.2f}'} | - | - | - | "
+                f"{owed} |"
+            )
+            continue
         scores = np.array([score(s)[0] for s in runs])
         partial = sum(not score(s)[1] for s in runs)
         n = f"{len(runs)}" + (f" ({partial} partial*)" if partial else "")
         best = published_best(_domain(runs[0]))
         mean, mid = _estimate([scores], np.mean), _estimate([scores], stats.iqm)
-        minutes, owed = _owed(runs)
-        backlog.append((minutes, owed))
         cost = "-" if minutes is None else f"{minutes:.1f}"
         reach, auc = _reach_and_auc(runs, _curves(runs))
         lines.append(
@@ -385,36 +417,47 @@ def _owed(runs: list[dict]) -> tuple[float | None, int]:
     return minutes, max(0, seeds_wanted(minutes) - len(runs))
 
 
-def backlog_line(summaries: list[dict]) -> str:
+def backlog_line(summaries: list[dict], planned=()) -> str:
     """The runs the cells still owe in all (:func:`seeds_wanted`), and what they cost at each cell's median CPU
-    minutes a run, apart from those of cells where no run recorded its cost."""
-    return _backlog_text([_owed(runs) for runs in cells(summaries).values()])
+    minutes a run, apart from those of cells where no run recorded its cost and of the ``planned`` cells never run
+    (:func:`stats_table`)."""
+    cells_owed = _with_planned(summaries, planned).items()
+    return _backlog_text([(*_owed(runs), len(runs), f"{method} on {row}") for (row, method), runs in cells_owed])
 
 
-def runs_line(summaries: list[dict]) -> str:
-    """One sentence of each method's runs a cell (its main setting on each domain, as :func:`cells`), then the
-    backlog (:func:`backlog_line`): the counts a page states without a table."""
+def runs_line(summaries: list[dict], planned=()) -> str:
+    """One sentence of each method's runs a cell (its main setting on each domain, as :func:`cells`, and the
+    ``planned`` cells never run, as 0), then the backlog (:func:`backlog_line`): the counts a page states without a
+    table."""
+    counts: dict[str, list[int]] = {}
+    for (row, method), runs in _with_planned(summaries, planned).items():
+        if not runs or row == _domain(runs[0]):
+            counts.setdefault(method, []).append(len(runs))
     parts = []
-    for method, by_domain in sorted(_main_cells(summaries).items()):
-        counts = sorted(len(scores) for scores in by_domain.values())
-        spread = f"{counts[0]}" if counts[0] == counts[-1] else f"{counts[0]} to {counts[-1]}"
-        parts.append(f"{method} {spread} on {len(counts)} domain{'s' * (len(counts) > 1)}")
-    return f"Runs a cell: {'; '.join(parts)}. {backlog_line(summaries)}"
+    for method, found in sorted(counts.items()):
+        low, high = min(found), max(found)
+        spread = f"{low}" if low == high else f"{low} to {high}"
+        parts.append(f"{method} {spread} on {len(found)} domain{'s' * (len(found) > 1)}")
+    return f"Runs a cell: {'; '.join(parts)}. {backlog_line(summaries, planned)}"
 
 
-def _backlog_text(cells_owed: list[tuple[float | None, int]]) -> str:
-    """:func:`backlog_line` of the cells' ``(median CPU minutes a run, runs owed)``."""
-    owed = [(cost, n) for cost, n in cells_owed if n]
+def _backlog_text(cells_owed: list[tuple[float | None, int, int, str]]) -> str:
+    """:func:`backlog_line` of the cells' ``(median CPU minutes a run, runs owed, runs made, name)``."""
+    owed = [(cost, n, made, name) for cost, n, made, name in cells_owed if n]
     if not owed:
         return "Runs owed: none."
-    unpriced = sum(n for cost, n in owed if cost is None)
-    minutes = sum(n * cost for cost, n in owed if cost is not None)
-    priced = sum(n for _, n in owed) - unpriced
-    text = f"Runs owed: {sum(n for _, n in owed)} over {len(owed)} cells"
+    unrun = [(n, name) for cost, n, made, name in owed if not made]
+    unpriced = sum(n for cost, n, made, _ in owed if cost is None and made)
+    minutes = sum(n * cost for cost, n, _, _ in owed if cost is not None)
+    priced = sum(n for cost, n, _, _ in owed if cost is not None)
+    text = f"Runs owed: {sum(n for _, n, _, _ in owed)} over {len(owed)} cells"
     if priced:
         text += f"; the {priced} in cells that recorded their cost, about {minutes / 60:.1f} CPU hours at those costs"
     if unpriced:
         text += f"; {unpriced} in cells whose runs recorded none (archived figures)"
+    if unrun:
+        names = ", ".join(name for _, name in unrun)
+        text += f"; {sum(n for n, _ in unrun)} in {len(unrun)} cell{'s' * (len(unrun) > 1)} never run ({names})"
     return text + "."
 
 
@@ -641,11 +684,12 @@ def plot_efficiency(summaries: list[dict], path: str | os.PathLike) -> list[Path
     return _save(fig, path)
 
 
-def report(summaries: list[dict]) -> str:
-    """The statistics of a set of runs as one markdown page: per cell, across domains, pairwise and over samples."""
+def report(summaries: list[dict], planned=()) -> str:
+    """The statistics of a set of runs as one markdown page: per cell (with the ``planned`` ones never run, as
+    :func:`stats_table`), across domains, pairwise and over samples."""
     parts = [
         "Per method and domain (each method's runs of one setting; scores: success rate, Platform's return):",
-        stats_table(summaries),
+        stats_table(summaries, planned),
         "Across domains (stratified by domain):",
         aggregate_table(summaries),
         "Probability of improvement (a run of X beats a run of Y; 0.5: neither tends to do better):",
