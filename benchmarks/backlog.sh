@@ -52,28 +52,21 @@ goalie() {  # issue 43: the recipe (pamdp reproduce hfo-goalie, done 2026-12-04)
 }
 
 seeds() {  # issue 44: 5 seeds a cell, 10 where a run costs under 10 CPU minutes; both cores, two runs of like cost at once
-    # Owed first by each domain's best method, then by the methods of HyAR's table (HyAR-TD3; MP-DQN, P-DQN), then the
-    # others (Hybrid SAC, PATRPO where it is not the best). docs/results.md's statistics table counts what each cell
-    # still owes. CPU minutes a run in brackets. Done by 2026-12-04 (third session): every best method at 5 (their
-    # seeds 3-4: curves for the samples-to-reach column), PATRPO at 10 on Platform, Goal and Hard Goal.
+    # docs/results.md's statistics table counts what each cell still owes, the cells never run included. Done by
+    # 2026-12-05 (summaries committed, so not rerun even on a new machine): seeds 0-4 of every cell run so far (Hybrid
+    # SAC at Hard Move n = 6: seed 0), seeds 5-9 of the
+    # cheap cells (PATRPO everywhere, HyAR-TD3 on Platform, Goal and Hard Goal, MP-DQN on Platform, Hybrid SAC on
+    # Platform, Goal and Hard Goal), Hybrid SAC at Hard Move n = 4 seeds 0-6. What is left, CPU minutes a run in
+    # brackets (measured, or estimated from benchmarks/large_k_cost.md where marked ~):
     local s="pamdp reproduce benchmark-suite --out $SUITE_OUT --workers 2"
-    local patrpo="PATRPO_on_Platform,PATRPO_on_Goal,PATRPO_on_Hard_Goal,PATRPO_on_Catch_Point"
-    local hm="PATRPO_on_Hard_Move_n=4,PATRPO_on_Hard_Move_n=6,PATRPO_on_Hard_Move_n=8,PATRPO_on_Hard_Move_n=10"
-    $s --seeds 3,4 --runs "$patrpo,$hm"                                           # 0.5-6 (done)
-    $s --seeds 3,4 --runs "HyAR-TD3_on_Platform,Hybrid_SAC_on_Catch_Point"        # 4, 11 (done)
-    $s --seeds 3,4 --runs "MP-DQN_on_Goal,MP-DQN_on_Hard_Goal"                    # 19, 30 (done)
-    $s --seeds 5,6,7,8,9 --runs "$hm"                                             # 1-6: PATRPO, the best on Hard Move (done)
-    $s --seeds 3,4 --runs "HyAR-TD3_on_Goal,HyAR-TD3_on_Hard_Goal,MP-DQN_on_Platform"   # 5-6, 1.5 (done)
-    $s --seeds 5,6,7,8,9 --runs "HyAR-TD3_on_Platform"                            # 4: the best on Platform (done)
-    $s --seeds 3,4 --runs "HyAR-TD3_on_Catch_Point,MP-DQN_on_Catch_Point"         # 17, 12 (MP-DQN done)
-    $s --seeds 3,4 --runs "HyAR-TD3_on_Hard_Move_n=4,HyAR-TD3_on_Hard_Move_n=6"   # 20 each
-    $s --seeds 3,4 --runs "HyAR-TD3_on_Hard_Move_n=8,HyAR-TD3_on_Hard_Move_n=10"  # 20 each
-    $s --seeds 5,6,7,8,9 --runs "HyAR-TD3_on_Goal,HyAR-TD3_on_Hard_Goal,MP-DQN_on_Platform"
-    $s --seeds 3,4 --runs "Hybrid_SAC_on_Platform,Hybrid_SAC_on_Goal,Hybrid_SAC_on_Hard_Goal"  # 1.3-3 (done)
-    $s --seeds 5,6,7,8,9 --runs "PATRPO_on_Catch_Point"                           # 3.7: HPPO's column of HyAR's table
-    $s --seeds 5,6,7,8,9 --runs "Hybrid_SAC_on_Platform,Hybrid_SAC_on_Goal,Hybrid_SAC_on_Hard_Goal"
-    $s --seeds 3,4,5,6,7,8,9 --runs "Hybrid_SAC_on_Hard_Move_n=4"                 # 9
-    $s --seeds 1,2,3,4 --runs "Hybrid_SAC_on_Hard_Move_n=6"                       # 11
+    $s --seeds 7,8,9 --runs "Hybrid_SAC_on_Hard_Move_n=4"                              # 7-9
+    $s --seeds 1-4 --runs "Hybrid_SAC_on_Hard_Move_n=6"                                # 11
+    # never run until 2026-12-05: HyAR's PDQN column at n = 8 and 10 (P-DQN's single pass), Hybrid SAC there,
+    # then MP-DQN at n = 4 and 6 (its K passes: the dearest cells of the suite)
+    $s --seeds 0-4 --runs "P-DQN_on_Hard_Move_n=8,P-DQN_on_Hard_Move_n=10"            # ~60, ~100 (2026-12-02)
+    $s --seeds 0-4 --runs "Hybrid_SAC_on_Hard_Move_n=8,Hybrid_SAC_on_Hard_Move_n=10"  # ~35, ~50
+    $s --seeds 0-4 --runs "MP-DQN_on_Hard_Move_n=4"                                    # ~180 (2026-12-02)
+    $s --seeds 0-4 --runs "MP-DQN_on_Hard_Move_n=6"                                    # ~550 (2026-12-02)
 }
 
 queues=("${@:-soccer}" ) && [ $# -eq 0 ] && queues=(soccer suite seeds)
