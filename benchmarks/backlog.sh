@@ -61,12 +61,12 @@ seeds() {  # issue 44: 5 seeds a cell, 10 where a run costs under 10 CPU minutes
     local s="pamdp reproduce benchmark-suite --out $SUITE_OUT --workers 2"
     $s --seeds 7,8,9 --runs "Hybrid_SAC_on_Hard_Move_n=4"                              # 7-9
     $s --seeds 1-4 --runs "Hybrid_SAC_on_Hard_Move_n=6"                                # 11
-    # never run until 2026-12-05: HyAR's PDQN column at n = 8 and 10 (P-DQN's single pass), Hybrid SAC there,
-    # then MP-DQN at n = 4 and 6 (its K passes: the dearest cells of the suite)
-    $s --seeds 0-4 --runs "P-DQN_on_Hard_Move_n=8,P-DQN_on_Hard_Move_n=10"            # ~60, ~100 (2026-12-02)
-    $s --seeds 0-4 --runs "Hybrid_SAC_on_Hard_Move_n=8,Hybrid_SAC_on_Hard_Move_n=10"  # ~35, ~50
-    $s --seeds 0-4 --runs "MP-DQN_on_Hard_Move_n=4"                                    # ~180 (2026-12-02)
-    $s --seeds 0-4 --runs "MP-DQN_on_Hard_Move_n=6"                                    # ~550 (2026-12-02)
+    # never run until 2026-12-05: HyAR's PDQN column at n = 6, 8 and 10 (P-DQN's single pass), Hybrid SAC at n = 8
+    # and 10, MP-DQN at n = 4 (benchmarks/large_k_cost.md, priced 2026-12-05)
+    $s --seeds 0-4 --runs "P-DQN_on_Hard_Move_n=6,P-DQN_on_Hard_Move_n=8"             # 13, 21
+    $s --seeds 0-4 --runs "Hybrid_SAC_on_Hard_Move_n=8"                                # 16
+    $s --seeds 0-4 --runs "P-DQN_on_Hard_Move_n=10,Hybrid_SAC_on_Hard_Move_n=10"      # 47, 51
+    $s --seeds 0-4 --runs "MP-DQN_on_Hard_Move_n=4"                                    # 68
 }
 
 queues=("${@:-soccer}" ) && [ $# -eq 0 ] && queues=(soccer suite seeds)

@@ -69,11 +69,13 @@ def worker(algo: str, n: int, preset: str, repeats: int) -> int:
     config = dataclasses.replace(config, **{k: v for k, v in shorter.items() if k in fields})
     torch.set_num_threads(1)
     model = cls(ENV, config, env_kwargs={"n": n})
-    model.learn(1, progress_bar=False)  # one epoch: fills replay past the warm-up, compiles, allocates
+    # learn(n) trains at least n more samples (once "learn(1)" was one epoch; it is now one batch of the vector
+    # env's steps, which measured sampling alone: no update before the replay held `samples`)
+    model.learn(samples, progress_bar=False)  # the warm-up: fills replay past learning_starts, compiles, allocates
     figures = []
     for _ in range(repeats):
         start, t = model.num_timesteps, time.process_time()
-        model.learn(1, progress_bar=False)
+        model.learn(samples, progress_bar=False)
         figures.append((time.process_time() - t) / (model.num_timesteps - start))
     print(json.dumps({"ms_per_sample": [1e3 * f for f in figures], "preset": preset}), flush=True)
     return 0

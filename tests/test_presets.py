@@ -190,7 +190,7 @@ def test_an_experiments_env_arguments_choose_the_preset(tmp_path):
     assert big.config().preset == "hard_move_large" and small.config().preset == "hard_move"
     suite = {s.label: s for s in load_experiment("benchmark-suite").specs(seeds=[0])}
     assert suite["P-DQN on Hard Move n=10"].config().preset == "hard_move_large"
-    assert suite["MP-DQN on Hard Move n=6"].config().preset == "hard_move"
+    assert suite["MP-DQN on Hard Move n=4"].config().preset == "hard_move"
 
 
 def test_an_entry_or_a_run_naming_an_argument_the_env_lacks_is_refused(monkeypatch):
