@@ -294,6 +294,14 @@ def test_the_readme_line_ranks_methods_by_their_aggregate_with_each_domain_weigh
     y = [_summary(f"Y on {d}", f"pamdp/{d}-v0", seed, 0.3) for d in ("Goal", "Platform") for seed in range(2)]
     line = results.aggregate_line(x + y)
     assert line.index("X **0.500 [") < line.index("Y **0.300 [0.300, 0.300]**")
+    # Z ran only Catch Point, which neither X nor Y ran: it stays out of the shared comparison instead of emptying
+    # it, and the line and table say so
+    z = [_summary("Z on Catch Point", "pamdp/CatchPoint-v0", seed, 0.9) for seed in range(3)]
+    line = results.aggregate_line(x + y + z)
+    assert "On the 2 domains they share (Platform, Goal): X **0.500 [" in line
+    assert line.endswith("(Z: not on all of them).") and "Z **0.900 [0.900, 0.900]** (1 domain, 3 runs)" in line
+    table = _cells(results.aggregate_table(x + y + z).split("\n\n")[0])
+    assert table[("| Z", "1")][-1] == "- |"
 
 
 def test_the_one_preset_table_judges_each_domain_against_hyars_figure_and_counts_them():

@@ -467,11 +467,17 @@ def _stratified(by_domain: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
 
 
 def _comparable(summaries: list[dict]) -> tuple[dict[str, dict[str, np.ndarray]], list[str]]:
-    """Each method's scores on the domains where it has 2 runs or more (its main setting's), and the domains every
-    such method has, in the suite's order."""
+    """Each method's scores on the domains where it has 2 runs or more (its main setting's), and the domains the
+    methods share, in the suite's order: those of the method of most domains, narrowed by each other method's in turn
+    (most domains first) where that leaves some; a method that ran none of them (P-DQN on Hard Move alone, beside
+    methods that share Platform to Catch Point) stays out of the shared comparison instead of emptying it."""
     by_method = {m: _stratified(d) for m, d in _main_cells(summaries).items()}
     by_method = {m: d for m, d in by_method.items() if d}
-    shared = set.intersection(*(set(d) for d in by_method.values())) if by_method else set()
+    shared: set[str] | None = None
+    for _, domains in sorted(((m, set(d)) for m, d in by_method.items()), key=lambda md: (-len(md[1]), md[0])):
+        if shared is None or shared & domains:
+            shared = domains if shared is None else shared & domains
+    shared = shared or set()
     order = [d[0] for d in DOMAINS]
     return by_method, sorted(shared, key=lambda d: (order.index(d) if d in order else len(order), d))
 
@@ -487,7 +493,7 @@ def aggregate_table(summaries: list[dict]) -> str:
     ]
     for method, by_domain in by_method.items():
         tasks = list(by_domain.values())
-        on_shared = [by_domain[d] for d in shared]
+        on_shared = [by_domain[d] for d in shared] if set(shared) <= set(by_domain) else []
         lines.append(
             f"| {method} | {len(tasks)} | {sum(map(len, tasks))} | {_estimate(tasks, stats.iqm)} | "
             f"{_estimate(tasks, np.mean)} | {_estimate(on_shared, stats.iqm) if on_shared else '-'} |"
@@ -503,18 +509,27 @@ def aggregate_line(summaries: list[dict]) -> str:
     def listing(domains_of) -> str:
         found = []
         for method, by_domain in by_method.items():
+            if not set(domains_of(by_domain)) <= set(by_domain):
+                continue
             tasks = [by_domain[d] for d in domains_of(by_domain)]
             found.append((stats.aggregate(tasks), method, tasks))
         parts = [
-            f"{method} **{_estimate(tasks, stats.iqm)}** ({len(tasks)} domains, {sum(map(len, tasks))} runs)"
+            f"{method} **{_estimate(tasks, stats.iqm)}** ({len(tasks)} domain{'s' * (len(tasks) > 1)}, "
+            f"{sum(map(len, tasks))} runs)"
             for _, method, tasks in sorted(found, key=lambda f: -f[0])
         ]
         return "; ".join(parts)
 
-    return (
+    text = (
         "IQM of the final figures with 95 % stratified bootstrap intervals, over the domains where a method has 2 "
-        f"runs or more: {listing(list)}. On the {len(shared)} domains all share ({', '.join(shared)}): "
-        f"{listing(lambda _: shared)}."
+        f"runs or more: {listing(list)}."
+    )
+    if not shared:
+        return text
+    apart = sorted(m for m, by_domain in by_method.items() if not set(shared) <= set(by_domain))
+    return (
+        f"{text} On the {len(shared)} domains {'they' if apart else 'all'} share ({', '.join(shared)}): "
+        f"{listing(lambda _: shared)}" + (f" ({', '.join(apart)}: not on all of them)." if apart else ".")
     )
 
 
@@ -593,6 +608,7 @@ def plot_profiles(summaries: list[dict], path: str | os.PathLike, title: str = "
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    by_method = {m: by_domain for m, by_domain in by_method.items() if set(shared) <= set(by_domain)}
     scores = np.concatenate([by_method[m][d] for m in by_method for d in shared])
     tau = np.linspace(min(0.0, scores.min()), max(1.0, scores.max()), 101)
     fig, ax = plt.subplots(figsize=(5.0, 3.4), dpi=110)
