@@ -288,12 +288,13 @@ def finals(summaries: list[dict]) -> list[dict]:
     return merge_finals(entries, [])
 
 
-def cells(summaries: list[dict]) -> dict[tuple[str, str], list[dict]]:
+def cells(summaries: list[dict], planned=()) -> dict[tuple[str, str], list[dict]]:
     """``{(row, method): summaries}``: each domain's cells, a method's main setting (its largest budget, then the
     one of most runs) under the domain's name, any other setting under ``"domain: what tells it apart"``, as the
     suite's table labels its rows. An archived figure, whose settings were not kept, counts with its experiment
     cell's runs where they are all of one setting (the archive kept the figures of the settings in use). Domains in
-    the suite's order, then others by name; methods by name."""
+    the suite's order, then others by name; methods by name. ``planned``: ``(domain, method)`` cells
+    (:func:`planned_cells`) that get a cell of no runs where they have none."""
     groups: dict[tuple[str, str], dict[tuple, list[dict]]] = {}
     unrecorded = []
     for s in summaries:
@@ -310,6 +311,9 @@ def cells(summaries: list[dict]) -> dict[tuple[str, str], list[dict]]:
         recorded = groups.setdefault((domain, method_of(s["label"], domain)), {})
         same = {st for st, runs in recorded.items() if any(r["label"] == s["label"] for r in runs)}
         recorded.setdefault(same.pop() if len(same) == 1 and len(recorded) == 1 else (None, None, None), []).append(s)
+    for cell in planned:  # an experiment's cell that has not run: a row of no runs, where it would stand
+        if cell not in groups:
+            groups[cell] = {(None, None, None): []}
     order = {d[0]: i for i, d in enumerate(DOMAINS)}
     out: dict[tuple[str, str], list[dict]] = {}
     for domain, method in sorted(groups, key=lambda k: (order.get(k[0], len(order)), k[0], k[1])):
@@ -327,21 +331,10 @@ def planned_cells(specs) -> list[tuple[str, str]]:
     planned: list[tuple[str, str]] = []
     for spec in specs:
         domain = _domain({"env": spec.env, "env_kwargs": dict(spec.env_kwargs)})
-        if (domain, method_of(spec.label, domain)) not in planned:
-            planned.append((domain, method_of(spec.label, domain)))
+        cell = (domain, method_of(spec.label, domain))
+        if cell not in planned:
+            planned.append(cell)
     return planned
-
-
-def _with_planned(summaries: list[dict], planned) -> dict[tuple[str, str], list[dict]]:
-    """:func:`cells`, with a cell of no runs for each planned ``(domain, method)`` that has none, in the same order."""
-    found = cells(summaries)
-    missing = {cell: [] for cell in planned if cell not in found}
-    if not missing:
-        return found
-    order = {d[0]: i for i, d in enumerate(DOMAINS)}
-    domains = {key: _domain(runs[0]) for key, runs in found.items()} | {key: key[0] for key in missing}
-    keys = sorted([*found, *missing], key=lambda k: (order.get(domains[k], len(order)), domains[k], k[1]))
-    return {key: found.get(key, []) for key in keys}
 
 
 def _main_cells(summaries: list[dict]) -> dict[str, dict[str, np.ndarray]]:
@@ -387,7 +380,7 @@ def stats_table(summaries: list[dict], planned=()) -> str:
         "|---|---|---|---|---|---|---|---|---|---|",
     ]
     backlog = []
-    for (row, method), runs in _with_planned(summaries, planned).items():
+    for (row, method), runs in cells(summaries, planned).items():
         minutes, owed = _owed(runs)
         backlog.append((minutes, owed, len(runs), f"{method} on {row}"))
         if not runs:
@@ -421,7 +414,7 @@ def backlog_line(summaries: list[dict], planned=()) -> str:
     """The runs the cells still owe in all (:func:`seeds_wanted`), and what they cost at each cell's median CPU
     minutes a run, apart from those of cells where no run recorded its cost and of the ``planned`` cells never run
     (:func:`stats_table`)."""
-    cells_owed = _with_planned(summaries, planned).items()
+    cells_owed = cells(summaries, planned).items()
     return _backlog_text([(*_owed(runs), len(runs), f"{method} on {row}") for (row, method), runs in cells_owed])
 
 
@@ -430,7 +423,7 @@ def runs_line(summaries: list[dict], planned=()) -> str:
     ``planned`` cells never run, as 0), then the backlog (:func:`backlog_line`): the counts a page states without a
     table."""
     counts: dict[str, list[int]] = {}
-    for (row, method), runs in _with_planned(summaries, planned).items():
+    for (row, method), runs in cells(summaries, planned).items():
         if not runs or row == _domain(runs[0]):
             counts.setdefault(method, []).append(len(runs))
     parts = []
