@@ -459,11 +459,14 @@ def _stratified(by_domain: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     return {d: x for d, x in by_domain.items() if len(x) >= 2}
 
 
-def _comparable(summaries: list[dict]) -> tuple[dict[str, dict[str, np.ndarray]], list[str]]:
-    """Each method's scores on the domains where it has 2 runs or more (its main setting's), and the domains the
+def _comparable(
+    summaries: list[dict],
+) -> tuple[dict[str, dict[str, np.ndarray]], list[str], dict[str, list[np.ndarray]]]:
+    """Each method's scores on the domains where it has 2 runs or more (its main setting's); the domains the
     methods share, in the suite's order: those of the method of most domains, narrowed by each other method's in turn
-    (most domains first) where that leaves some; a method that ran none of them (P-DQN on Hard Move alone, beside
-    methods that share Platform to Catch Point) stays out of the shared comparison instead of emptying it."""
+    (most domains first) where that leaves some; and the scores on those domains of each method that has them all.
+    A method that ran none of them (P-DQN on Hard Move alone, beside methods that share Platform to Catch Point)
+    stays out of the shared comparison instead of emptying it."""
     by_method = {m: _stratified(d) for m, d in _main_cells(summaries).items()}
     by_method = {m: d for m, d in by_method.items() if d}
     shared: set[str] | None = None
@@ -472,13 +475,15 @@ def _comparable(summaries: list[dict]) -> tuple[dict[str, dict[str, np.ndarray]]
             shared = domains if shared is None else shared & domains
     shared = shared or set()
     order = [d[0] for d in DOMAINS]
-    return by_method, sorted(shared, key=lambda d: (order.index(d) if d in order else len(order), d))
+    shared = sorted(shared, key=lambda d: (order.index(d) if d in order else len(order), d))
+    on_shared = {m: [d[x] for x in shared] for m, d in by_method.items() if shared and set(shared) <= set(d)}
+    return by_method, shared, on_shared
 
 
 def aggregate_table(summaries: list[dict]) -> str:
     """Per method: the IQM and mean of its runs over the domains where it has 2 runs or more (its main setting's),
     stratified by domain, and over the domains that every method has so (the only comparison of like with like)."""
-    by_method, shared = _comparable(summaries)
+    by_method, shared, on_shared = _comparable(summaries)
     lines = [
         f"| method | domains | runs | IQM [95 % CI] | mean [95 % CI] | IQM on the {len(shared)} shared domains "
         "[95 % CI] |",
@@ -486,10 +491,10 @@ def aggregate_table(summaries: list[dict]) -> str:
     ]
     for method, by_domain in by_method.items():
         tasks = list(by_domain.values())
-        on_shared = [by_domain[d] for d in shared] if set(shared) <= set(by_domain) else []
+        mine = on_shared.get(method)
         lines.append(
             f"| {method} | {len(tasks)} | {sum(map(len, tasks))} | {_estimate(tasks, stats.iqm)} | "
-            f"{_estimate(tasks, np.mean)} | {_estimate(on_shared, stats.iqm) if on_shared else '-'} |"
+            f"{_estimate(tasks, np.mean)} | {_estimate(mine, stats.iqm) if mine else '-'} |"
         )
     return "\n".join(lines) + (f"\n\nShared domains: {', '.join(shared)}." if shared else "")
 
@@ -497,32 +502,27 @@ def aggregate_table(summaries: list[dict]) -> str:
 def aggregate_line(summaries: list[dict]) -> str:
     """One sentence of :func:`aggregate_table`: each method's IQM over its domains, best first, then on the shared
     domains (for a page that has no room for the table)."""
-    by_method, shared = _comparable(summaries)
+    by_method, shared, on_shared = _comparable(summaries)
 
-    def listing(domains_of) -> str:
-        found = []
-        for method, by_domain in by_method.items():
-            if not set(domains_of(by_domain)) <= set(by_domain):
-                continue
-            tasks = [by_domain[d] for d in domains_of(by_domain)]
-            found.append((stats.aggregate(tasks), method, tasks))
+    def listing(tasks_of: dict[str, list[np.ndarray]]) -> str:
+        found = sorted(tasks_of.items(), key=lambda mt: -stats.aggregate(mt[1]))
         parts = [
             f"{method} **{_estimate(tasks, stats.iqm)}** ({len(tasks)} domain{'s' * (len(tasks) > 1)}, "
             f"{sum(map(len, tasks))} runs)"
-            for _, method, tasks in sorted(found, key=lambda f: -f[0])
+            for method, tasks in found
         ]
         return "; ".join(parts)
 
     text = (
         "IQM of the final figures with 95 % stratified bootstrap intervals, over the domains where a method has 2 "
-        f"runs or more: {listing(list)}."
+        f"runs or more: {listing({m: list(d.values()) for m, d in by_method.items()})}."
     )
     if not shared:
         return text
-    apart = sorted(m for m, by_domain in by_method.items() if not set(shared) <= set(by_domain))
+    apart = sorted(by_method.keys() - on_shared.keys())
     return (
         f"{text} On the {len(shared)} domains {'they' if apart else 'all'} share ({', '.join(shared)}): "
-        f"{listing(lambda _: shared)}" + (f" ({', '.join(apart)}: not on all of them)." if apart else ".")
+        f"{listing(on_shared)}" + (f" ({', '.join(apart)}: not on all of them)." if apart else ".")
     )
 
 
@@ -593,7 +593,7 @@ def plot_profiles(summaries: list[dict], path: str | os.PathLike, title: str = "
     other domains would compare other tasks): the share of its runs scoring above each threshold, each domain
     weighing the same (:func:`.stats.performance_profile`), with the 95 % stratified bootstrap band; ``path`` with
     ``.png`` and ``.svg`` suffixes (nothing without such a domain)."""
-    by_method, shared = _comparable(summaries)
+    _, shared, on_shared = _comparable(summaries)
     if not shared:
         return []
     import matplotlib
@@ -601,13 +601,12 @@ def plot_profiles(summaries: list[dict], path: str | os.PathLike, title: str = "
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    by_method = {m: by_domain for m, by_domain in by_method.items() if set(shared) <= set(by_domain)}
-    scores = np.concatenate([by_method[m][d] for m in by_method for d in shared])
+    scores = np.concatenate([x for tasks in on_shared.values() for x in tasks])
     tau = np.linspace(min(0.0, scores.min()), max(1.0, scores.max()), 101)
     fig, ax = plt.subplots(figsize=(5.0, 3.4), dpi=110)
-    for method, by_domain in by_method.items():
-        profile = stats.performance_profile([by_domain[d] for d in shared], tau)
-        runs = sum(len(by_domain[d]) for d in shared)
+    for method, tasks in on_shared.items():
+        profile = stats.performance_profile(tasks, tau)
+        runs = sum(map(len, tasks))
         line = ax.plot(tau, profile.fraction, label=f"{method} ({runs} runs)", linewidth=1.4, color=_colour(method))[0]
         ax.fill_between(tau, profile.low, profile.high, color=line.get_color(), alpha=0.2, step=None)
     ax.set_xlabel("score tau (success rate; Platform: return)")
