@@ -56,14 +56,13 @@ seeds() {  # issue 44: 5 seeds a cell, 10 where a run costs under 10 CPU minutes
     # 2026-12-05 (summaries committed, so not rerun even on a new machine): seeds 0-4 of every cell run so far (Hybrid
     # SAC at Hard Move n = 6: seed 0), seeds 5-9 of the
     # cheap cells (PATRPO everywhere, HyAR-TD3 on Platform, Goal and Hard Goal, MP-DQN on Platform, Hybrid SAC on
-    # Platform, Goal and Hard Goal), Hybrid SAC at Hard Move n = 4 seeds 0-6. What is left, CPU minutes a run in
-    # brackets (measured, or estimated from benchmarks/large_k_cost.md where marked ~):
+    # Platform, Goal and Hard Goal), Hybrid SAC at Hard Move n = 4 (10 seeds) and n = 6 (5), P-DQN at n = 6 seeds 0-3.
+    # What is left, CPU minutes a run in brackets (measured in the queue, or priced in benchmarks/large_k_cost.md):
     local s="pamdp reproduce benchmark-suite --out $SUITE_OUT --workers 2"
-    $s --seeds 7,8,9 --runs "Hybrid_SAC_on_Hard_Move_n=4"                              # 7-9
-    $s --seeds 1-4 --runs "Hybrid_SAC_on_Hard_Move_n=6"                                # 11
     # never run until 2026-12-05: HyAR's PDQN column at n = 6, 8 and 10 (P-DQN's single pass), Hybrid SAC at n = 8
     # and 10, MP-DQN at n = 4 (benchmarks/large_k_cost.md, priced 2026-12-05)
-    $s --seeds 0-4 --runs "P-DQN_on_Hard_Move_n=6,P-DQN_on_Hard_Move_n=8"             # 13, 21
+    $s --seeds 4 --runs "P-DQN_on_Hard_Move_n=6"                                       # 16
+    $s --seeds 0-4 --runs "P-DQN_on_Hard_Move_n=8"                                     # 21
     $s --seeds 0-4 --runs "Hybrid_SAC_on_Hard_Move_n=8"                                # 16
     $s --seeds 0-4 --runs "P-DQN_on_Hard_Move_n=10,Hybrid_SAC_on_Hard_Move_n=10"      # 47, 51
     $s --seeds 0-4 --runs "MP-DQN_on_Hard_Move_n=4"                                    # 68
