@@ -61,8 +61,8 @@ seeds() {  # issue 44: 5 seeds a cell, 10 where a run costs under 10 CPU minutes
     local s="pamdp reproduce benchmark-suite --out $SUITE_OUT --workers 2"
     # never run until 2026-12-05: HyAR's PDQN column at n = 6, 8 and 10 (P-DQN's single pass), Hybrid SAC at n = 8
     # and 10, MP-DQN at n = 4 (benchmarks/large_k_cost.md, priced 2026-12-05)
-    $s --seeds 4 --runs "P-DQN_on_Hard_Move_n=6"                                       # 16
-    $s --seeds 0-4 --runs "P-DQN_on_Hard_Move_n=8"                                     # 21
+    $s --seeds 4 --runs "P-DQN_on_Hard_Move_n=6,P-DQN_on_Hard_Move_n=8"                # 16, 21 (two at once)
+    $s --seeds 0-3 --runs "P-DQN_on_Hard_Move_n=8"                                     # 21
     $s --seeds 0-4 --runs "Hybrid_SAC_on_Hard_Move_n=8"                                # 16
     $s --seeds 0-4 --runs "P-DQN_on_Hard_Move_n=10,Hybrid_SAC_on_Hard_Move_n=10"      # 47, 51
     $s --seeds 0-4 --runs "MP-DQN_on_Hard_Move_n=4"                                    # 68
