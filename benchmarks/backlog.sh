@@ -26,6 +26,7 @@ SOCCER_OUT=${SOCCER_OUT:-$RUNS/repro}
 SUITE_OUT=${SUITE_OUT:-$RUNS/suite}
 HFO_OUT=${HFO_OUT:-$RUNS/hfo}
 GOALIE_OUT=${GOALIE_OUT:-$RUNS/goalie}
+RECORDED=${RECORDED:-$(cd .. && pwd)/docs/results/summaries}  # the committed run summaries (seeds: --recorded)
 
 # All in functions, which bash reads whole before running any of them: editing this file while it runs
 # changes nothing in the running copy.
@@ -52,17 +53,14 @@ goalie() {  # issue 43: the recipe (pamdp reproduce hfo-goalie, done 2026-12-04)
 }
 
 seeds() {  # issue 44: 5 seeds a cell, 10 where a run costs under 10 CPU minutes; both cores, two runs of like cost at once
-    # docs/results.md's statistics table counts what each cell still owes, the cells never run included. Done by
-    # 2026-12-05 (summaries committed, so not rerun even on a new machine): seeds 0-4 of every cell run so far (Hybrid
-    # SAC at Hard Move n = 6: seed 0), seeds 5-9 of the
-    # cheap cells (PATRPO everywhere, HyAR-TD3 on Platform, Goal and Hard Goal, MP-DQN on Platform, Hybrid SAC on
-    # Platform, Goal and Hard Goal), Hybrid SAC at Hard Move n = 4 (10 seeds) and n = 6 (5), P-DQN at n = 6 seeds 0-3.
-    # What is left, CPU minutes a run in brackets (measured in the queue, or priced in benchmarks/large_k_cost.md):
-    local s="pamdp reproduce benchmark-suite --out $SUITE_OUT --workers 2"
-    # never run until 2026-12-05: HyAR's PDQN column at n = 6, 8 and 10 (P-DQN's single pass), Hybrid SAC at n = 8
-    # and 10, MP-DQN at n = 4 (benchmarks/large_k_cost.md, priced 2026-12-05)
-    $s --seeds 4 --runs "P-DQN_on_Hard_Move_n=6,P-DQN_on_Hard_Move_n=8"                # 16, 21 (two at once)
-    $s --seeds 0-3 --runs "P-DQN_on_Hard_Move_n=8"                                     # 21
+    # docs/results.md's statistics table counts what each cell still owes, the cells never run included. The runs
+    # whose summaries are committed (docs/results/summaries/benchmark-suite) are not trained again (--recorded), on a
+    # new machine too: each line names whole cells, and `pamdp reproduce benchmark-suite --status --recorded ...`
+    # lists what is left. Cells still owing runs on 2026-12-05, CPU minutes a run in brackets (measured in the
+    # queue, or priced in benchmarks/large_k_cost.md): never run before 2026-12-05, HyAR's PDQN column at n = 6, 8
+    # and 10 (P-DQN's single pass), Hybrid SAC at n = 8 and 10, MP-DQN at n = 4.
+    local s="pamdp reproduce benchmark-suite --out $SUITE_OUT --workers 2 --recorded $RECORDED/benchmark-suite"
+    $s --seeds 0-4 --runs "P-DQN_on_Hard_Move_n=6,P-DQN_on_Hard_Move_n=8"             # 16, 21
     $s --seeds 0-4 --runs "Hybrid_SAC_on_Hard_Move_n=8"                                # 16
     $s --seeds 0-4 --runs "P-DQN_on_Hard_Move_n=10,Hybrid_SAC_on_Hard_Move_n=10"      # 47, 51
     $s --seeds 0-4 --runs "MP-DQN_on_Hard_Move_n=4"                                    # 68

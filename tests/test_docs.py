@@ -172,8 +172,8 @@ def test_documented_commands_are_valid_and_the_short_ones_run(line, tmp_path, mo
         for name, text in re.findall(r"^```toml\n# ([\w.-]+\.toml)\b.*?\n(.*?)^```", path.read_text(), re.S | re.M):
             (tmp_path / name).write_text(text)
     argv = _argv(line, tmp_path / "runs")
-    if argv[0] == "reproduce" and argv[1].startswith("benchmarks/"):
-        monkeypatch.chdir(ROOT)  # an experiment file of the repository, named from its root
+    if argv[0] == "reproduce" and any(a.startswith(("benchmarks/", "docs/")) for a in argv[1:]):
+        monkeypatch.chdir(ROOT)  # an experiment file or the summaries of the repository, named from its root
     args = build_parser().parse_args(argv)
     if args.command == "reproduce":
         status = [a for a in argv if a not in ("--backend", "ray")]

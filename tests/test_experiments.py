@@ -721,3 +721,40 @@ def test_the_report_table_counts_each_seeds_gradient_updates_and_flags_an_untrai
     assert main(["plot", str(tmp_path / "exp"), "--out", str(tmp_path / "fig")]) == 0
     table = {line.split(" | ")[0][2:]: line.split(" | ")[-1] for line in capsys.readouterr().out.splitlines()[2:5]}
     assert table == {"trained": "49, 50 |", "warm-up only": "0 (untrained) |", "old": "- |"}
+
+
+def test_runs_whose_summaries_were_kept_are_not_trained_again(tmp_path, capsys):
+    """A run tree lost with its machine: ``--recorded`` finds its committed summary, checks that it is of the same
+    settings, seed and budget, and neither trains it again nor counts it as owed."""
+    exp = write_experiment(tmp_path / "tiny.toml")
+    out, kept = tmp_path / "results", tmp_path / "kept"
+    assert main(["reproduce", str(exp), "--out", str(out), "--seeds", "0,1"]) == 0
+    assert main(["summarize", str(out / "tiny"), "--out", str(kept)]) == 0
+    finals = {
+        s: json.loads((out / "tiny" / "small_delta" / f"seed{s}" / "evaluation.json").read_text()) for s in (0, 1)
+    }
+    lost = tmp_path / "lost"
+    (out / "tiny").rename(lost)  # the machine goes, the summaries stay
+    capsys.readouterr()
+    assert main(["reproduce", str(exp), "--out", str(out), "--seeds", "0-2", "--recorded", str(kept), "--status"]) == 0
+    status = capsys.readouterr().out
+    for seed in (0, 1):
+        assert f"| small delta | {seed} | recorded | 600 |" in status
+        assert f"| {finals[seed]['mean_return']:.3f} |" in status  # the final greedy return, from the summary
+    assert "| small delta | 2 | not started |" in status
+    assert "tiny: 2 of 3 runs done (2 recorded in kept summaries" in status and "1 not started" in status
+    assert main(["reproduce", str(exp), "--out", str(out), "--seeds", "0-2", "--recorded", str(kept)]) == 0
+    assert "2 runs recorded" in capsys.readouterr().err
+    assert sorted(p.name for p in (out / "tiny" / "small_delta").iterdir()) == ["seed2"]  # only the one owed
+    # Another setting (a budget of 800) is not what the summaries record: each is named, and its run trains.
+    exp.write_text(exp.read_text().replace("total_steps = 600", "total_steps = 800"))
+    assert main(["reproduce", str(exp), "--out", str(tmp_path / "again"), "--seeds", "0", "--recorded", str(kept)]) == 0
+    err = capsys.readouterr().err
+    assert "seed0.json is not this run (budget: 600 in the summary, 800 asked): it trains" in err
+    assert (tmp_path / "again" / "tiny" / "small_delta" / "seed0" / "evaluation.json").exists()
+    exp.write_text(exp.read_text().replace("total_steps = 800", "total_steps = 600").replace("[16]", "[24]"))
+    assert main(["reproduce", str(exp), "--out", str(out), "--seeds", "0", "--recorded", str(kept), "--status"]) == 0
+    assert "seed0.json is not this run (settings digest: " in capsys.readouterr().err
+    assert main(["reproduce", str(exp), "--out", str(out), "--recorded", str(tmp_path / "nowhere"), "--status"]) == 2
+    err = capsys.readouterr().err
+    assert f"--recorded {tmp_path / 'nowhere'}: not a directory; expected one of run summaries" in err

@@ -316,7 +316,16 @@ def build_parser() -> argparse.ArgumentParser:
     rp.add_argument(
         "--status",
         action="store_true",
-        help="train nothing: list each run's state (done, partial, not started) and the training time still to go",
+        help="train nothing: list each run's state (done, partial, not started, recorded) and the training time "
+        "still to go",
+    )
+    rp.add_argument(
+        "--recorded",
+        default=None,
+        metavar="DIR",
+        help="kept run summaries (DIR/ARM/seedN.json, as `pamdp summarize --out` writes them, e.g. "
+        "docs/results/summaries/benchmark-suite): a run with no finished directory under --out whose summary there "
+        "is of the same settings, env, seed and budget is not trained again",
     )
 
     pl = sub.add_parser("plot", help="learning curves (PNG, SVG) and a results table from run directories")
@@ -476,11 +485,23 @@ def cmd_reproduce(args) -> int:
     jobs = exp.jobs(args.out, exp.specs(seeds, args.scale, labels))
     for spec, _ in jobs:
         spec.check()  # every setting and env argument is checked before the first run starts
+    recorded = _recorded_runs(jobs, args.recorded) if args.recorded is not None else {}
     if args.status:
-        from pamdp.experiments.status import format_status, run_status
+        from pamdp.experiments.status import format_status, recorded_status, run_status
 
-        print(format_status(exp.name, [run_status(spec, out) for spec, out in jobs], args.workers), end="")
+        statuses = [
+            recorded_status(spec, recorded[spec.label, spec.seed])
+            if (spec.label, spec.seed) in recorded
+            else run_status(spec, out)
+            for spec, out in jobs
+        ]
+        print(format_status(exp.name, statuses, args.workers), end="")
         return 0
+    if recorded:
+        print(f"{exp.name}: {len(recorded)} runs recorded in {args.recorded}: not trained again", file=sys.stderr)
+        jobs = [(spec, out) for spec, out in jobs if (spec.label, spec.seed) not in recorded]
+        if not jobs:
+            return 0
     root = Path(args.out) / exp.name
     root.mkdir(parents=True, exist_ok=True)  # else every run would fail alike: refused here in one line naming it
     if not os.access(root, os.W_OK):
@@ -505,6 +526,29 @@ def cmd_reproduce(args) -> int:
         print(f"{len(failed)} of {len(outcomes)} runs failed: {', '.join(o.out for o in failed)}", file=sys.stderr)
         return 1
     return 0
+
+
+def _recorded_runs(jobs, root: str) -> dict:
+    """``{(label, seed): its summary}`` for the jobs whose run directory is not finished and whose summary under
+    ``root`` stands for it (:func:`.runner.recorded_differences`); a summary of another setting is named on stderr,
+    and its run trains."""
+    from pamdp.experiments.runner import is_finished, recorded_differences
+    from pamdp.experiments.summary import load, summary_path
+
+    if not Path(root).is_dir():
+        raise ValueError(f"--recorded {root}: not a directory; expected one of run summaries (ARM/seedN.json)")
+    found = {}
+    for spec, out in jobs:
+        path = summary_path(root, spec.label, spec.seed)
+        if is_finished(out, spec) or not path.exists():
+            continue
+        summary = load(path)
+        differ = recorded_differences(spec, summary)
+        if differ:
+            print(f"{path} is not this run ({'; '.join(differ)}): it trains", file=sys.stderr)
+        else:
+            found[spec.label, spec.seed] = summary
+    return found
 
 
 def cmd_plot(args) -> int:

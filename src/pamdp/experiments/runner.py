@@ -35,7 +35,7 @@ from pamdp.envs.backends import check_env_kwargs
 from pamdp.experiments.summary import SUMMARY, git_commit, write_summary
 from pamdp.presets import choose
 
-__all__ = ["RunConfig", "RunSpec", "train_run", "run_lock", "is_finished", "run_all"]
+__all__ = ["RunConfig", "RunSpec", "train_run", "run_lock", "is_finished", "recorded_differences", "run_all"]
 
 LOCK_FILE = ".lock"
 HOLDER_FILE = ".lock-holder"  # who holds the lock: beside it, since a locked file is not readable on every system
@@ -152,6 +152,56 @@ def is_finished(out: str | Path, spec: RunSpec) -> bool:
     if recorded.get("total_steps") != spec.total_steps:
         return False
     return spec.eval_episodes <= 0 or (out / "evaluation.json").exists()
+
+
+def recorded_differences(spec: RunSpec, summary: dict) -> list[str]:
+    """What keeps a kept summary (:mod:`pamdp.experiments.summary`) from standing for ``spec``'s run: ``[]`` where
+    it is of a finished run of the same algorithm, settings (seed included), env with its arguments and budget,
+    evaluated at the end if ``spec`` asks for it; else each difference in words (``budget: 500 in the summary,
+    1000 asked``).
+
+    ``pamdp reproduce --recorded`` skips the runs it finds so: a run tree lost with its machine need not train
+    again where its summary was committed. A summary converted from the suite's archive of figures (source
+    ``suite-finals.json``) holds no algorithm, settings or budget; the results' tables count it as its cell's seed,
+    and so does this: only what it holds is compared.
+    """
+    from pamdp.experiments.plots import setting_of
+    from pamdp.experiments.summary import SOURCES
+
+    config = spec.check().config
+    differ = []
+    if summary.get("source") == SOURCES[1]:  # an archive entry: what it does not hold stands as asked
+        summary = {
+            "algo": spec.algo,
+            "total_steps": spec.total_steps,
+            **{k: v for k, v in summary.items() if v is not None},
+        }
+        summary.setdefault("settings_hash", setting_of({"algo": spec.algo, "config": config.to_dict()})["settings"])
+    if summary.get("algo") != spec.algo:
+        differ.append(f"algorithm: {summary.get('algo')!r} in the summary, {spec.algo!r} asked")
+    else:
+        asked = setting_of({"algo": spec.algo, "config": config.to_dict()})["settings"]
+        if summary.get("settings_hash") != asked:
+            differ.append(f"settings digest: {summary.get('settings_hash')!r} in the summary, {asked!r} asked")
+        if summary.get("seed") != spec.seed:
+            differ.append(f"seed: {summary.get('seed')!r} in the summary, {spec.seed} asked")
+    if summary.get("env") != spec.env:
+        differ.append(f"env: {summary.get('env')!r} in the summary, {spec.env!r} asked")
+    else:
+        defaults = env_defaults(spec.env)
+        if {**defaults, **(summary.get("env_kwargs") or {})} != {**defaults, **dict(spec.env_kwargs)}:
+            differ.append(f"env_kwargs: {summary.get('env_kwargs')!r} in the summary, {dict(spec.env_kwargs)!r} asked")
+    if summary.get("total_steps") != spec.total_steps:
+        differ.append(f"budget: {summary.get('total_steps')!r} in the summary, {spec.total_steps} asked")
+    if not summary.get("finished"):
+        differ.append(f"the run had trained {summary.get('samples')} samples, not finished")
+    elif spec.eval_episodes > 0:
+        episodes = (summary.get("final") or {}).get("episodes")
+        if not summary.get("final"):
+            differ.append("no final evaluation in the summary")
+        elif episodes is not None and episodes != spec.eval_episodes:
+            differ.append(f"final evaluation: {episodes} episodes in the summary, {spec.eval_episodes} asked")
+    return differ
 
 
 def _read_run_json(path: Path) -> dict:

@@ -4,7 +4,8 @@ The paper's experiments take tens of CPU-hours on a laptop and are run over many
 where the last one stopped. This reads every run's directory without training anything and reports, per run,
 whether it is finished, partial (it resumes from its checkpoint) or not started, how many samples it has and
 how long it trained, and for the experiment the training time still to go, extrapolated from the time per
-sample its runs have taken so far.
+sample its runs have taken so far. A run whose directory is gone but whose summary was kept
+(``--recorded``) is "recorded", and counts as done.
 """
 
 from __future__ import annotations
@@ -20,9 +21,9 @@ from pathlib import Path
 from pamdp.experiments.runner import RunSpec, is_finished
 from pamdp.logger import success_of
 
-__all__ = ["RunStatus", "run_status", "format_status", "remaining_seconds"]
+__all__ = ["RunStatus", "run_status", "recorded_status", "format_status", "remaining_seconds"]
 
-DONE, PARTIAL, NOT_STARTED = "done", "partial", "not started"
+DONE, PARTIAL, NOT_STARTED, RECORDED = "done", "partial", "not started", "recorded"
 RECENT_EPOCHS = 5  # a run's pace is taken over its last epochs: code, load and phases change it as a run goes
 
 
@@ -33,7 +34,7 @@ class RunStatus:
     label: str
     seed: int
     out: str
-    state: str  # "done", "partial" or "not started"
+    state: str  # "done", "partial", "not started" or "recorded" (its summary kept, its directory not at hand)
     steps: int  # samples trained on so far (from progress.csv)
     total_steps: int
     train_seconds: float  # summed epoch times from progress.csv
@@ -122,6 +123,26 @@ def run_status(spec: RunSpec, out: str | Path, now: float | None = None) -> RunS
     )
 
 
+def recorded_status(spec: RunSpec, summary: dict) -> RunStatus:
+    """The state of ``spec``'s run as its kept ``summary`` (:mod:`pamdp.experiments.summary`) records it: done, with
+    the summary's training time (CPU, else wall) and final figures."""
+    final = summary.get("final") or {}
+    seconds = summary.get("cpu_seconds") if summary.get("cpu_seconds") is not None else summary.get("wall_seconds")
+    return RunStatus(
+        spec.label,
+        spec.seed,
+        summary.get("origin") or "",
+        RECORDED,
+        int(summary.get("samples") or spec.total_steps),
+        spec.total_steps,
+        float(seconds or 0.0),
+        None,  # a summary keeps the greedy evaluations, not the training returns
+        _float(final.get("mean_return")),
+        _float(final.get("success_rate")),
+        None,
+    )
+
+
 def _minutes(seconds: float) -> str:
     return f"{seconds / 60:.0f} min" if seconds < 5940 else f"{seconds / 3600:.1f} h"
 
@@ -141,7 +162,7 @@ def remaining_seconds(statuses: list[RunStatus]) -> tuple[float, dict[str, int]]
             by_label.setdefault(s.label, []).append(s.seconds_per_step)
     total, unknown = 0.0, {}
     for s in statuses:
-        if s.state == DONE:
+        if s.state in (DONE, RECORDED):
             continue
         rate = s.seconds_per_step
         if rate is None and s.label in by_label:
@@ -161,7 +182,7 @@ def format_status(name: str, statuses: list[RunStatus], workers: int = 1) -> str
     )
     lines = [head, "|---" * (head.count("|") - 1) + "|"]
     for s in statuses:
-        share = f"{s.steps:,} / {s.total_steps:,}" if s.state != DONE else f"{s.total_steps:,}"
+        share = f"{s.steps:,} / {s.total_steps:,}" if s.state not in (DONE, RECORDED) else f"{s.total_steps:,}"
         state = s.state
         if s.state == PARTIAL and s.idle_seconds is not None:  # a run in training writes every epoch
             state += f" (last epoch {_minutes(s.idle_seconds)} ago)"
@@ -177,14 +198,17 @@ def format_status(name: str, statuses: list[RunStatus], workers: int = 1) -> str
         if goal:
             cells.append(f"{s.success_rate:.3f}" if s.success_rate is not None else "-")
         lines.append("| " + " | ".join(cells) + " |")
-    counts = {k: sum(s.state == k for s in statuses) for k in (DONE, PARTIAL, NOT_STARTED)}
+    counts = {k: sum(s.state == k for s in statuses) for k in (DONE, PARTIAL, NOT_STARTED, RECORDED)}
     left, unknown = remaining_seconds(statuses)
-    summary = f"{name}: {counts[DONE]} of {len(statuses)} runs done, {counts[PARTIAL]} partial, "
-    summary += f"{counts[NOT_STARTED]} not started"
+    done = counts[DONE] + counts[RECORDED]
+    summary = f"{name}: {done} of {len(statuses)} runs done"
+    if counts[RECORDED]:
+        summary += f" ({counts[RECORDED]} recorded in kept summaries, their directories not here)"
+    summary += f", {counts[PARTIAL]} partial, {counts[NOT_STARTED]} not started"
     trained = sum(s.train_seconds for s in statuses)
     if trained > 0:
         summary += f"; {_minutes(trained)} of training so far"
-    if counts[DONE] < len(statuses):
+    if done < len(statuses):
         if left > 0:
             workers = max(1, workers)
             summary += (

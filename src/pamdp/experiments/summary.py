@@ -27,7 +27,7 @@ from pathlib import Path
 
 from pamdp.logger import RENAMED, success_of
 
-__all__ = ["FORMAT", "SUMMARY", "git_commit", "summarize", "write_summary", "load", "save"]
+__all__ = ["FORMAT", "SUMMARY", "git_commit", "summarize", "write_summary", "load", "save", "summary_path"]
 
 FORMAT = 1
 """The summary's format version, kept in each file: a reader refuses a newer one rather than misread it."""
@@ -183,7 +183,7 @@ def save(summaries: list[dict], root: str | os.PathLike) -> list[Path]:
     for summary in summaries:
         if not isinstance(summary.get("seed"), int):
             raise ValueError(f"the run {summary['origin']} records no seed; expected a run.json with its config")
-        path = Path(root) / _slug(summary["label"]) / f"seed{summary['seed']}.json"
+        path = summary_path(root, summary["label"], summary["seed"])
         if path in paths:
             raise ValueError(
                 f"two runs of {summary['label']!r} seed {summary['seed']}: {paths[path]['origin']} and "
@@ -194,6 +194,12 @@ def save(summaries: list[dict], root: str | os.PathLike) -> list[Path]:
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_text(json.dumps(summary, indent=1) + "\n")
     return list(paths)
+
+
+def summary_path(root: str | os.PathLike, label: str, seed: int) -> Path:
+    """Where :func:`save` keeps the summary of run ``label``'s seed ``seed`` under ``root``: ``root/ARM/seedN.json``,
+    the layout of an experiment's run directories (``ARM``: the label as a directory name)."""
+    return Path(root) / _slug(label) / f"seed{seed}.json"
 
 
 def _slug(label: str) -> str:
