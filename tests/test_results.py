@@ -2,6 +2,7 @@
 and the tables of a small hand-made set of summaries hold the hand-computed cells."""
 
 import csv
+import dataclasses
 import json
 import shutil
 import subprocess
@@ -13,6 +14,7 @@ import pytest
 from pamdp import __version__
 from pamdp.cli import main
 from pamdp.experiments import results
+from pamdp.experiments.runner import RunSpec, recorded_differences
 from pamdp.experiments.suite import from_suite_final
 from pamdp.experiments.summary import load, save, summarize
 
@@ -163,6 +165,14 @@ def test_an_archived_suite_entry_becomes_a_summary_of_its_final_figure_only():
     assert platform["final"] == {"mean_return": 0.9}
     with pytest.raises(ValueError, match="not a final evaluation"):
         from_suite_final({**entry, "final": False})
+    # `reproduce --recorded` takes it for its cell's seed, as the tables do, comparing what it holds
+    spec = RunSpec("patrpo", "pamdp/HardMove-v0", 1_000_000, seed=2, env_kwargs=(("n", 6),), preset="hard_move")
+    assert recorded_differences(spec, summary) == []
+    other = dataclasses.replace(spec, seed=3, env_kwargs=(("n", 8),))
+    assert recorded_differences(other, summary) == [
+        "seed: 2 in the summary, 3 asked",
+        "env_kwargs: {'n': 6} in the summary, {'n': 8} asked",
+    ]
 
 
 def _synthetic():
