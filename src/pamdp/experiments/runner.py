@@ -168,29 +168,19 @@ def recorded_differences(spec: RunSpec, summary: dict) -> list[str]:
     from pamdp.experiments.plots import setting_of
     from pamdp.experiments.summary import SOURCES
 
-    config = spec.check().config
-    differ = []
+    asked = setting_of({"algo": spec.algo, "config": spec.check().config.to_dict()})["settings"]
     if summary.get("source") == SOURCES[1]:  # an archive entry: what it does not hold stands as asked
-        summary = {
-            "algo": spec.algo,
-            "total_steps": spec.total_steps,
-            **{k: v for k, v in summary.items() if v is not None},
-        }
-        summary.setdefault("settings_hash", setting_of({"algo": spec.algo, "config": config.to_dict()})["settings"])
+        held = {k: v for k, v in summary.items() if v is not None}
+        summary = {"algo": spec.algo, "total_steps": spec.total_steps, "settings_hash": asked, **held}
+    differ = []
     if summary.get("algo") != spec.algo:
         differ.append(f"algorithm: {summary.get('algo')!r} in the summary, {spec.algo!r} asked")
     else:
-        asked = setting_of({"algo": spec.algo, "config": config.to_dict()})["settings"]
         if summary.get("settings_hash") != asked:
             differ.append(f"settings digest: {summary.get('settings_hash')!r} in the summary, {asked!r} asked")
         if summary.get("seed") != spec.seed:
             differ.append(f"seed: {summary.get('seed')!r} in the summary, {spec.seed} asked")
-    if summary.get("env") != spec.env:
-        differ.append(f"env: {summary.get('env')!r} in the summary, {spec.env!r} asked")
-    else:
-        defaults = env_defaults(spec.env)
-        if {**defaults, **(summary.get("env_kwargs") or {})} != {**defaults, **dict(spec.env_kwargs)}:
-            differ.append(f"env_kwargs: {summary.get('env_kwargs')!r} in the summary, {dict(spec.env_kwargs)!r} asked")
+    differ += _env_differences(summary, spec.env, dict(spec.env_kwargs), "in the summary")
     if summary.get("total_steps") != spec.total_steps:
         differ.append(f"budget: {summary.get('total_steps')!r} in the summary, {spec.total_steps} asked")
     if not summary.get("finished"):
@@ -231,16 +221,22 @@ def env_defaults(env: str) -> dict:
     return {p.name: p.default for p in params if p.default is not inspect.Parameter.empty}
 
 
+def _env_differences(recorded: dict, env: str, env_kwargs: dict, where: str) -> list[str]:
+    """The env, else its arguments, where ``recorded`` (a ``run.json`` or a summary, ``where`` saying which) differs
+    from ``env`` with ``env_kwargs``; the arguments count with their defaults: Hard Move's ``{"n": 4}`` is its
+    ``{}``."""
+    if recorded.get("env") != env:
+        return [f"env: {recorded.get('env')!r} {where}, {env!r} asked"]
+    defaults = env_defaults(env)
+    if {**defaults, **(recorded.get("env_kwargs") or {})} != {**defaults, **env_kwargs}:
+        return [f"env_kwargs: {recorded.get('env_kwargs')!r} {where}, {env_kwargs!r} asked"]
+    return []
+
+
 def _differences(recorded: dict, asked: dict) -> list[str]:
     """What differs between a recorded run and the one asked for, setting by setting: ``delta: 0.01 in the
     run, 0.05 asked``. Env arguments count with their defaults: Hard Move's ``{"n": 4}`` is its ``{}``."""
-    differ = []
-    if recorded.get("env") != asked["env"]:
-        differ.append(f"env: {recorded.get('env')!r} in the run, {asked['env']!r} asked")
-    else:
-        defaults = env_defaults(asked["env"])
-        if {**defaults, **(recorded.get("env_kwargs") or {})} != {**defaults, **asked["env_kwargs"]}:
-            differ.append(f"env_kwargs: {recorded.get('env_kwargs')!r} in the run, {asked['env_kwargs']!r} asked")
+    differ = _env_differences(recorded, asked["env"], asked["env_kwargs"], "in the run")
     old, new = recorded.get("config", {}), asked["config"]
     for name in sorted(set(old) | set(new)):
         if old.get(name) != new.get(name):
