@@ -5,7 +5,7 @@ Each experiment's summaries lie in ``docs/results/summaries/EXPERIMENT/ARM/seedN
 ``<!-- results:NAME start -->`` and ``<!-- results:NAME end -->`` in ``docs/results.md`` (and the README's line of
 the suite's aggregates); everything between the markers is replaced. The benchmark suite's ``suite.md`` and
 ``suite-finals.json`` (the archive that ``pamdp plot --suite-archive`` reads) are rewritten from the same
-summaries, and its performance profiles and sample-efficiency figures are drawn.
+summaries, and its performance profiles, sample-efficiency figure and a figure per domain are drawn.
 
     python docs/gen_results.py            # rewrite the tables, suite.md, suite-finals.json and the figures
     python docs/gen_results.py --check    # exit 1 if a table or file is out of date (for CI and the tests)
@@ -90,6 +90,7 @@ def main() -> int:
         path.write_text(wanted[path])
     results.plot_profiles(summaries("benchmark-suite"), SUITE / "profiles")
     results.plot_efficiency(summaries("benchmark-suite"), SUITE / "efficiency")
+    results.plot_domains(summaries("benchmark-suite"), SUITE)
     return 0
 
 

@@ -514,10 +514,11 @@ def test_the_benchmark_suite_is_hyars_table_at_its_budgets():
     assert all(s.config()[2].multi_pass == s.label.startswith("MP-DQN") for s in specs if s.algo == "pdqn")
 
 
-def _suite_run(root, label, env, seed, env_kwargs=None, evaluation=None, greedy=None):
+def _suite_run(root, label, env, seed, env_kwargs=None, evaluation=None, greedy=None, total_steps=None):
     run = root / label.replace(" ", "_") / f"seed{seed}"
     run.mkdir(parents=True)
-    (run / "run.json").write_text(json.dumps({"label": label, "algo": "x", "env": env, "env_kwargs": env_kwargs or {}}))
+    recorded = {"label": label, "algo": "x", "env": env, "env_kwargs": env_kwargs or {}}
+    (run / "run.json").write_text(json.dumps(recorded | ({"total_steps": total_steps} if total_steps else {})))
     column = "eval/mean_return" if env == "pamdp/Platform-v0" else "eval/success_rate"
     rows = "".join(f"{10_000 * (i + 1)},0.0,{v}\n" for i, v in enumerate(greedy or [""]))
     (run / "progress.csv").write_text(f"time/total_timesteps,charts/episodic_return,{column}\n{rows}")
@@ -534,7 +535,9 @@ def test_the_suite_table_puts_each_domains_runs_beside_hyars_numbers(tmp_path):
     _suite_run(root, "MP-DQN on Platform", "pamdp/Platform-v0", 0, evaluation={"mean_return": 0.96})
     _suite_run(root, "MP-DQN on Platform", "pamdp/Platform-v0", 1, evaluation={"goal_rate": 1.0, "mean_return": 0.9})
     # a run still training: its last greedy evaluation; another domain's n tells Hard Move's rows apart
-    _suite_run(root, "PATRPO on Hard Move n=8", "pamdp/HardMove-v0", 0, {"n": 8}, greedy=[0.1, "", 0.4])
+    _suite_run(
+        root, "PATRPO on Hard Move n=8", "pamdp/HardMove-v0", 0, {"n": 8}, greedy=[0.1, "", 0.4], total_steps=60_000
+    )
     _suite_run(root, "PATRPO on Goal", "pamdp/Goal-v0", 0)  # nothing evaluated yet
     report = write_report([root], tmp_path / "fig")
     lines = report["suite"].read_text().splitlines()
@@ -547,7 +550,9 @@ def test_the_suite_table_puts_each_domains_runs_beside_hyars_numbers(tmp_path):
     assert rows["Platform"][0] == "0.93 +- 0.03 (2 seeds)"  # the return, not the old success key
     assert rows["Hard Move n=8"][:2] == ["-", "0.40 +- 0.00 (1 seed, 1 partial*)"]
     assert rows["Hard Move n=10"][:2] == ["-", "-"] and rows["Hard Move n=10"][2] == "0.75 +- 0.05"
-    assert report["domain-goal_png"].exists() and "domain-hard-move-n8_svg" in report
+    # a figure for the domain whose run logged greedy evaluations during training, none for those that logged none
+    assert report["domain-hard-move-n8_png"].exists() and "domain-hard-move-n8_svg" in report
+    assert not any(key.startswith(("domain-goal", "domain-platform")) for key in report)
     other = tmp_path / "other"
     _suite_run(other, "MP-DQN on CartPole", "CartPole-v1", 0, evaluation={"success_rate": 1.0})
     _suite_run(other, "MP-DQN on Hard Move n=5", "pamdp/HardMove-v0", 0, {"n": 5}, evaluation={"success_rate": 1.0})

@@ -330,6 +330,28 @@ def test_the_one_preset_table_judges_each_domain_against_hyars_figure_and_counts
     assert table.endswith("on 1 of the 2 domains it has one for.")
 
 
+def test_a_cells_greedy_band_is_the_mean_of_each_runs_last_evaluation_and_stops_where_a_run_stops():
+    # three runs evaluated every 100 samples of a 400-sample budget; the third is still training (last at 200)
+    a = ((np.array([100.0, 200, 300, 400]), np.array([0.0, 0.2, 0.4, 0.8])), 400.0)
+    b = ((np.array([100.0, 200, 300, 400]), np.array([0.1, 0.1, 0.5, 0.5])), 400.0)
+    c = ((np.array([100.0, 200]), np.array([0.3, 0.6])), 400.0)
+    points = np.array([50.0, 150, 250, 300, 350])
+    band = results.greedy_band([a, b], points, relative=False)
+    # by 50 samples no run had been evaluated; by 150: 0.0 and 0.1; by 250: 0.2 and 0.1; by 300: 0.4 and 0.5
+    assert band["seen"].tolist() == [False, True, True, True, True]
+    np.testing.assert_allclose(band["mean"][1:], [0.05, 0.15, 0.45, 0.45])
+    assert np.isnan(band["low"]).all()  # two runs: no interval
+    # the run still training counts up to one interval past its last evaluation (300), not after it
+    band = results.greedy_band([a, b, c], points, relative=False)
+    assert band["seen"].tolist() == [False, True, True, True, False]
+    np.testing.assert_allclose(band["mean"][1:4], [0.4 / 3, 0.9 / 3, 1.5 / 3])
+    # the band at 300 samples: the percentile bootstrap of the mean of (0.4, 0.5, 0.6) lies within their range
+    assert 0.4 <= band["low"][3] < 0.5 < band["high"][3] <= 0.6
+    # the same points as fractions of each run's budget
+    relative = results.greedy_band([a, b, c], points / 400, relative=True)
+    np.testing.assert_array_equal(relative["mean"], band["mean"])
+
+
 def test_the_figures_are_drawn_where_there_is_something_to_draw(tmp_path):
     runs = _synthetic()
     profiles = results.plot_profiles(runs, tmp_path / "profiles")
@@ -344,6 +366,10 @@ def test_the_figures_are_drawn_where_there_is_something_to_draw(tmp_path):
     assert "A (7 runs)" in profiles[1].read_text()  # both domains are shared: A's 3 + 4 runs
     platform_only = [s for s in runs if s["env"] == "pamdp/Platform-v0"]  # no curves
     assert results.plot_efficiency(platform_only, tmp_path / "none") == []
+    # a figure per domain with curves, in samples: Goal's (A's and B's curves), none for Platform (no curve)
+    domains = results.plot_domains(runs, tmp_path)
+    assert [p.name for p in domains] == ["domain-goal.png", "domain-goal.svg"]
+    assert "A (3)" in domains[1].read_text() and "B (2)" in domains[1].read_text()
     assert results.plot_profiles([runs[0]], tmp_path / "one") == []  # one run: no domain with 2 runs to resample
     # the committed figures are checked against redrawn ones: the same runs must give the same bytes
     (tmp_path / "again").mkdir()

@@ -12,7 +12,7 @@ import numpy as np
 
 from pamdp.experiments import results
 from pamdp.experiments.plots import EXTRA_FIGURES, aggregate, find_groups, plot_curves, results_table
-from pamdp.experiments.suite import from_suite_final, load_finals, merge_finals, plot_domains, suite_finals, suite_table
+from pamdp.experiments.suite import from_suite_final, load_finals, merge_finals, suite_finals, suite_table
 from pamdp.experiments.summary import summarize
 
 __all__ = ["write_report"]
@@ -36,7 +36,8 @@ def write_report(
     training success rate per epoch (epochs logged before a run recorded it are left out), and with
     ``eval_every`` ``greedy_success_rate.png`` and ``.svg``, that of the greedy evaluations. Runs on the benchmark
     suite's domains also get ``suite.md``, their table beside HyAR's published one, ``suite-finals.json``, each
-    seed's figure, and a figure per domain (:mod:`pamdp.experiments.suite`). ``suite_archive``: an earlier
+    seed's figure (:mod:`pamdp.experiments.suite`), and a figure per domain of their greedy curves with 95 % bands
+    (``domain-NAME.png`` and ``.svg``, :func:`.results.plot_domains`). ``suite_archive``: an earlier
     ``suite-finals.json``, whose entries fill the table where no run at hand has their domain, method and seed.
 
     ``stats.md`` holds the statistics of the runs' final figures (:func:`.results.report`: means and interquartile
@@ -82,11 +83,11 @@ def write_report(
         extra["stats"] = out / "stats.md"
         extra.update({f"profiles_{p.suffix[1:]}": p for p in results.plot_profiles(summaries, out / "profiles")})
         extra.update({f"efficiency_{p.suffix[1:]}": p for p in results.plot_efficiency(summaries, out / "efficiency")})
-    if finals:  # runs on the benchmark suite's domains: their table beside HyAR's, and a figure per domain
+        extra.update({f"{p.stem}_{p.suffix[1:]}": p for p in results.plot_domains(summaries, out)})  # suite domains
+    if finals:  # runs on the benchmark suite's domains: their table beside HyAR's
         (out / "suite.md").write_text(suite_table(finals) + "\n")
         (out / "suite-finals.json").write_text(json.dumps(finals, indent=1) + "\n")
         extra["suite"], extra["suite_finals"] = out / "suite.md", out / "suite-finals.json"
-        extra.update({f"{p.stem}_{p.suffix[1:]}": p for p in plot_domains(groups, out)})
     return {"png": png, "svg": svg, "csv": csv_path, "table": table, **extra}
 
 

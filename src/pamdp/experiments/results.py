@@ -14,7 +14,8 @@ so they are aggregated across domains as they are.
 - :func:`efficiency_table`: from the greedy curves, the rate at fractions of the budget, the samples to 90 % of the
   best published rate (censored where never reached) and the normalised area under the curve;
 - :func:`plot_profiles`: the performance profiles (share of runs above each score) with their bands;
-- :func:`plot_efficiency`: the greedy curves over the fraction of the budget, with their bands.
+- :func:`plot_efficiency`: the greedy curves over the fraction of the budget, with their bands;
+- :func:`plot_domains`: the same curves, a figure per domain, over samples.
 
 An interval over fewer than :data:`MIN_RUNS` runs is not printed: a bootstrap of two runs can only return their
 values, a range that says nothing about a third.
@@ -52,6 +53,9 @@ __all__ = [
     "standing_line",
     "plot_profiles",
     "plot_efficiency",
+    "plot_domains",
+    "domain_figure",
+    "greedy_band",
     "report",
 ]
 
@@ -644,16 +648,66 @@ def _save(fig, path: str | os.PathLike) -> list[Path]:
     return written
 
 
-def plot_efficiency(summaries: list[dict], path: str | os.PathLike) -> list[Path]:
-    """The greedy curves of each cell with curves, a panel per domain, over the fraction of the budget: the mean over
-    runs of the last evaluation made by each fraction, with the 95 % bootstrap band of that mean where the cell has
-    :data:`MIN_RUNS` runs or more, and the 90 % of the best published figure that the efficiency table counts the
-    samples to; ``path`` with ``.png`` and ``.svg`` suffixes (nothing where no run logged a curve)."""
-    by_domain: dict[str, dict[str, list]] = {}
+def _greedy_cells(summaries: list[dict]) -> dict[str, dict[str, tuple[list, int]]]:
+    """``{domain: {method: (curves, runs)}}``: each domain's main cells whose runs logged greedy curves
+    (:func:`_curves`), with the cell's number of runs (archived runs kept no curve)."""
+    by_domain: dict[str, dict[str, tuple[list, int]]] = {}
     for (row, method), runs in cells(summaries).items():
         curves = _curves(runs)
         if curves and row == _domain(runs[0]):
-            by_domain.setdefault(row, {})[method] = curves
+            by_domain.setdefault(row, {})[method] = (curves, len(runs))
+    return by_domain
+
+
+def greedy_band(curves: list, points: np.ndarray, relative: bool) -> dict[str, np.ndarray]:
+    """A cell's greedy curve at ``points`` (fractions of each run's budget where ``relative``, else samples): the
+    mean over runs of each run's last evaluation made by then, and the 95 % bootstrap interval of that mean where
+    the cell has :data:`MIN_RUNS` runs or more (else NaN). ``seen``: the points where every run had been evaluated
+    and none had yet stopped (a run still training stops one evaluation interval after its last evaluation), so
+    the mean is always over all the cell's runs."""
+    at = []
+    for (steps, values), budget in curves:
+        limits = points * budget if relative else points
+        row = stats.rate_at_fractions(steps, values, budget=1.0, fractions=limits)
+        done = steps[np.isfinite(values)]
+        gap = np.median(np.diff(done)) if len(done) > 1 else 0.0
+        row[limits > done[-1] + gap] = np.nan  # past the run's last evaluation: not known yet
+        at.append(row)
+    at = np.array(at)
+    seen = ~np.isnan(at).any(axis=0)
+    mean = np.full(len(points), np.nan)
+    low, high = mean.copy(), mean.copy()
+    mean[seen] = at[:, seen].mean(axis=0)
+    if len(curves) >= MIN_RUNS:
+        for i in np.flatnonzero(seen):
+            band = stats.interval([at[:, i]], np.mean, resamples=500)
+            low[i], high[i] = band.low, band.high
+    return {"seen": seen, "mean": mean, "low": low, "high": high}
+
+
+def _draw_greedy(ax, domain: str, methods: dict[str, tuple[list, int]], points: np.ndarray, relative: bool):
+    """One domain's panel: each method's :func:`greedy_band` (the legend says how many of the cell's runs logged
+    curves) and the :data:`TARGET` share of the best figure of HyAR's table, dashed."""
+    for method, (curves, runs) in methods.items():
+        band = greedy_band(curves, points, relative)
+        seen = band["seen"]
+        count = f"{len(curves)}" if len(curves) == runs else f"{len(curves)} of {runs}"
+        ax.plot(points[seen], band["mean"][seen], label=f"{method} ({count})", linewidth=1.2, color=_colour(method))
+        if len(curves) >= MIN_RUNS:
+            ax.fill_between(points[seen], band["low"][seen], band["high"][seen], color=_colour(method), alpha=0.2)
+    best = published_best(domain)
+    if best is not None:
+        ax.axhline(TARGET * best, color="grey", linestyle="--", linewidth=0.8)
+    ax.grid(alpha=0.3)
+
+
+def plot_efficiency(summaries: list[dict], path: str | os.PathLike) -> list[Path]:
+    """The greedy curves of each cell with curves, a panel per domain, over the fraction of the budget: the mean over
+    runs of the last evaluation made by each fraction, with the 95 % bootstrap band of that mean where the cell has
+    :data:`MIN_RUNS` runs or more (:func:`greedy_band`), and the 90 % of the best published figure that the
+    efficiency table counts the samples to; ``path`` with ``.png`` and ``.svg`` suffixes (nothing where no run
+    logged a curve)."""
+    by_domain = _greedy_cells(summaries)
     if not by_domain:
         return []
     import matplotlib
@@ -666,22 +720,8 @@ def plot_efficiency(summaries: list[dict], path: str | os.PathLike) -> list[Path
     rows = -(-len(by_domain) // cols)
     fig, axes = plt.subplots(rows, cols, figsize=(2.6 * cols, 2.3 * rows), dpi=110, squeeze=False, sharex=True)
     for ax, (domain, methods) in zip(axes.flat, by_domain.items()):
-        for method, curves in methods.items():
-            with np.errstate(all="ignore"):
-                at = np.array([stats.rate_at_fractions(*c, budget=b, fractions=grid) for c, b in curves])
-            seen = ~np.isnan(at).any(axis=0)  # from the first fraction every run had been evaluated by
-            mean = at.mean(axis=0)
-            label, colour = f"{method} ({len(curves)})", _colour(method)
-            line = ax.plot(grid[seen], mean[seen], label=label, linewidth=1.2, color=colour)[0]
-            if len(curves) >= MIN_RUNS:
-                bands = [stats.interval([at[:, i]], np.mean, resamples=500) for i in np.flatnonzero(seen)]
-                low, high = np.array([b.low for b in bands]), np.array([b.high for b in bands])
-                ax.fill_between(grid[seen], low, high, color=line.get_color(), alpha=0.2)
-        best = published_best(domain)
-        if best is not None:
-            ax.axhline(TARGET * best, color="grey", linestyle="--", linewidth=0.8)
+        _draw_greedy(ax, domain, methods, grid, relative=True)
         ax.set_title(domain, fontsize=9)
-        ax.grid(alpha=0.3)
         ax.legend(fontsize=7, frameon=False)
     for ax in axes.flat[len(by_domain) :]:
         ax.axis("off")
@@ -690,6 +730,49 @@ def plot_efficiency(summaries: list[dict], path: str | os.PathLike) -> list[Path
     fig.suptitle(f"greedy evaluations (dashed: {TARGET * 100:g} % of the best figure of HyAR's table)", fontsize=9)
     fig.tight_layout()
     return _save(fig, path)
+
+
+def domain_figure(domain: str) -> str:
+    """The file name (no suffix) of a suite domain's figure: ``domain-hard-move-n8`` for ``Hard Move n=8``."""
+    return "domain-" + domain.lower().replace(" ", "-").replace("=", "")
+
+
+def plot_domains(summaries: list[dict], out: str | os.PathLike) -> list[Path]:
+    """A figure per suite domain whose runs logged greedy curves (:func:`domain_figure` ``.png`` and ``.svg`` in
+    ``out``): each method's greedy success rate (Platform: return) over environment samples, the mean over its
+    runs with the 95 % bootstrap band (:func:`greedy_band`), and the :data:`TARGET` share of the best figure of
+    HyAR's table, dashed. The panels of :func:`plot_efficiency`, one domain at a time and in samples."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.ticker import EngFormatter
+
+    written = []
+    suite = {d[0] for d in DOMAINS}
+    for domain, methods in _greedy_cells(summaries).items():
+        if domain not in suite:
+            continue
+        budget = max(b for curves, _ in methods.values() for _, b in curves)
+        points = np.linspace(0.02, 1.0, 50) * budget
+        fig, ax = plt.subplots(figsize=(6.4, 3.2), dpi=110)
+        _draw_greedy(ax, domain, methods, points, relative=False)
+        ax.set_title(domain)
+        ax.set_xlabel("environment samples")
+        ax.xaxis.set_major_formatter(EngFormatter(sep=""))
+        figure = "return" if domain == "Platform" else "success rate"
+        ax.set_ylabel(f"greedy {figure}\n(100 episodes)")
+        ax.legend(
+            loc="upper left",
+            bbox_to_anchor=(1.01, 1.0),
+            fontsize=8,
+            frameon=False,
+            title=f"runs with curves\n(dashed: {TARGET * 100:g} % of\nHyAR's best figure)",
+            title_fontsize=7,
+        )
+        fig.tight_layout()
+        written += _save(fig, Path(out) / domain_figure(domain))
+    return written
 
 
 def report(summaries: list[dict], planned=()) -> str:

@@ -39,7 +39,6 @@ __all__ = [
     "suite_cells",
     "format_cell",
     "suite_table",
-    "plot_domains",
 ]
 
 DOMAINS: tuple[tuple[str, str, dict], ...] = (
@@ -282,24 +281,6 @@ def suite_table(finals: list[dict]) -> str:
         "evaluation episodes). Per seed, with where each figure comes from: `suite-finals.json` beside this table.",
     ]
     return "\n".join(lines)
-
-
-def plot_domains(groups: dict[str, list[Path]], out: str | os.PathLike) -> list[Path]:
-    """One figure per suite domain with runs (``domain-NAME.png`` and ``.svg``): the greedy success rate (Platform:
-    return) of each method's evaluations during training, over samples."""
-    from pamdp.experiments.plots import GREEDY_METRIC, GREEDY_SUCCESS_METRIC, _recorded, plot_curves
-
-    by_domain: dict[str, dict[str, list[Path]]] = {}
-    for label, runs in groups.items():
-        domain = domain_of(_recorded(runs[0]))
-        if domain is not None:
-            by_domain.setdefault(domain, {})[method_of(label, domain)] = runs
-    written = []
-    for domain, methods in by_domain.items():
-        metric = GREEDY_METRIC if domain == "Platform" else GREEDY_SUCCESS_METRIC
-        name = "domain-" + domain.lower().replace(" ", "-").replace("=", "")
-        written += plot_curves(methods, Path(out) / name, domain, metric, x="samples")
-    return written
 
 
 def from_suite_final(entry: dict) -> dict:
