@@ -37,10 +37,9 @@ def summaries(experiment: str) -> list[dict]:
     return [load(path) for path in sorted((SUMMARIES / experiment).rglob("*.json"))]
 
 
-def tables() -> dict[str, str]:
-    """Each generated table of the page by its marker's name."""
-    suite = summaries("benchmark-suite")
-    planned = results.planned_cells(load_experiment("benchmark-suite").specs())  # its cells not run yet owe runs too
+def tables(suite: list[dict], planned: list[tuple[str, str]]) -> dict[str, str]:
+    """Each generated table of the page by its marker's name, from the suite's summaries and its config's cells
+    (``planned``: those not run yet owe runs too)."""
     return {
         "suite": suite_table(results.finals(suite)) + "\n",
         "suite-stats": results.stats_table(suite, planned) + "\n",
@@ -81,10 +80,8 @@ STATS_FIGURES = "\n".join(
 )
 
 
-def files() -> dict[Path, str]:
+def files(suite: list[dict], planned: list[tuple[str, str]]) -> dict[Path, str]:
     """The suite's table, archive and statistics page beside its figures, as the summaries give them."""
-    suite = summaries("benchmark-suite")
-    planned = results.planned_cells(load_experiment("benchmark-suite").specs())
     return {
         SUITE / "suite.md": suite_table(results.finals(suite)) + "\n",
         SUITE / "suite-finals.json": json.dumps(results.finals(suite), indent=1) + "\n",
@@ -92,8 +89,8 @@ def files() -> dict[Path, str]:
     }
 
 
-def render(text: str, page: Path = PAGE) -> str:
-    generated = tables()
+def render(text: str, generated: dict[str, str], page: Path = PAGE) -> str:
+    """``text`` with each marked table replaced by its ``generated`` one (:func:`tables`)."""
 
     def fill(match: re.Match) -> str:
         name = match.group(2)
@@ -108,7 +105,10 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--check", action="store_true", help="exit 1 if a table or file is out of date")
     args = parser.parse_args()
-    wanted = {page: render(page.read_text(), page) for page in (PAGE, README)} | files()
+    suite = summaries("benchmark-suite")  # read once: every table, file and figure below is of these
+    planned = results.planned_cells(load_experiment("benchmark-suite").specs())
+    generated = tables(suite, planned)
+    wanted = {page: render(page.read_text(), generated, page) for page in (PAGE, README)} | files(suite, planned)
     stale = [path for path, text in wanted.items() if not path.exists() or path.read_text() != text]
     if args.check:
         for path in stale:
@@ -116,9 +116,9 @@ def main() -> int:
         return int(bool(stale))
     for path in stale:
         path.write_text(wanted[path])
-    results.plot_profiles(summaries("benchmark-suite"), SUITE / "profiles")
-    results.plot_efficiency(summaries("benchmark-suite"), SUITE / "efficiency")
-    results.plot_domains(summaries("benchmark-suite"), SUITE)
+    results.plot_profiles(suite, SUITE / "profiles")
+    results.plot_efficiency(suite, SUITE / "efficiency")
+    results.plot_domains(suite, SUITE)
     return 0
 
 
