@@ -138,6 +138,28 @@ def test_forms_lay_out_every_actions_parameters(form):
         assert not torch.allclose(dist.mean[:, 0, 0], dist.mean[:, 2, 0])
 
 
+def test_every_action_with_all_parameters_lays_out_and_draws_as_the_masked_layout_does():
+    """Where every action has all m parameters (Hard Move's layout) the actor skips the gathers and the mask: its
+    means and log-stds are the network's outputs in order, action by action, and its draws and log-densities those
+    of the same distribution with an all-ones mask."""
+    dense = HybridActionSpace((-np.ones(2),) * 3, (np.ones(2),) * 3)
+    torch.manual_seed(4)
+    actor = HybridSACActor(4, dense, "flat", (8,), "tanh")
+    with torch.no_grad():
+        actor.net[-1].bias.copy_(torch.arange(15.0) / 10)
+    obs = torch.randn(5, 4)
+    dist, raw = actor(obs), actor.net(obs)
+    for a in range(3):
+        torch.testing.assert_close(dist.mean[:, a], raw[:, 3 + 2 * a : 5 + 2 * a])
+        torch.testing.assert_close(dist.log_std[:, a], raw[:, 9 + 2 * a : 11 + 2 * a].clamp(-5, 2))
+    masked = SquashedHybrid(dist.logits, dist.mean, dist.log_std, torch.ones(3, 2))
+    (u, x), (u_m, x_m) = (d.rsample(torch.Generator().manual_seed(1)) for d in (dist, masked))
+    torch.testing.assert_close(x, x_m)
+    torch.testing.assert_close(dist.log_prob_c(u), masked.log_prob_c(u_m))
+    torch.testing.assert_close(actor.flat_params(x), torch.cat([x[:, 0], x[:, 1], x[:, 2]], -1))
+    torch.testing.assert_close(dist.mode()[1], masked.mode()[1])
+
+
 def _model(**changes) -> HybridSAC:
     return HybridSAC("pamdp/Platform-v0", dataclasses.replace(SMALL, **changes))
 

@@ -260,18 +260,21 @@ class SquashedHybrid(Categorical):
         logits: ``(B, K)`` logits of ``pi_d``, masked actions already at :data:`~pamdp.distributions.MASKED`.
         mean: ``(B, K, m)`` means of the pre-squash Gaussians ``u``, per action and padded parameter.
         log_std: ``(B, K, m)`` their log standard deviations.
-        param_mask: ``(K, m)`` float, 1 where action ``a`` uses padded parameter ``i``.
+        param_mask: ``(K, m)`` float, 1 where action ``a`` uses padded parameter ``i``; ``None`` where every action
+            uses all ``m`` (nothing to mask).
     """
 
     mean: torch.Tensor
     log_std: torch.Tensor
-    param_mask: torch.Tensor
+    param_mask: torch.Tensor | None
 
     def rsample(self, generator: torch.Generator | None = None) -> tuple[torch.Tensor, torch.Tensor]:
         """Reparameterised pre-squash ``u`` and parameters ``x = tanh(u)`` of every action, ``(B, K, m)`` each;
         unused entries are zero."""
         noise = torch.randn(self.mean.shape, generator=generator, dtype=self.mean.dtype, device=self.mean.device)
-        u = (self.mean + self.log_std.exp() * noise) * self.param_mask
+        u = self.mean + self.log_std.exp() * noise
+        if self.param_mask is not None:
+            u = u * self.param_mask
         return u, torch.tanh(u)
 
     def log_prob_c(self, u: torch.Tensor) -> torch.Tensor:
@@ -282,7 +285,8 @@ class SquashedHybrid(Categorical):
         z = (u - self.mean) * torch.exp(-self.log_std)
         gaussian = -0.5 * z.pow(2) - self.log_std - 0.5 * _LOG_2PI
         log_det = 2.0 * (math.log(2.0) - u - F.softplus(-2.0 * u))
-        return ((gaussian - log_det) * self.param_mask).sum(-1)
+        log_p = gaussian - log_det
+        return (log_p if self.param_mask is None else log_p * self.param_mask).sum(-1)
 
     def sample_discrete(self, generator: torch.Generator | None = None) -> torch.Tensor:
         """``(B,)`` actions drawn from ``pi_d``."""
@@ -291,7 +295,8 @@ class SquashedHybrid(Categorical):
     def mode(self) -> tuple[torch.Tensor, torch.Tensor]:
         """The greedy action: ``argmax_a pi_d(a | s)`` and ``tanh`` of its Gaussian's mean, ``(B,)`` and ``(B, m)``."""
         a = self.logits.argmax(-1)
-        return a, torch.tanh(self.mean[torch.arange(len(a), device=a.device), a]) * self.param_mask[a]
+        x = torch.tanh(self.mean[torch.arange(len(a), device=a.device), a])
+        return a, x if self.param_mask is None else x * self.param_mask[a]
 
 
 def kl_divergence(

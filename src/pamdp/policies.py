@@ -381,6 +381,8 @@ class HybridSACActor(nn.Module):
         self.total = total = hybrid.total_param_size
         # the all-actions vector's entries in the flattened padded (K * m) layout
         self.register_buffer("flat_index", torch.tensor(np.flatnonzero(mask), dtype=torch.long))
+        # every action with all m parameters (Hard Move, Catch Point): the two layouts are one, no gather needed
+        self.dense = bool(mask.all())
         if form == "flat":  # starts near uniform, centred, with unit noise, as the hierarchical form does
             self.net = mlp(obs_dim, hidden_sizes, self.n_actions + 2 * total, activation)
             small_init_(self.net[-1])
@@ -389,6 +391,8 @@ class HybridSACActor(nn.Module):
 
     def _padded(self, flat: torch.Tensor) -> torch.Tensor:
         """``(B, sum_a m_a)`` all-actions values as ``(B, K, m)``, zero where unused."""
+        if self.dense:
+            return flat.reshape(-1, self.n_actions, self.m)
         return flat[:, self.param_index].view(-1, self.n_actions, self.m) * self.param_mask
 
     def forward(self, obs: torch.Tensor, mask: torch.Tensor | None = None) -> SquashedHybrid:
@@ -399,11 +403,13 @@ class HybridSACActor(nn.Module):
             mean, log_std = every_action_mlp(self.pi_c, obs).split(self.m, dim=-1)
             logits = self.pi_d(obs)
         log_std = log_std.clamp(LOG_STD_MIN, LOG_STD_MAX)
-        return SquashedHybrid(masked_logits(logits, mask), mean, log_std, self.param_mask)
+        param_mask = None if self.dense else self.param_mask
+        return SquashedHybrid(masked_logits(logits, mask), mean, log_std, param_mask)
 
     def flat_params(self, x: torch.Tensor) -> torch.Tensor:
         """Every action's parameters ``(B, K, m)`` as the critics' all-actions vector ``(B, sum_a m_a)``."""
-        return x.reshape(x.shape[0], -1)[:, self.flat_index]
+        flat = x.reshape(x.shape[0], -1)
+        return flat if self.dense else flat[:, self.flat_index]
 
 
 class ValueNetwork(nn.Module):
