@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import warnings
 from collections.abc import Callable, Sequence
 
 import numpy as np
@@ -43,6 +44,10 @@ __all__ = [
 ]
 
 BOUNDS = ("invert", "squash", "zero")
+
+#: An epoch's mean critic value (its ``train/q_mean``) beyond this many times the largest discounted return the
+#: replay's rewards allow, ``max |r| / (1 - gamma)``, is taken for a diverged critic (:meth:`OffPolicyLoop.run_epoch`).
+DIVERGED = 10.0
 
 
 @dataclasses.dataclass(frozen=True)
@@ -356,6 +361,7 @@ class OffPolicyLoop:
         self.tail_value = tail_value
         self.update_credit = 0.0
         self.stepper: VectorStepper | None = None  # the env's copies, from the first epoch on
+        self.diverged_warned = False  # the warning of a diverged critic is given once a model
 
     def td_target(self, batch: dict[str, torch.Tensor], next_value: torch.Tensor) -> torch.Tensor:
         """``y = r + gamma V(s')`` of a replayed batch, with no bootstrap after a termination; where the loop keeps
@@ -438,7 +444,33 @@ class OffPolicyLoop:
         stats.update(stepper.episodes.pop())
         stats["steps"] = n_valid
         stats.update(algo._epoch_stats(start_step + n_valid))
+        self._check_critic(stats, start_step + n_valid)
         return stats
+
+    def _check_critic(self, stats: dict[str, float], step: int) -> None:
+        """Log ``train/q_bound``, the largest discounted return the replay's rewards allow (``max |r| / (1 -
+        gamma)``, on the critics' scale), and warn once, with a ``RuntimeWarning``, where the epoch's mean critic
+        value is not finite or lies beyond :data:`DIVERGED` times it (times 1 where it is smaller, the scale of an
+        untrained network's outputs): a diverged critic, whose greedy policy's figures would otherwise look like
+        those of a run that merely learned little."""
+        q, gamma = stats.get("train/q_mean"), self.config.gamma
+        if q is None or len(self.buffer) == 0:
+            return
+        largest = float(self.buffer.data["reward"][: len(self.buffer)].abs().max())
+        bound = stats["train/q_bound"] = largest / (1.0 - gamma) if gamma < 1 else math.inf
+        limit = DIVERGED * max(bound, 1.0)
+        if (math.isfinite(q) and abs(q) <= limit) or self.diverged_warned:
+            return
+        self.diverged_warned = True
+        warnings.warn(
+            f"the critics have likely diverged: their mean value in the epoch ending at step {step:,} is {q:.4g}, "
+            f"beyond {limit:.4g}, {DIVERGED:g} times the largest discounted return the replay's rewards allow "
+            f"(max |reward| {largest:.4g} after reward_scale, gamma {gamma:g}: {bound:.4g}; 1 where smaller); "
+            "the greedy policy's figures mean little from here on. A smaller critic learning rate, a slower target "
+            "(tau) or grad_clip may hold them.",
+            RuntimeWarning,
+            stacklevel=2,
+        )
 
     def _finish_returns(self, counters: np.ndarray, step: Step) -> None:
         """Queue this step's transitions per env copy; write their Monte-Carlo returns when episodes end."""
