@@ -504,7 +504,7 @@ def test_the_benchmark_suite_is_hyars_table_at_its_budgets():
         ("P-DQN", large),
         ("HyAR-TD3", budgets),
         ("PATRPO", budgets),
-        ("Hybrid SAC", budgets),
+        ("Hybrid SAC", budgets.keys() - {"Hard Move n=10"}),  # its critics diverged at n=8: the config says why
     ):
         mine = {s.label.split(" on ")[1]: s for s in specs if s.label.startswith(method + " on ")}
         assert {d: s.total_steps for d, s in mine.items()} == {d: budgets[d] for d in domains}

@@ -447,7 +447,7 @@ def _backlog_text(cells_owed: list[tuple[float | None, int, int, str]]) -> str:
     unpriced = sum(n for cost, n, made, _ in owed if cost is None and made)
     minutes = sum(n * cost for cost, n, _, _ in owed if cost is not None)
     priced = sum(n for cost, n, _, _ in owed if cost is not None)
-    text = f"Runs owed: {sum(n for _, n, _, _ in owed)} over {len(owed)} cells"
+    text = f"Runs owed: {sum(n for _, n, _, _ in owed)} over {len(owed)} cell{'s' * (len(owed) > 1)}"
     if priced:
         text += f"; the {priced} in cells that recorded their cost, about {minutes / 60:.1f} CPU hours at those costs"
     if unpriced:
