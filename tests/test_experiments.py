@@ -763,3 +763,18 @@ def test_runs_whose_summaries_were_kept_are_not_trained_again(tmp_path, capsys):
     assert main(["reproduce", str(exp), "--out", str(out), "--recorded", str(tmp_path / "nowhere"), "--status"]) == 2
     err = capsys.readouterr().err
     assert f"--recorded {tmp_path / 'nowhere'}: not a directory; expected one of run summaries" in err
+
+
+def test_a_runs_warnings_are_kept_in_its_log_and_name_it_where_shown(tmp_path):
+    """A warning raised while a run trains (here: a budget below learning_starts, which trains nothing) is written
+    to the run's stdout.log, which stays with it, and the one shown names the run, as runs side by side share a
+    terminal."""
+    from pamdp.experiments.runner import RunSpec, run_all
+
+    settings = (("num_envs", 2), ("learning_starts", 1000), ("hidden_sizes", (8,)))
+    spec = RunSpec("pdqn", "pamdp/Platform-v0", 40, seed=3, settings=settings, eval_episodes=1, label="too short")
+    with pytest.warns(UserWarning, match=r"^too short, seed 3: total_timesteps = 40 makes no gradient update"):
+        (outcome,) = run_all([(spec, str(tmp_path / "run"))], workers=1, log=lambda msg: None)
+    assert outcome.error is None
+    log = (tmp_path / "run" / "stdout.log").read_text()
+    assert "UserWarning: total_timesteps = 40 makes no gradient update" in log

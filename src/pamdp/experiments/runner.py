@@ -471,6 +471,17 @@ def _stop_when_orphaned(parent: int, every: float = 1.0) -> None:
     threading.Thread(target=watch, name="pamdp-orphan-watch", daemon=True).start()
 
 
+def _also_to(log, run: str, show):
+    """A ``warnings.showwarning`` that also writes each warning to the run's ``log`` (its ``stdout.log``, kept with
+    the run: a diverged critic, say) and names the ``run`` in the one shown, which the runs beside it share."""
+
+    def shown(message, category, filename, lineno, file=None, line=None):
+        print(f"{category.__name__}: {message}", file=log, flush=True)
+        show(f"{run}: {message}", category, filename, lineno, file, line)
+
+    return shown
+
+
 def _worker(spec: RunSpec, out: str, callback=None, parent: int | None = None) -> dict:
     import torch
 
@@ -482,7 +493,8 @@ def _worker(spec: RunSpec, out: str, callback=None, parent: int | None = None) -
     torch.set_num_threads(1)
     log_file = Path(out) / "stdout.log"
     Path(out).mkdir(parents=True, exist_ok=True)
-    with open(log_file, "a") as f:
+    with open(log_file, "a") as f, warnings.catch_warnings():
+        warnings.showwarning = _also_to(f, f"{spec.label or spec.algo}, seed {spec.seed}", warnings.showwarning)
         return train_run(
             spec, out, progress_bar=False, log=lambda msg: print(msg, file=f, flush=True), callback=callback
         )
