@@ -381,7 +381,8 @@ class HybridSACActor(nn.Module):
         self.total = total = hybrid.total_param_size
         # the all-actions vector's entries in the flattened padded (K * m) layout
         self.register_buffer("flat_index", torch.tensor(np.flatnonzero(mask), dtype=torch.long))
-        # every action with all m parameters (Hard Move, Catch Point): the two layouts are one, no gather needed
+        # every action with all m parameters (Hard Move, Platform; not Catch Point, whose second action has none):
+        # the two layouts are one, no gather needed
         self.dense = bool(mask.all())
         if form == "flat":  # starts near uniform, centred, with unit noise, as the hierarchical form does
             self.net = mlp(obs_dim, hidden_sizes, self.n_actions + 2 * total, activation)
